@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Runs galvoplan's whole test suite on a fresh Debian machine with the Rust toolchain.
+# Installs the system packages the build and tests need (only the missing ones), then runs the
+# tests in debug with a target dir shared outside the clone.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$HOME/.cache/galvoplan-target}"
+
+# Build: a C compiler for build scripts. The GUI loads X11/Wayland/EGL/fontconfig at run time
+# only; the kittest GUI tests run headless and need none of them.
+need=()
+for pkg in gcc libc6-dev; do
+  dpkg -s "$pkg" >/dev/null 2>&1 || need+=("$pkg")
+done
+if [ ${#need[@]} -gt 0 ]; then
+  SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+  $SUDO apt-get update -q
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -q "${need[@]}"
+fi
+
+start=$(date +%s)
+# The headless core on its own (no GUI dependencies).
+cargo test --no-default-features --lib --bins
+# Everything: library, CLI, integration and GUI (egui_kittest) tests.
+cargo test --all-targets
+echo "test.sh: done in $(( $(date +%s) - start )) s"

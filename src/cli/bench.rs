@@ -1,0 +1,28 @@
+//! `galvoplan bench`: one row per instance.
+
+use super::BenchArgs;
+use anyhow::{Context, Result};
+use galvoplan::bench::{collect_svgs, format_table, run_instance};
+use galvoplan::document::write_atomic;
+use galvoplan::job::JobCtx;
+
+pub fn run(a: &BenchArgs) -> Result<()> {
+    let profile = a.job.profile()?;
+    let settings = a.job.settings()?;
+    let opts = a.job.import()?;
+    let files = collect_svgs(&a.paths).context("cannot list the benchmark paths")?;
+    anyhow::ensure!(!files.is_empty(), "no SVG files in {:?}", a.paths);
+    let ctx = JobCtx::default();
+    let mut rows = Vec::new();
+    for f in &files {
+        eprintln!("galvoplan: bench {}", f.display());
+        rows.push(run_instance(f, &profile, &settings, &opts, a.repeat, &ctx)?);
+    }
+    print!("{}", format_table(&rows));
+    if let Some(p) = &a.json {
+        let text = serde_json::to_string_pretty(&rows)?;
+        write_atomic(p, text.as_bytes())
+            .with_context(|| format!("{}: cannot write", p.display()))?;
+    }
+    Ok(())
+}

@@ -1,0 +1,181 @@
+//! Command-line front end (clap). Errors print as one line: `galvoplan: error: FILE: what`.
+
+mod bench;
+mod plan;
+mod progress;
+
+use anyhow::Result;
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use galvoplan::document::{Algo, FieldsMode, MachineProfile, SolverSettings};
+use galvoplan::import::ImportOptions;
+use std::path::PathBuf;
+
+/// CAM for redundant laser-marking machines (galvo scanner on an XY base stage).
+#[derive(Parser, Debug)]
+#[command(name = "galvoplan", version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+    /// With no subcommand: an SVG or project file to open in the GUI.
+    file: Option<PathBuf>,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Plan one job: SVG in, G-code (and report, preview) out.
+    Plan(PlanArgs),
+    /// Run the pipeline over SVG files or folders and print one row per instance.
+    Bench(BenchArgs),
+}
+
+/// Field placement, as on the command line.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+enum FieldsArg {
+    /// Greedy serpentine cover (baseline).
+    Greedy,
+}
+
+/// Ordering algorithm, as on the command line.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+enum AlgoArg {
+    /// Fields in creation order, nearest neighbour inside each.
+    Baseline,
+}
+
+/// Options shared by `plan` and `bench`.
+#[derive(Args, Debug, Clone)]
+struct JobOpts {
+    /// Machine profile: a TOML file or a built-in name (seed000, small-field).
+    #[arg(long, default_value = "seed000")]
+    profile: String,
+    /// Scan-field placement.
+    #[arg(long, value_enum, default_value = "greedy")]
+    fields: FieldsArg,
+    /// Ordering algorithm.
+    #[arg(long, value_enum, default_value = "baseline")]
+    algo: AlgoArg,
+    /// Random seed.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Time limit for the ordering stage, s.
+    #[arg(long)]
+    time_limit: Option<f64>,
+    /// Chord tolerance for flattening curves, mm.
+    #[arg(long, default_value_t = 0.01)]
+    chord_tol: f64,
+}
+
+impl JobOpts {
+    fn profile(&self) -> Result<MachineProfile> {
+        Ok(MachineProfile::load(&self.profile)?)
+    }
+    fn settings(&self) -> Result<SolverSettings> {
+        if let Some(t) = self.time_limit {
+            anyhow::ensure!(
+                t.is_finite() && t > 0.0,
+                "--time-limit must be a positive number of seconds, got {t}"
+            );
+        }
+        Ok(SolverSettings {
+            fields: match self.fields {
+                FieldsArg::Greedy => FieldsMode::Greedy,
+            },
+            algo: match self.algo {
+                AlgoArg::Baseline => Algo::Baseline,
+            },
+            seed: self.seed,
+            time_limit_s: self.time_limit,
+            ..SolverSettings::default()
+        })
+    }
+    fn import(&self) -> Result<ImportOptions> {
+        anyhow::ensure!(
+            self.chord_tol.is_finite() && self.chord_tol > 0.0,
+            "--chord-tol must be a positive number of mm, got {}",
+            self.chord_tol
+        );
+        Ok(ImportOptions {
+            chord_tol_mm: self.chord_tol,
+        })
+    }
+}
+
+#[derive(Args, Debug)]
+struct PlanArgs {
+    /// Input SVG.
+    input: PathBuf,
+    /// Output G-code.
+    #[arg(short, long)]
+    output: PathBuf,
+    /// JSON report.
+    #[arg(long)]
+    report: Option<PathBuf>,
+    /// SVG preview of the planned path.
+    #[arg(long)]
+    preview: Option<PathBuf>,
+    /// Write exactly the geometry to be marked as an SVG in mm.
+    #[arg(long)]
+    export_geometry: Option<PathBuf>,
+    #[command(flatten)]
+    job: JobOpts,
+}
+
+#[derive(Args, Debug)]
+struct BenchArgs {
+    /// SVG files or folders of SVGs.
+    #[arg(required = true)]
+    paths: Vec<PathBuf>,
+    /// Also write the rows as JSON.
+    #[arg(long)]
+    json: Option<PathBuf>,
+    /// Runs per instance; times are medians.
+    #[arg(long, default_value_t = 1)]
+    repeat: usize,
+    #[command(flatten)]
+    job: JobOpts,
+}
+
+/// Entry point: parses arguments, runs, prints a one-line error on failure.
+pub fn main() -> std::process::ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Some(Command::Plan(a)) => plan::run(&a),
+        Some(Command::Bench(a)) => bench::run(&a),
+        None => open_gui(cli.file),
+    };
+    match result {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            let msg = one_line(&e);
+            eprintln!("galvoplan: error: {msg}");
+            std::process::ExitCode::FAILURE
+        }
+    }
+}
+
+/// The error and its causes on one line, skipping causes already quoted by their parent.
+fn one_line(e: &anyhow::Error) -> String {
+    let mut msg = String::new();
+    for cause in e.chain() {
+        let text = cause.to_string();
+        if !msg.contains(&text) {
+            if !msg.is_empty() {
+                msg.push_str(": ");
+            }
+            msg.push_str(&text);
+        }
+    }
+    msg.replace('\n', " ")
+}
+
+#[cfg(feature = "gui")]
+fn open_gui(file: Option<PathBuf>) -> Result<()> {
+    galvoplan::app::run(file)
+}
+
+#[cfg(not(feature = "gui"))]
+fn open_gui(_file: Option<PathBuf>) -> Result<()> {
+    anyhow::bail!(
+        "this build has no GUI (built without the `gui` feature); use a subcommand, see --help"
+    )
+}

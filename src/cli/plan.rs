@@ -1,0 +1,78 @@
+//! `galvoplan plan`: one job, SVG in, G-code / report / preview out.
+
+use super::progress::BarProgress;
+use super::PlanArgs;
+use anyhow::{Context, Result};
+use galvoplan::document::write_atomic;
+use galvoplan::export::{geometry_svg, preview_svg, report_json, write_gcode};
+use galvoplan::job::{CancelToken, JobCtx};
+use galvoplan::pipeline::{load_svg, plan_document};
+use std::sync::Arc;
+use std::time::Instant;
+
+pub fn run(a: &PlanArgs) -> Result<()> {
+    let profile = a.job.profile()?;
+    let settings = a.job.settings()?;
+    let opts = a.job.import()?;
+    let (mut doc, import_s) = load_svg(&a.input, profile, settings, &opts)?;
+    for w in &doc.warnings {
+        eprintln!("galvoplan: warning: {}: {w}", a.input.display());
+    }
+    let progress = Arc::new(BarProgress::new());
+    let ctx = JobCtx::new(CancelToken::new(), progress.clone());
+    let result = plan_document(&mut doc, &ctx);
+    progress.finish();
+    let mut plan = result?;
+    let t0 = Instant::now();
+    let source = a.input.display().to_string();
+    let gcode = write_gcode(
+        &doc.geometries,
+        &plan,
+        &doc.profile,
+        doc.page_mm[1],
+        &source,
+    );
+    let preview = a
+        .preview
+        .as_ref()
+        .map(|_| preview_svg(&doc.geometries, &plan, doc.page_mm));
+    let geometry = a
+        .export_geometry
+        .as_ref()
+        .map(|_| geometry_svg(&doc.geometries, doc.page_mm));
+    let export_s = t0.elapsed().as_secs_f64();
+    let t = &mut plan.metrics.solve_s;
+    t.import = import_s;
+    t.export = export_s;
+    t.total = t.import + t.hatch + t.fields + t.order + t.export;
+    let write = |path: &std::path::Path, text: &str| {
+        write_atomic(path, text.as_bytes())
+            .with_context(|| format!("{}: cannot write", path.display()))
+    };
+    write(&a.output, &gcode)?;
+    if let Some(p) = &a.report {
+        write(
+            p,
+            &report_json(&source, &plan, &doc.settings, &doc.warnings),
+        )?;
+    }
+    if let (Some(p), Some(s)) = (&a.preview, &preview) {
+        write(p, s)?;
+    }
+    if let (Some(p), Some(s)) = (&a.export_geometry, &geometry) {
+        write(p, s)?;
+    }
+    let m = &plan.metrics;
+    eprintln!(
+        "galvoplan: {}: {} geometries, {} fields, idle {:.1} mm, base {:.1} mm, marked {:.1} mm, {} direction changes, {:.1} ms",
+        source,
+        doc.geometries.len(),
+        m.fields,
+        m.idle_mm,
+        m.base_mm,
+        m.marked_mm,
+        m.direction_changes,
+        m.solve_s.total * 1e3
+    );
+    Ok(())
+}

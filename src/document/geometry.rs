@@ -1,0 +1,167 @@
+//! One continuous stroke of the artwork.
+
+use crate::geom::{polyline_length, BBox, Pt};
+use serde::{Deserialize, Serialize};
+
+/// Where a geometry came from in the source file.
+#[derive(Debug, Clone, Default, Serialize, Deserialize, PartialEq)]
+pub struct Source {
+    /// The element's `id`, or a description such as `path #12` when it has none.
+    pub element: String,
+    /// Index of the subpath inside the element (0 for the first).
+    pub subpath: usize,
+    /// Layer: the stroke colour as `#rrggbb` (or `none`).
+    pub layer: String,
+}
+
+/// One continuous stroke: a polyline in mm.
+///
+/// A closed geometry does not repeat its first point; it may start at any vertex and is
+/// marked back to that vertex. An open one starts at either end.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct Geometry {
+    /// Vertices in mm (machine coordinates).
+    pub points: Vec<Pt>,
+    /// True when the stroke returns to its first vertex.
+    pub closed: bool,
+    /// Origin in the source file.
+    pub source: Source,
+}
+
+impl Geometry {
+    /// Makes a geometry; for a closed one a repeated last point is dropped.
+    pub fn new(mut points: Vec<Pt>, closed: bool, source: Source) -> Self {
+        if closed && points.len() > 1 {
+            if let (Some(a), Some(b)) = (points.first(), points.last()) {
+                if a.dist(*b) < 1e-9 {
+                    points.pop();
+                }
+            }
+        }
+        Self {
+            points,
+            closed,
+            source,
+        }
+    }
+    /// Bounding box.
+    pub fn bbox(&self) -> BBox {
+        BBox::of(&self.points)
+    }
+    /// Marked length in mm.
+    pub fn length_mm(&self) -> f64 {
+        polyline_length(&self.points, self.closed)
+    }
+    /// Centroid of the vertices (used as the geometry's representative point).
+    pub fn centroid(&self) -> Pt {
+        let n = self.points.len().max(1) as f64;
+        let s = self.points.iter().fold(Pt::default(), |a, &p| a.add(p));
+        s.scale(1.0 / n)
+    }
+    /// Number of possible start choices: every vertex of a closed geometry, both ends of an open one.
+    pub fn start_choices(&self) -> usize {
+        if self.closed {
+            self.points.len()
+        } else {
+            2
+        }
+    }
+    /// The (start, end) points of the stroke for a start choice `c < start_choices()`:
+    /// closed geometries start and end at vertex `c`; open ones run forwards (`c == 0`) or backwards.
+    pub fn ends(&self, choice: usize) -> (Pt, Pt) {
+        let first = self.points.first().copied().unwrap_or_default();
+        let last = self.points.last().copied().unwrap_or_default();
+        if self.closed {
+            let p = self.points.get(choice).copied().unwrap_or(first);
+            (p, p)
+        } else if choice == 0 {
+            (first, last)
+        } else {
+            (last, first)
+        }
+    }
+    /// A short human description: element, subpath and size.
+    pub fn describe(&self) -> String {
+        let b = self.bbox();
+        format!(
+            "{} (subpath {}, {:.2} × {:.2} mm at x {:.2}, y {:.2})",
+            self.source.element,
+            self.source.subpath,
+            b.width(),
+            b.height(),
+            b.min_x,
+            b.min_y
+        )
+    }
+    /// The points in marking order for a start vertex and direction.
+    ///
+    /// Closed: `start_vertex` onwards (or backwards when `reversed`) and back to it.
+    /// Open: as stored, or reversed.
+    pub fn marking_path(&self, start_vertex: usize, reversed: bool) -> Vec<Pt> {
+        let n = self.points.len();
+        if n == 0 {
+            return Vec::new();
+        }
+        if !self.closed {
+            let mut v = self.points.clone();
+            if reversed {
+                v.reverse();
+            }
+            return v;
+        }
+        let s = start_vertex % n;
+        (0..=n)
+            .map(|i| {
+                let k = if reversed {
+                    (s + n - i % n) % n
+                } else {
+                    (s + i) % n
+                };
+                self.points[k]
+            })
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sq() -> Geometry {
+        let pts = vec![
+            Pt::new(0.0, 0.0),
+            Pt::new(1.0, 0.0),
+            Pt::new(1.0, 1.0),
+            Pt::new(0.0, 1.0),
+            Pt::new(0.0, 0.0),
+        ];
+        Geometry::new(pts, true, Source::default())
+    }
+
+    #[test]
+    fn closed_drops_repeated_point_and_walks_back() {
+        let g = sq();
+        assert_eq!(g.points.len(), 4);
+        assert!((g.length_mm() - 4.0).abs() < 1e-12);
+        let p = g.marking_path(2, false);
+        assert_eq!(p.len(), 5);
+        assert_eq!(p[0], Pt::new(1.0, 1.0));
+        assert_eq!(p[4], Pt::new(1.0, 1.0));
+        assert_eq!(p[1], Pt::new(0.0, 1.0));
+        let r = g.marking_path(2, true);
+        assert_eq!(r[1], Pt::new(1.0, 0.0));
+        assert_eq!(g.ends(3), (Pt::new(0.0, 1.0), Pt::new(0.0, 1.0)));
+    }
+
+    #[test]
+    fn open_ends() {
+        let g = Geometry::new(
+            vec![Pt::new(0.0, 0.0), Pt::new(2.0, 0.0)],
+            false,
+            Source::default(),
+        );
+        assert_eq!(g.start_choices(), 2);
+        assert_eq!(g.ends(1), (Pt::new(2.0, 0.0), Pt::new(0.0, 0.0)));
+        assert_eq!(g.marking_path(0, true)[0], Pt::new(2.0, 0.0));
+    }
+}

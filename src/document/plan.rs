@@ -1,0 +1,151 @@
+//! Scan fields and plans (ordered strokes plus metrics).
+
+use crate::geom::{BBox, Pt};
+use serde::{Deserialize, Serialize};
+
+use super::Algo;
+
+/// A scan field: the base parks at `center` and the scanner reaches `size` around it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ScanField {
+    /// Id, unique within a document (report and G-code comments use it).
+    pub id: usize,
+    /// Centre in mm = base position.
+    pub center: Pt,
+    /// Size (x, y) in mm.
+    pub size: [f64; 2],
+    /// Placed by the operator: automatic placement keeps it.
+    #[serde(default)]
+    pub locked: bool,
+    /// Geometries allocated to this field (indices into the document's geometries).
+    #[serde(default)]
+    pub geometries: Vec<usize>,
+}
+
+impl ScanField {
+    /// The area the scanner reaches.
+    pub fn bbox(&self) -> BBox {
+        BBox::centered(self.center, self.size[0], self.size[1])
+    }
+}
+
+/// One stroke of a plan: which geometry, in which field, from which vertex, in which direction.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Step {
+    /// Geometry index.
+    pub geometry: usize,
+    /// Field id.
+    pub field: usize,
+    /// Start vertex: any vertex of a closed geometry; 0 or the last vertex of an open one.
+    pub start_vertex: usize,
+    /// Marked backwards (for an open geometry: from its last vertex).
+    pub reversed: bool,
+}
+
+impl Step {
+    /// The step for a start choice as in [`crate::document::Geometry::ends`].
+    pub fn from_choice(geometry: usize, field: usize, g: &super::Geometry, choice: usize) -> Step {
+        if g.closed {
+            Step {
+                geometry,
+                field,
+                start_vertex: choice,
+                reversed: false,
+            }
+        } else {
+            Step {
+                geometry,
+                field,
+                start_vertex: if choice == 0 {
+                    0
+                } else {
+                    g.points.len().saturating_sub(1)
+                },
+                reversed: choice != 0,
+            }
+        }
+    }
+    /// The start choice index of this step (inverse of [`Step::from_choice`]).
+    pub fn choice(&self, g: &super::Geometry) -> usize {
+        if g.closed {
+            self.start_vertex
+        } else {
+            usize::from(self.reversed)
+        }
+    }
+}
+
+/// Wall time per pipeline stage, in s.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct StageTimes {
+    /// SVG import and normalisation.
+    pub import: f64,
+    /// Hatch generation.
+    pub hatch: f64,
+    /// Scan-field placement and allocation.
+    pub fields: f64,
+    /// Ordering (baseline / HHA / HGA).
+    pub order: f64,
+    /// Export (G-code, report, preview).
+    pub export: f64,
+    /// Sum of the stages.
+    pub total: f64,
+}
+
+/// Metrics of a plan (definitions in DESIGN.md and [`crate::order::metrics`]).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Metrics {
+    /// Laser-off travel between consecutive strokes, mm.
+    pub idle_mm: f64,
+    /// Marked length, mm.
+    pub marked_mm: f64,
+    /// Length of the polyline through the field centres in visiting order, mm.
+    pub base_mm: f64,
+    /// Number of scan fields.
+    pub fields: usize,
+    /// A lower bound on the number of fields, when known.
+    pub fields_lower_bound: Option<usize>,
+    /// Area covered by exactly one field, mm².
+    pub covered_area_mm2: f64,
+    /// 1 − covered / (fields × field area), in %.
+    pub overlap_pct: f64,
+    /// Sign reversals of the travel direction along the base path.
+    pub direction_changes: usize,
+    /// Estimated step-and-scan machine time, s.
+    pub job_time_s: Option<f64>,
+    /// Wall time per stage, s.
+    pub solve_s: StageTimes,
+}
+
+/// One GA generation in a plan's convergence history.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct GenerationRecord {
+    /// Generation number (0 = initial population).
+    pub generation: usize,
+    /// Best idle travel, mm.
+    pub best_idle_mm: f64,
+    /// Mean idle travel of the population, mm.
+    pub mean_idle_mm: f64,
+    /// Population size.
+    pub population: usize,
+    /// Seconds since the start of the run.
+    pub elapsed_s: f64,
+}
+
+/// The result of one ordering run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Plan {
+    /// Display name (e.g. "HHA #1").
+    pub name: String,
+    /// The algorithm that made it.
+    pub algo: Algo,
+    /// The fields it was planned on, in visiting order.
+    pub fields: Vec<ScanField>,
+    /// Strokes in marking order.
+    pub order: Vec<Step>,
+    /// Its metrics.
+    pub metrics: Metrics,
+    /// GA convergence history (empty for other algorithms).
+    #[serde(default)]
+    pub history: Vec<GenerationRecord>,
+}

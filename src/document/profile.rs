@@ -1,0 +1,324 @@
+//! Machine profiles: stroke, scan field, dynamics, laser timing and G-code dialect (TOML).
+
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+/// Current profile format version.
+pub const PROFILE_VERSION: u32 = 1;
+
+/// Limits of one base-stage axis (seed 002, Table 2 style).
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(default, deny_unknown_fields)]
+pub struct AxisLimits {
+    /// Maximum velocity in mm/s.
+    pub max_velocity_mm_s: f64,
+    /// Maximum acceleration in mm/s².
+    pub max_accel_mm_s2: f64,
+}
+
+impl Default for AxisLimits {
+    fn default() -> Self {
+        Self {
+            max_velocity_mm_s: 500.0,
+            max_accel_mm_s2: 5_000.0,
+        }
+    }
+}
+
+/// Scanner speeds.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(default, deny_unknown_fields)]
+pub struct ScannerSpeeds {
+    /// Jump (laser off) speed in mm/s.
+    pub jump_speed_mm_s: f64,
+    /// Mark (laser on) speed in mm/s.
+    pub mark_speed_mm_s: f64,
+}
+
+impl Default for ScannerSpeeds {
+    fn default() -> Self {
+        Self {
+            jump_speed_mm_s: 5_000.0,
+            mark_speed_mm_s: 1_000.0,
+        }
+    }
+}
+
+/// Laser timing.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(default, deny_unknown_fields)]
+pub struct LaserTiming {
+    /// Delay after switching on, in s.
+    pub on_delay_s: f64,
+    /// Delay after switching off, in s.
+    pub off_delay_s: f64,
+    /// Settling delay after a scanner jump, in s.
+    pub jump_delay_s: f64,
+}
+
+impl Default for LaserTiming {
+    fn default() -> Self {
+        Self {
+            on_delay_s: 100e-6,
+            off_delay_s: 100e-6,
+            jump_delay_s: 200e-6,
+        }
+    }
+}
+
+/// G-code dialect options. The defaults produce the contract in DESIGN.md.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(default, deny_unknown_fields)]
+pub struct GcodeDialect {
+    /// Word that switches the laser on (`M3` or `M4`).
+    pub laser_on: String,
+    /// Word that switches the laser off.
+    pub laser_off: String,
+    /// Laser power written as `S..` after the on word; none when absent.
+    pub power: Option<f64>,
+    /// Marking feed in mm/min written on `G1`.
+    pub feed_mm_min: f64,
+    /// Decimal places for coordinates.
+    pub decimals: usize,
+    /// Mirror Y about the page height (for y-up machines).
+    pub flip_y: bool,
+}
+
+impl Default for GcodeDialect {
+    fn default() -> Self {
+        Self {
+            laser_on: "M3".into(),
+            laser_off: "M5".into(),
+            power: None,
+            feed_mm_min: 60_000.0,
+            decimals: 4,
+            flip_y: false,
+        }
+    }
+}
+
+/// A redundant laser-marking machine: base stage plus galvanometer scanner.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(default, deny_unknown_fields)]
+pub struct MachineProfile {
+    /// Format version ([`PROFILE_VERSION`]).
+    pub version: u32,
+    /// Display name.
+    pub name: String,
+    /// Base-stage stroke (x, y) in mm: field centres range over `[0, stroke]`.
+    pub stroke_mm: [f64; 2],
+    /// Scan-field size (x, y) in mm.
+    pub field_mm: [f64; 2],
+    /// Base-stage X axis.
+    pub axis_x: AxisLimits,
+    /// Base-stage Y axis.
+    pub axis_y: AxisLimits,
+    /// Scanner speeds.
+    pub scanner: ScannerSpeeds,
+    /// Laser timing.
+    pub laser: LaserTiming,
+    /// G-code output options.
+    pub gcode: GcodeDialect,
+}
+
+impl Default for MachineProfile {
+    fn default() -> Self {
+        Self {
+            version: PROFILE_VERSION,
+            name: "seed000 (300 × 300 mm stroke, 70 × 70 mm field)".into(),
+            stroke_mm: [300.0, 300.0],
+            field_mm: [70.0, 70.0],
+            axis_x: AxisLimits::default(),
+            axis_y: AxisLimits::default(),
+            scanner: ScannerSpeeds::default(),
+            laser: LaserTiming::default(),
+            gcode: GcodeDialect::default(),
+        }
+    }
+}
+
+/// Errors reading or validating a profile.
+#[derive(Debug, Error)]
+pub enum ProfileError {
+    /// The file could not be read.
+    #[error("{file}: cannot read profile: {source}")]
+    Io {
+        /// The file.
+        file: String,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// The TOML did not parse.
+    #[error("{file}: invalid profile: {msg}")]
+    Parse {
+        /// The file.
+        file: String,
+        /// Parser message (with line and column).
+        msg: String,
+    },
+    /// A value is out of range.
+    #[error("{file}: invalid profile: {msg}")]
+    Invalid {
+        /// The file.
+        file: String,
+        /// What is wrong.
+        msg: String,
+    },
+    /// No built-in profile by that name.
+    #[error("no built-in profile named '{0}' (known: {known})", known = BUILTIN.iter().map(|b| b.0).collect::<Vec<_>>().join(", "))]
+    Unknown(String),
+}
+
+/// Built-in profiles: (name, TOML text).
+pub const BUILTIN: &[(&str, &str)] = &[
+    (
+        "seed000",
+        include_str!("../../assets/profiles/seed000.toml"),
+    ),
+    (
+        "small-field",
+        include_str!("../../assets/profiles/small-field.toml"),
+    ),
+];
+
+impl MachineProfile {
+    /// Parses and validates a profile from TOML text; `file` names it in errors.
+    pub fn from_toml(text: &str, file: &str) -> Result<Self, ProfileError> {
+        let p: MachineProfile = toml::from_str(text).map_err(|e| ProfileError::Parse {
+            file: file.into(),
+            msg: e.to_string().replace('\n', " "),
+        })?;
+        p.validate().map_err(|msg| ProfileError::Invalid {
+            file: file.into(),
+            msg,
+        })?;
+        Ok(p)
+    }
+    /// Reads a profile file, or a built-in profile when `path` names one.
+    pub fn load(path: &str) -> Result<Self, ProfileError> {
+        if let Some((name, text)) = BUILTIN.iter().find(|(n, _)| *n == path) {
+            return Self::from_toml(text, name);
+        }
+        let text = std::fs::read_to_string(path).map_err(|source| ProfileError::Io {
+            file: path.into(),
+            source,
+        })?;
+        Self::from_toml(&text, path)
+    }
+    /// A built-in profile by name.
+    pub fn builtin(name: &str) -> Result<Self, ProfileError> {
+        BUILTIN
+            .iter()
+            .find(|(n, _)| *n == name)
+            .ok_or_else(|| ProfileError::Unknown(name.into()))
+            .and_then(|(n, t)| Self::from_toml(t, n))
+    }
+    /// Serialises to TOML.
+    pub fn to_toml(&self) -> String {
+        toml::to_string_pretty(self).unwrap_or_default()
+    }
+    /// Checks ranges; returns a message naming the first bad value.
+    pub fn validate(&self) -> Result<(), String> {
+        if self.version == 0 || self.version > PROFILE_VERSION {
+            return Err(format!(
+                "version {} not supported (this build reads up to {PROFILE_VERSION})",
+                self.version
+            ));
+        }
+        let positive = [
+            ("stroke_mm[0]", self.stroke_mm[0], true),
+            ("stroke_mm[1]", self.stroke_mm[1], true),
+            ("field_mm[0]", self.field_mm[0], false),
+            ("field_mm[1]", self.field_mm[1], false),
+            (
+                "axis_x.max_velocity_mm_s",
+                self.axis_x.max_velocity_mm_s,
+                false,
+            ),
+            ("axis_x.max_accel_mm_s2", self.axis_x.max_accel_mm_s2, false),
+            (
+                "axis_y.max_velocity_mm_s",
+                self.axis_y.max_velocity_mm_s,
+                false,
+            ),
+            ("axis_y.max_accel_mm_s2", self.axis_y.max_accel_mm_s2, false),
+            (
+                "scanner.jump_speed_mm_s",
+                self.scanner.jump_speed_mm_s,
+                false,
+            ),
+            (
+                "scanner.mark_speed_mm_s",
+                self.scanner.mark_speed_mm_s,
+                false,
+            ),
+            ("gcode.feed_mm_min", self.gcode.feed_mm_min, false),
+        ];
+        for (name, v, zero_ok) in positive {
+            let ok = v.is_finite() && (v > 0.0 || (zero_ok && v == 0.0));
+            if !ok {
+                return Err(format!("{name} = {v} must be a positive number"));
+            }
+        }
+        for (name, v) in [
+            ("laser.on_delay_s", self.laser.on_delay_s),
+            ("laser.off_delay_s", self.laser.off_delay_s),
+            ("laser.jump_delay_s", self.laser.jump_delay_s),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(format!("{name} = {v} must be zero or positive"));
+            }
+        }
+        if self.gcode.decimals > 9 {
+            return Err("gcode.decimals must be at most 9".into());
+        }
+        for (name, w) in [
+            ("gcode.laser_on", &self.gcode.laser_on),
+            ("gcode.laser_off", &self.gcode.laser_off),
+        ] {
+            if w.trim().is_empty() {
+                return Err(format!("{name} must not be empty"));
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn builtins_parse_and_seed_machine_matches_paper() {
+        for (name, _) in BUILTIN {
+            MachineProfile::builtin(name).unwrap();
+        }
+        let p = MachineProfile::builtin("seed000").unwrap();
+        assert_eq!(p.stroke_mm, [300.0, 300.0]);
+        assert_eq!(p.field_mm, [70.0, 70.0]);
+        assert!(!p.gcode.flip_y);
+    }
+
+    #[test]
+    fn toml_round_trip() {
+        let p = MachineProfile::default();
+        let q = MachineProfile::from_toml(&p.to_toml(), "x").unwrap();
+        assert_eq!(p, q);
+    }
+
+    #[test]
+    fn bad_values_are_named() {
+        let e = MachineProfile::from_toml("version = 1\nfield_mm = [0.0, 70.0]\n", "p.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("p.toml") && e.contains("field_mm[0]"), "{e}");
+        let e = MachineProfile::from_toml("version = 1\nbogus = 3\n", "p.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("bogus"), "{e}");
+        let e = MachineProfile::from_toml("version = 99\n", "p.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("version 99"), "{e}");
+    }
+}

@@ -1,0 +1,117 @@
+//! Solver settings: which field placement and ordering to run, seed, limits, GA parameters.
+
+use serde::{Deserialize, Serialize};
+
+/// How scan fields are placed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum FieldsMode {
+    /// Greedy cover in serpentine order (baseline).
+    #[default]
+    Greedy,
+}
+
+/// Which ordering algorithm runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum Algo {
+    /// Fields in creation order, nearest neighbour inside each field.
+    #[default]
+    Baseline,
+}
+
+/// How start vertices are chosen once the order is fixed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum VertexMode {
+    /// Seed 000's vertex enhancement algorithm only.
+    Vea,
+    /// VEA followed by the exact layered-graph shortest path.
+    #[default]
+    Exact,
+}
+
+/// Cost of moving between two points.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum CostModel {
+    /// Euclidean distance in mm.
+    #[default]
+    Distance,
+    /// Machine time from the profile's dynamics (seed 002).
+    Time,
+}
+
+/// Parameters of the hybrid genetic algorithm (seed 000 §3.3.6 defaults).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct GaParams {
+    /// Initial population size `ps`.
+    pub population: usize,
+    /// Smallest population size.
+    pub population_min: usize,
+    /// Largest population size.
+    pub population_max: usize,
+    /// Fraction of the population kept as elite.
+    pub elite_fraction: f64,
+    /// Mutation probability.
+    pub mutation_rate: f64,
+    /// Stop after this many generations without improvement.
+    pub stall_generations: usize,
+    /// Seed the population with the HHA plan.
+    pub seed_with_hha: bool,
+}
+
+impl Default for GaParams {
+    fn default() -> Self {
+        Self {
+            population: 32,
+            population_min: 16,
+            population_max: 48,
+            elite_fraction: 0.2,
+            mutation_rate: 0.3,
+            stall_generations: 5,
+            seed_with_hha: false,
+        }
+    }
+}
+
+/// Settings of one planning run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct SolverSettings {
+    /// Field placement.
+    pub fields: FieldsMode,
+    /// Ordering algorithm.
+    pub algo: Algo,
+    /// Random seed (all randomised stages are deterministic for a given seed).
+    pub seed: u64,
+    /// Time limit for the ordering stage in s (none: the algorithm's own termination).
+    pub time_limit_s: Option<f64>,
+    /// Directional penalty weight (seed 000 Eq. 7; 0.1 is used with one field).
+    pub direction_weight: f64,
+    /// Start-vertex choice.
+    pub vertex: VertexMode,
+    /// Cost model.
+    pub cost_model: CostModel,
+    /// Cut geometries larger than a field at field borders instead of failing.
+    pub split_oversize: bool,
+    /// GA parameters.
+    pub ga: GaParams,
+}
+
+impl Default for SolverSettings {
+    fn default() -> Self {
+        Self {
+            fields: FieldsMode::default(),
+            algo: Algo::default(),
+            seed: 1,
+            time_limit_s: None,
+            direction_weight: 0.5,
+            vertex: VertexMode::default(),
+            cost_model: CostModel::default(),
+            split_oversize: false,
+            ga: GaParams::default(),
+        }
+    }
+}

@@ -1,0 +1,200 @@
+//! Plane geometry helpers: points, bounding boxes, distances and curve flattening.
+//!
+//! All coordinates are millimetres in machine coordinates (x right, y down, as in SVG).
+
+mod flatten;
+
+pub use flatten::{flatten_cubic, flatten_quad};
+
+use serde::{Deserialize, Serialize};
+
+/// A point (or vector) in millimetres.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct Pt {
+    /// x in mm.
+    pub x: f64,
+    /// y in mm.
+    pub y: f64,
+}
+
+impl Pt {
+    /// Makes a point.
+    pub const fn new(x: f64, y: f64) -> Self {
+        Self { x, y }
+    }
+    /// Euclidean distance to `o`, in mm.
+    pub fn dist(self, o: Pt) -> f64 {
+        (self.x - o.x).hypot(self.y - o.y)
+    }
+    /// Squared distance to `o`, in mm².
+    pub fn dist2(self, o: Pt) -> f64 {
+        let (dx, dy) = (self.x - o.x, self.y - o.y);
+        dx * dx + dy * dy
+    }
+    /// Vector difference `self - o`.
+    pub fn sub(self, o: Pt) -> Pt {
+        Pt::new(self.x - o.x, self.y - o.y)
+    }
+    /// Vector sum `self + o`.
+    pub fn add(self, o: Pt) -> Pt {
+        Pt::new(self.x + o.x, self.y + o.y)
+    }
+    /// Scales by `k`.
+    pub fn scale(self, k: f64) -> Pt {
+        Pt::new(self.x * k, self.y * k)
+    }
+    /// Dot product.
+    pub fn dot(self, o: Pt) -> f64 {
+        self.x * o.x + self.y * o.y
+    }
+    /// Length of the vector.
+    pub fn norm(self) -> f64 {
+        self.x.hypot(self.y)
+    }
+    /// True when both coordinates are finite.
+    pub fn is_finite(self) -> bool {
+        self.x.is_finite() && self.y.is_finite()
+    }
+}
+
+/// An axis-aligned bounding box in mm.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct BBox {
+    /// Smallest x.
+    pub min_x: f64,
+    /// Smallest y.
+    pub min_y: f64,
+    /// Largest x.
+    pub max_x: f64,
+    /// Largest y.
+    pub max_y: f64,
+}
+
+impl BBox {
+    /// The empty box (inverted, so that any point extends it).
+    pub const EMPTY: BBox = BBox {
+        min_x: f64::INFINITY,
+        min_y: f64::INFINITY,
+        max_x: f64::NEG_INFINITY,
+        max_y: f64::NEG_INFINITY,
+    };
+    /// The box of a set of points (`EMPTY` for none).
+    pub fn of(points: &[Pt]) -> BBox {
+        let mut b = BBox::EMPTY;
+        for &p in points {
+            b.extend(p);
+        }
+        b
+    }
+    /// A box centred on `c` with size `w` × `h`.
+    pub fn centered(c: Pt, w: f64, h: f64) -> BBox {
+        BBox {
+            min_x: c.x - w / 2.0,
+            min_y: c.y - h / 2.0,
+            max_x: c.x + w / 2.0,
+            max_y: c.y + h / 2.0,
+        }
+    }
+    /// Grows the box to hold `p`.
+    pub fn extend(&mut self, p: Pt) {
+        self.min_x = self.min_x.min(p.x);
+        self.min_y = self.min_y.min(p.y);
+        self.max_x = self.max_x.max(p.x);
+        self.max_y = self.max_y.max(p.y);
+    }
+    /// The union of two boxes.
+    pub fn union(self, o: BBox) -> BBox {
+        BBox {
+            min_x: self.min_x.min(o.min_x),
+            min_y: self.min_y.min(o.min_y),
+            max_x: self.max_x.max(o.max_x),
+            max_y: self.max_y.max(o.max_y),
+        }
+    }
+    /// Width in mm.
+    pub fn width(&self) -> f64 {
+        self.max_x - self.min_x
+    }
+    /// Height in mm.
+    pub fn height(&self) -> f64 {
+        self.max_y - self.min_y
+    }
+    /// Centre point.
+    pub fn center(&self) -> Pt {
+        Pt::new(
+            (self.min_x + self.max_x) / 2.0,
+            (self.min_y + self.max_y) / 2.0,
+        )
+    }
+    /// True when `o` lies wholly inside `self`, allowing `eps` mm of slack.
+    pub fn contains_box(&self, o: &BBox, eps: f64) -> bool {
+        o.min_x >= self.min_x - eps
+            && o.max_x <= self.max_x + eps
+            && o.min_y >= self.min_y - eps
+            && o.max_y <= self.max_y + eps
+    }
+    /// True when `p` lies inside, allowing `eps` mm of slack.
+    pub fn contains_pt(&self, p: Pt, eps: f64) -> bool {
+        p.x >= self.min_x - eps
+            && p.x <= self.max_x + eps
+            && p.y >= self.min_y - eps
+            && p.y <= self.max_y + eps
+    }
+    /// Area in mm² (0 for an empty box).
+    pub fn area(&self) -> f64 {
+        if self.is_empty() {
+            0.0
+        } else {
+            self.width() * self.height()
+        }
+    }
+    /// True for the empty box.
+    pub fn is_empty(&self) -> bool {
+        self.min_x > self.max_x || self.min_y > self.max_y
+    }
+}
+
+/// Length of a polyline in mm; `closed` adds the segment back to the first point.
+pub fn polyline_length(points: &[Pt], closed: bool) -> f64 {
+    let open: f64 = points.windows(2).map(|w| w[0].dist(w[1])).sum();
+    match (closed, points.first(), points.last()) {
+        (true, Some(&a), Some(&b)) if points.len() > 1 => open + a.dist(b),
+        _ => open,
+    }
+}
+
+/// Distance from `p` to the segment `a`–`b`, in mm.
+pub fn point_segment_dist(p: Pt, a: Pt, b: Pt) -> f64 {
+    let ab = b.sub(a);
+    let len2 = ab.dot(ab);
+    if len2 <= 0.0 {
+        return p.dist(a);
+    }
+    let t = (p.sub(a).dot(ab) / len2).clamp(0.0, 1.0);
+    p.dist(a.add(ab.scale(t)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bbox_and_length() {
+        let pts = [Pt::new(0.0, 0.0), Pt::new(3.0, 0.0), Pt::new(3.0, 4.0)];
+        let b = BBox::of(&pts);
+        assert_eq!((b.width(), b.height()), (3.0, 4.0));
+        assert!((polyline_length(&pts, false) - 7.0).abs() < 1e-12);
+        assert!((polyline_length(&pts, true) - 12.0).abs() < 1e-12);
+        assert!(b.contains_pt(Pt::new(1.0, 1.0), 0.0));
+        assert!(!b.contains_pt(Pt::new(-0.1, 1.0), 0.0));
+        assert!(BBox::EMPTY.is_empty());
+    }
+
+    #[test]
+    fn segment_distance() {
+        let d = point_segment_dist(Pt::new(1.0, 1.0), Pt::new(0.0, 0.0), Pt::new(2.0, 0.0));
+        assert!((d - 1.0).abs() < 1e-12);
+        let d = point_segment_dist(Pt::new(-1.0, 0.0), Pt::new(0.0, 0.0), Pt::new(2.0, 0.0));
+        assert!((d - 1.0).abs() < 1e-12);
+    }
+}

@@ -1,0 +1,7 @@
+//! The `galvoplan` binary: no subcommand opens the GUI; subcommands run headless.
+
+mod cli;
+
+fn main() -> std::process::ExitCode {
+    cli::main()
+}

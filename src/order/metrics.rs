@@ -1,0 +1,280 @@
+//! Plan metrics. Every report, benchmark and GUI table uses these definitions (DESIGN.md).
+//!
+//! * `idle_mm`: Σ over consecutive strokes of the straight distance from where one ends to where
+//!   the next starts (laser off). The approach from the start position and a final return are
+//!   excluded.
+//! * `marked_mm`: total marked length.
+//! * `base_mm`: length of the polyline through the field centres in visiting order.
+//! * `covered_area_mm2`: area covered by exactly one field (seed 000 §5.1);
+//!   `overlap_pct = 100 · (1 − covered / (fields · field area))`.
+//! * `direction_changes`: see [`direction_changes`].
+//! * `job_time_s`: step-and-scan estimate, see [`job_time_s`].
+
+use crate::document::{Geometry, MachineProfile, Metrics, ScanField, Step};
+use crate::geom::Pt;
+
+/// Computes all metrics of an ordering; `fields` in visiting order.
+pub fn compute(
+    geometries: &[Geometry],
+    fields: &[ScanField],
+    steps: &[Step],
+    profile: &MachineProfile,
+) -> Metrics {
+    let idle_mm = idle_mm(geometries, steps);
+    let marked_mm = steps
+        .iter()
+        .map(|s| geometries[s.geometry].length_mm())
+        .sum();
+    let centers: Vec<Pt> = fields.iter().map(|f| f.center).collect();
+    let base_mm = centers.windows(2).map(|w| w[0].dist(w[1])).sum();
+    let (covered_area_mm2, overlap_pct) = coverage(fields, profile.field_mm);
+    Metrics {
+        idle_mm,
+        marked_mm,
+        base_mm,
+        fields: fields.len(),
+        fields_lower_bound: None,
+        covered_area_mm2,
+        overlap_pct,
+        direction_changes: direction_changes(geometries, fields, steps, profile.field_mm),
+        job_time_s: Some(job_time_s(geometries, fields, steps, profile)),
+        solve_s: Default::default(),
+    }
+}
+
+/// Start and end point of a step.
+pub fn step_ends(geometries: &[Geometry], s: &Step) -> (Pt, Pt) {
+    let g = &geometries[s.geometry];
+    g.ends(s.choice(g))
+}
+
+/// Laser-off travel between consecutive strokes, mm.
+pub fn idle_mm(geometries: &[Geometry], steps: &[Step]) -> f64 {
+    steps
+        .windows(2)
+        .map(|w| {
+            step_ends(geometries, &w[0])
+                .1
+                .dist(step_ends(geometries, &w[1]).0)
+        })
+        .sum()
+}
+
+/// Area covered by exactly one field and the overlap percentage (seed 000 §5.1).
+///
+/// Exact for axis-aligned fields: a sweep over the x-slabs between field edges, and in each
+/// slab over the y-intervals, counting how many fields cover each piece.
+pub fn coverage(fields: &[ScanField], field_mm: [f64; 2]) -> (f64, f64) {
+    if fields.is_empty() {
+        return (0.0, 0.0);
+    }
+    let boxes: Vec<_> = fields.iter().map(ScanField::bbox).collect();
+    let mut xs: Vec<f64> = boxes.iter().flat_map(|b| [b.min_x, b.max_x]).collect();
+    xs.sort_by(f64::total_cmp);
+    xs.dedup();
+    let mut once = 0.0;
+    let mut events: Vec<(f64, i32)> = Vec::new();
+    for w in xs.windows(2) {
+        let (x0, x1) = (w[0], w[1]);
+        if x1 <= x0 {
+            continue;
+        }
+        let xm = (x0 + x1) / 2.0;
+        events.clear();
+        for b in boxes.iter().filter(|b| b.min_x <= xm && xm <= b.max_x) {
+            events.push((b.min_y, 1));
+            events.push((b.max_y, -1));
+        }
+        events.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        let mut depth = 0;
+        let mut last_y = f64::NEG_INFINITY;
+        let mut len_once = 0.0;
+        for &(y, d) in &events {
+            if depth == 1 {
+                len_once += y - last_y;
+            }
+            depth += d;
+            last_y = y;
+        }
+        once += len_once * (x1 - x0);
+    }
+    let full = fields.len() as f64 * field_mm[0] * field_mm[1];
+    let overlap_pct = if full > 0.0 {
+        100.0 * (1.0 - once / full)
+    } else {
+        0.0
+    };
+    (once, overlap_pct)
+}
+
+/// Number of direction changes of the TCP path along the base path (seed 000 §2.3).
+///
+/// The sweep is followed through the geometries' centroids in marking order. Each move from one
+/// centroid to the next is projected onto the *local base direction* of the field being left:
+/// the unit vector from that field's centre to the next field's centre (for the last field, from
+/// the previous field's centre; with a single field, from the first to the last centroid). Moves
+/// whose projection is shorter than 1 % of the field width are ignored (sideways steps within a
+/// row); every sign reversal between the remaining projections counts as one direction change.
+/// A plan that sweeps steadily from field to field scores 0; a nearest-neighbour zigzag scores high.
+pub fn direction_changes(
+    geometries: &[Geometry],
+    fields: &[ScanField],
+    steps: &[Step],
+    field_mm: [f64; 2],
+) -> usize {
+    if steps.len() < 3 {
+        return 0;
+    }
+    let centroids: Vec<Pt> = steps
+        .iter()
+        .map(|s| geometries[s.geometry].centroid())
+        .collect();
+    let fallback = {
+        let d = centroids[centroids.len() - 1].sub(centroids[0]);
+        if d.norm() > 0.0 {
+            d.scale(1.0 / d.norm())
+        } else {
+            Pt::new(1.0, 0.0)
+        }
+    };
+    let dir_of = |field_id: usize| -> Pt {
+        let k = fields.iter().position(|f| f.id == field_id);
+        let (a, b) = match k {
+            Some(k) if k + 1 < fields.len() => (fields[k].center, fields[k + 1].center),
+            Some(k) if k > 0 => (fields[k - 1].center, fields[k].center),
+            _ => return fallback,
+        };
+        let d = b.sub(a);
+        if d.norm() > 0.0 {
+            d.scale(1.0 / d.norm())
+        } else {
+            fallback
+        }
+    };
+    let dead_band = 0.01 * field_mm[0];
+    let mut last_sign = 0.0f64;
+    let mut changes = 0;
+    for (w, s) in centroids.windows(2).zip(steps) {
+        let p = w[1].sub(w[0]).dot(dir_of(s.field));
+        if p.abs() < dead_band {
+            continue;
+        }
+        let sign = p.signum();
+        if last_sign != 0.0 && sign != last_sign {
+            changes += 1;
+        }
+        last_sign = sign;
+    }
+    changes
+}
+
+/// Time of a point-to-point move of one axis with a trapezoidal velocity profile, s.
+fn axis_time_s(d_mm: f64, v_mm_s: f64, a_mm_s2: f64) -> f64 {
+    let d = d_mm.abs();
+    if d == 0.0 {
+        return 0.0;
+    }
+    if d < v_mm_s * v_mm_s / a_mm_s2 {
+        2.0 * (d / a_mm_s2).sqrt()
+    } else {
+        d / v_mm_s + v_mm_s / a_mm_s2
+    }
+}
+
+/// Step-and-scan job time estimate, s: base moves between field centres (both axes move at once,
+/// each with a trapezoidal profile, the slower one counts), scanner jumps at jump speed plus the
+/// jump delay, marks at mark speed plus laser on and off delays.
+pub fn job_time_s(
+    geometries: &[Geometry],
+    fields: &[ScanField],
+    steps: &[Step],
+    profile: &MachineProfile,
+) -> f64 {
+    let base: f64 = fields
+        .windows(2)
+        .map(|w| {
+            let d = w[1].center.sub(w[0].center);
+            axis_time_s(
+                d.x,
+                profile.axis_x.max_velocity_mm_s,
+                profile.axis_x.max_accel_mm_s2,
+            )
+            .max(axis_time_s(
+                d.y,
+                profile.axis_y.max_velocity_mm_s,
+                profile.axis_y.max_accel_mm_s2,
+            ))
+        })
+        .sum();
+    let lt = &profile.laser;
+    let marks: f64 = steps
+        .iter()
+        .map(|s| {
+            geometries[s.geometry].length_mm() / profile.scanner.mark_speed_mm_s
+                + lt.on_delay_s
+                + lt.off_delay_s
+        })
+        .sum();
+    let jumps = idle_mm(geometries, steps) / profile.scanner.jump_speed_mm_s
+        + steps.len().saturating_sub(1) as f64 * lt.jump_delay_s;
+    base + marks + jumps
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fields::tests_support::rect;
+
+    fn field(id: usize, x: f64, y: f64) -> ScanField {
+        ScanField {
+            id,
+            center: Pt::new(x, y),
+            size: [70.0, 70.0],
+            locked: false,
+            geometries: vec![],
+        }
+    }
+
+    #[test]
+    fn coverage_of_two_overlapping_fields() {
+        let f = [field(0, 35.0, 35.0), field(1, 70.0, 35.0)];
+        let (once, pct) = coverage(&f, [70.0, 70.0]);
+        // overlap strip 35 × 70 is covered twice
+        assert!((once - (2.0 * 4900.0 - 2.0 * 35.0 * 70.0)).abs() < 1e-9);
+        assert!((pct - 50.0).abs() < 1e-9);
+        let (once, pct) = coverage(&f[..1], [70.0, 70.0]);
+        assert!((once - 4900.0).abs() < 1e-9 && pct.abs() < 1e-12);
+    }
+
+    #[test]
+    fn idle_and_direction_changes() {
+        let gs: Vec<Geometry> = (0..4)
+            .map(|i| rect(i as f64 * 10.0, 0.0, 2.0, 2.0))
+            .collect();
+        let f = [field(0, 35.0, 35.0)];
+        let steps = |order: &[usize]| -> Vec<Step> {
+            order
+                .iter()
+                .map(|&g| Step {
+                    geometry: g,
+                    field: 0,
+                    start_vertex: 0,
+                    reversed: false,
+                })
+                .collect()
+        };
+        let sweep = steps(&[0, 1, 2, 3]);
+        assert!((idle_mm(&gs, &sweep) - 30.0).abs() < 1e-12);
+        assert_eq!(direction_changes(&gs, &f, &sweep, [70.0, 70.0]), 0);
+        let zig = steps(&[0, 2, 1, 3]);
+        assert_eq!(direction_changes(&gs, &f, &zig, [70.0, 70.0]), 2);
+    }
+
+    #[test]
+    fn trapezoid_times() {
+        // short move: triangle profile
+        assert!((axis_time_s(1.0, 100.0, 100.0) - 0.2).abs() < 1e-12);
+        // long move: cruise
+        assert!((axis_time_s(300.0, 100.0, 1000.0) - 3.1).abs() < 1e-12);
+    }
+}

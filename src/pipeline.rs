@@ -1,0 +1,91 @@
+//! The whole pipeline on a [`Document`]: import → fields → order → metrics, with stage times.
+
+use crate::document::{Document, MachineProfile, Plan, SolverSettings};
+use crate::fields::{place_fields, FieldError};
+use crate::import::{import_svg_file, ImportError, ImportOptions};
+use crate::job::JobCtx;
+use crate::order::{order_plan, OrderError};
+use std::path::Path;
+use std::time::Instant;
+use thiserror::Error;
+
+/// A pipeline failure; the message names the file where one is involved.
+#[derive(Debug, Error)]
+pub enum PipelineError {
+    /// The artwork could not be imported.
+    #[error(transparent)]
+    Import(#[from] ImportError),
+    /// Fields could not be placed.
+    #[error("{file}: {source}")]
+    Fields {
+        /// The document's source file.
+        file: String,
+        /// The cause.
+        source: FieldError,
+    },
+    /// Ordering failed.
+    #[error("{file}: {source}")]
+    Order {
+        /// The document's source file.
+        file: String,
+        /// The cause.
+        source: OrderError,
+    },
+}
+
+/// Imports an SVG into a new document with the given profile and settings; returns it with the
+/// import time in s.
+pub fn load_svg(
+    path: &Path,
+    profile: MachineProfile,
+    settings: SolverSettings,
+    opts: &ImportOptions,
+) -> Result<(Document, f64), PipelineError> {
+    let t0 = Instant::now();
+    let imported = import_svg_file(path, opts)?;
+    let doc = Document {
+        source: Some(path.display().to_string()),
+        page_mm: imported.page_mm,
+        geometries: imported.geometries,
+        warnings: imported.warnings,
+        profile,
+        settings,
+        fields: Vec::new(),
+        plans: Vec::new(),
+    };
+    Ok((doc, t0.elapsed().as_secs_f64()))
+}
+
+/// Places fields (replacing the document's) and orders the geometries; returns the plan with
+/// `solve_s.fields` and `solve_s.order` filled in. The plan is not added to `doc.plans`.
+pub fn plan_document(doc: &mut Document, ctx: &JobCtx) -> Result<Plan, PipelineError> {
+    let file = doc.source.clone().unwrap_or_else(|| "document".into());
+    let t0 = Instant::now();
+    let fields =
+        place_fields(&doc.geometries, &doc.profile, &doc.settings, ctx).map_err(|source| {
+            PipelineError::Fields {
+                file: file.clone(),
+                source,
+            }
+        })?;
+    let fields_s = t0.elapsed().as_secs_f64();
+    doc.fields = fields;
+    if let Some(r) = ctx.recorder() {
+        r.geometry(&doc.geometries);
+        r.fields(&doc.fields);
+    }
+    let mut plan = order_plan(
+        &doc.geometries,
+        &doc.fields,
+        &doc.profile,
+        &doc.settings,
+        ctx,
+    )
+    .map_err(|source| PipelineError::Order { file, source })?;
+    plan.metrics.solve_s.fields = fields_s;
+    plan.metrics.solve_s.total = plan.metrics.solve_s.fields + plan.metrics.solve_s.order;
+    if let Some(r) = ctx.recorder() {
+        r.plan(&doc.geometries, &plan);
+    }
+    Ok(plan)
+}

@@ -1,0 +1,139 @@
+//! The binary: exit codes, one-line errors, outputs written.
+
+mod common;
+
+use std::process::Command;
+
+fn galvoplan(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_galvoplan"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+#[test]
+fn plan_writes_gcode_report_preview_geometry() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = |n: &str| dir.path().join(n).display().to_string();
+    let demo = common::root()
+        .join("assets/examples/demo.svg")
+        .display()
+        .to_string();
+    let out = galvoplan(&[
+        "plan",
+        &demo,
+        "-o",
+        &d("job.gcode"),
+        "--report",
+        &d("job.json"),
+        "--preview",
+        &d("job.svg"),
+        "--export-geometry",
+        &d("geom.svg"),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d("job.json")).unwrap()).unwrap();
+    for key in [
+        "idle_mm",
+        "marked_mm",
+        "base_mm",
+        "fields",
+        "covered_area_mm2",
+        "overlap_pct",
+        "direction_changes",
+        "solve_s",
+    ] {
+        assert!(!report["metrics"][key].is_null(), "metrics.{key} missing");
+    }
+    assert!(report["fields"][0]["center"].is_array() && report["fields"][0]["size"].is_array());
+    let gcode = std::fs::read_to_string(d("job.gcode")).unwrap();
+    assert_eq!(
+        gcode.matches("\nM3\n").count(),
+        report["order"].as_array().unwrap().len()
+    );
+    assert!(std::fs::read_to_string(d("job.svg"))
+        .unwrap()
+        .contains("<svg"));
+    assert!(std::fs::read_to_string(d("geom.svg"))
+        .unwrap()
+        .contains("<path"));
+}
+
+#[test]
+fn bad_inputs_exit_nonzero_with_one_line_naming_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let full = std::fs::read_to_string(common::root().join("assets/examples/demo.svg")).unwrap();
+    let cases: [(&str, &[u8], &str); 4] = [
+        ("truncated.svg", &full.as_bytes()[..full.len() / 3], "malformed XML"),
+        ("empty.svg", b"", "empty file"),
+        ("notes.svg", b"just some notes\n", "not a valid SVG"),
+        (
+            "text.svg",
+            br#"<svg xmlns="http://www.w3.org/2000/svg" width="10mm" height="10mm"><text x="1" y="5">hi</text></svg>"#,
+            "no markable geometry",
+        ),
+    ];
+    for (name, bytes, what) in cases {
+        let p = dir.path().join(name);
+        std::fs::write(&p, bytes).unwrap();
+        let out_gcode = dir.path().join("x.gcode");
+        let out = galvoplan(&[
+            "plan",
+            &p.display().to_string(),
+            "-o",
+            &out_gcode.display().to_string(),
+        ]);
+        assert!(!out.status.success(), "{name}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(err.trim_end().lines().count(), 1, "{name}: {err}");
+        assert!(err.contains(name) && err.contains(what), "{name}: {err}");
+        assert!(!err.contains("panicked"), "{name}: {err}");
+        assert!(!out_gcode.exists(), "{name}: no output on failure");
+    }
+}
+
+#[test]
+fn oversize_geometry_is_listed() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("big.svg");
+    std::fs::write(
+        &p,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="300mm" height="300mm" viewBox="0 0 300 300"><rect id="huge" x="10" y="10" width="100" height="20" stroke="black" fill="none"/><circle cx="200" cy="200" r="5" stroke="black" fill="none"/></svg>"#,
+    )
+    .unwrap();
+    let out = galvoplan(&[
+        "plan",
+        &p.display().to_string(),
+        "-o",
+        &dir.path().join("o.gcode").display().to_string(),
+    ]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("big.svg") && err.contains("#huge") && err.contains("100.00 × 20.00 mm"),
+        "{err}"
+    );
+}
+
+#[test]
+fn bench_prints_a_row_per_instance() {
+    let dir = tempfile::tempdir().unwrap();
+    let json = dir.path().join("b.json");
+    let examples = common::root().join("assets/examples").display().to_string();
+    let out = galvoplan(&["bench", &examples, "--json", &json.display().to_string()]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let table = String::from_utf8_lossy(&out.stdout);
+    assert!(table.lines().any(|l| l.starts_with("| demo |")), "{table}");
+    let rows: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(json).unwrap()).unwrap();
+    assert!(rows[0]["idle_mm"].as_f64().unwrap() > 0.0);
+}

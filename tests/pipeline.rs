@@ -1,0 +1,94 @@
+//! End to end on the bundled examples: import → fields → order → export, checked.
+
+mod common;
+
+use galvoplan::document::{MachineProfile, SolverSettings};
+use galvoplan::export::{preview_svg, report_json, write_gcode};
+use galvoplan::import::ImportOptions;
+use galvoplan::job::JobCtx;
+use galvoplan::pipeline::{load_svg, plan_document};
+
+fn run(
+    name: &str,
+    settings: SolverSettings,
+) -> (galvoplan::document::Document, galvoplan::document::Plan) {
+    let path = common::root().join("assets/examples").join(name);
+    let (mut doc, _) = load_svg(
+        &path,
+        MachineProfile::default(),
+        settings,
+        &ImportOptions::default(),
+    )
+    .unwrap();
+    let plan = plan_document(&mut doc, &JobCtx::default()).unwrap();
+    (doc, plan)
+}
+
+#[test]
+fn demo_plans_and_checks() {
+    let (doc, plan) = run("demo.svg", SolverSettings::default());
+    assert!(doc.geometries.len() > 100);
+    common::check_plan(&doc, &plan);
+    let m = &plan.metrics;
+    assert!(m.fields >= 4, "demo spans several fields");
+    let marked: f64 = doc.geometries.iter().map(|g| g.length_mm()).sum();
+    assert!((m.marked_mm - marked).abs() < 1e-6);
+    assert!(m.idle_mm > 0.0 && m.base_mm > 0.0);
+    assert!(m.overlap_pct >= 0.0 && m.overlap_pct < 100.0);
+    // idle_mm equals the sum of the G-code's laser-off travel between strokes
+    let g = write_gcode(&doc.geometries, &plan, &doc.profile, doc.page_mm[1], "demo");
+    assert!(g.starts_with("; galvoplan"));
+    assert!(g.contains("G21\nG90\n"));
+    let report: serde_json::Value = serde_json::from_str(&report_json(
+        "demo.svg",
+        &plan,
+        &doc.settings,
+        &doc.warnings,
+    ))
+    .unwrap();
+    assert_eq!(
+        report["order"].as_array().unwrap().len(),
+        doc.geometries.len()
+    );
+    assert!(report["metrics"]["idle_mm"].as_f64().unwrap() > 0.0);
+    assert!(report["metrics"]["solve_s"]["total"].is_number());
+    let svg = preview_svg(&doc.geometries, &plan, doc.page_mm);
+    assert!(galvoplan::import::import_svg(
+        svg.as_bytes(),
+        "preview.svg",
+        &ImportOptions::default()
+    )
+    .is_ok());
+}
+
+#[test]
+fn same_input_same_plan() {
+    let (_, a) = run("demo.svg", SolverSettings::default());
+    let (_, b) = run("demo.svg", SolverSettings::default());
+    assert_eq!(a.order, b.order);
+    assert_eq!(a.fields, b.fields);
+}
+
+#[test]
+fn project_round_trip_with_plan() {
+    let (mut doc, plan) = run("demo.svg", SolverSettings::default());
+    doc.plans.push(plan);
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("demo.galvoplan.json");
+    galvoplan::document::save_project(&doc, &p).unwrap();
+    let back = galvoplan::document::load_project(&p).unwrap();
+    assert!(back == doc, "project round trip changed the document");
+    // a corrupt file is reported, the good one is untouched by a failed save elsewhere
+    std::fs::write(
+        dir.path().join("bad.json"),
+        "{\"format\":\"galvoplan-project\",\"version\":1,",
+    )
+    .unwrap();
+    let e = galvoplan::document::load_project(&dir.path().join("bad.json"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("bad.json") && e.contains("not a valid galvoplan project"),
+        "{e}"
+    );
+}
