@@ -1,7 +1,7 @@
 //! The whole pipeline on a [`Document`]: import → fields → order → metrics, with stage times.
 
-use crate::document::{Document, MachineProfile, Plan, SolverSettings};
-use crate::fields::{place_fields, FieldError};
+use crate::document::{Document, MachineProfile, Plan, ScanField, SolverSettings};
+use crate::fields::{place_fields, split_oversize, FieldError};
 use crate::import::{import_svg_file, ImportError, ImportOptions};
 use crate::job::JobCtx;
 use crate::order::{order_plan, OrderError};
@@ -56,20 +56,30 @@ pub fn load_svg(
     Ok((doc, t0.elapsed().as_secs_f64()))
 }
 
-/// Places fields (replacing the document's) and orders the geometries; returns the plan with
-/// `solve_s.fields` and `solve_s.order` filled in. The plan is not added to `doc.plans`.
+/// Places fields (replacing the document's unlocked ones; locked fields stay) and orders the
+/// geometries; returns the plan with `solve_s.fields` and `solve_s.order` filled in. With
+/// `split_oversize`, geometries larger than a field are first cut into pieces (and reported as
+/// warnings). The plan is not added to `doc.plans`.
 pub fn plan_document(doc: &mut Document, ctx: &JobCtx) -> Result<Plan, PipelineError> {
     let file = doc.source.clone().unwrap_or_else(|| "document".into());
     let t0 = Instant::now();
-    let fields =
-        place_fields(&doc.geometries, &doc.profile, &doc.settings, ctx).map_err(|source| {
-            PipelineError::Fields {
-                file: file.clone(),
-                source,
-            }
+    if doc.settings.split_oversize {
+        let warnings = split_oversize(&mut doc.geometries, doc.profile.field_mm);
+        if !warnings.is_empty() {
+            // indices changed: fields and plans of the old geometry list are void
+            doc.fields.clear();
+            doc.plans.clear();
+        }
+        doc.warnings.extend(warnings);
+    }
+    let locked: Vec<ScanField> = doc.fields.iter().filter(|f| f.locked).cloned().collect();
+    let placement = place_fields(&doc.geometries, &doc.profile, &doc.settings, &locked, ctx)
+        .map_err(|source| PipelineError::Fields {
+            file: file.clone(),
+            source,
         })?;
     let fields_s = t0.elapsed().as_secs_f64();
-    doc.fields = fields;
+    doc.fields = placement.fields.clone();
     if let Some(r) = ctx.recorder() {
         r.geometry(&doc.geometries);
         r.fields(&doc.fields);
@@ -83,6 +93,7 @@ pub fn plan_document(doc: &mut Document, ctx: &JobCtx) -> Result<Plan, PipelineE
     )
     .map_err(|source| PipelineError::Order { file, source })?;
     plan.metrics.solve_s.fields = fields_s;
+    plan.metrics.fields_lower_bound = Some(placement.lower_bound);
     plan.metrics.solve_s.total = plan.metrics.solve_s.fields + plan.metrics.solve_s.order;
     if let Some(r) = ctx.recorder() {
         r.plan(&doc.geometries, &plan);

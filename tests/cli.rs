@@ -1,4 +1,5 @@
 //! The binary: exit codes, one-line errors, outputs written.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
 
 mod common;
 
@@ -118,14 +119,40 @@ fn oversize_geometry_is_listed() {
         err.contains("big.svg") && err.contains("#huge") && err.contains("100.00 × 20.00 mm"),
         "{err}"
     );
+    let report = dir.path().join("o.json");
+    let out = galvoplan(&[
+        "plan",
+        &p.display().to_string(),
+        "-o",
+        &dir.path().join("o.gcode").display().to_string(),
+        "--report",
+        &report.display().to_string(),
+        "--split-oversize",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("#huge") && err.contains("split into 2 strokes"),
+        "{err}"
+    );
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(report).unwrap()).unwrap();
+    assert_eq!(report["order"].as_array().unwrap().len(), 3);
 }
 
 #[test]
 fn bench_prints_a_row_per_instance() {
     let dir = tempfile::tempdir().unwrap();
     let json = dir.path().join("b.json");
-    let examples = common::root().join("assets/examples").display().to_string();
-    let out = galvoplan(&["bench", &examples, "--json", &json.display().to_string()]);
+    let demo = common::root()
+        .join("assets/examples/demo.svg")
+        .display()
+        .to_string();
+    let out = galvoplan(&["bench", &demo, "--json", &json.display().to_string()]);
     assert!(
         out.status.success(),
         "{}",

@@ -1,5 +1,6 @@
 //! Golden end-to-end test: SVG → G-code, compared with a stored file within a numeric tolerance.
 //! Set `UPDATE_GOLDEN=1` to rewrite the stored file after an intended change.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
 
 mod common;
 

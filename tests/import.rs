@@ -1,4 +1,5 @@
 //! SVG import: element kinds, transforms, units, warnings and errors.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use galvoplan::geom::{BBox, Pt};
 use galvoplan::import::{import_svg, ImportError, ImportOptions, Imported};
@@ -73,7 +74,7 @@ fn flattened_circle_stays_within_chord_tolerance() {
         // vertices on the curve (within usvg's own Bézier approximation of the circle, ~0.03 %)
         let c = Pt::new(50.0, 50.0);
         for w in g.points.windows(2) {
-            let mid = w[0].add(w[1]).scale(0.5);
+            let mid = w[0].plus(w[1]).scale(0.5);
             let sagitta = 20.0 - mid.dist(c);
             assert!(sagitta <= tol + 20.0 * 3e-4, "tol {tol}: sagitta {sagitta}");
         }

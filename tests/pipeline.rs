@@ -1,4 +1,5 @@
 //! End to end on the bundled examples: import → fields → order → export, checked.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
 
 mod common;
 

@@ -14,9 +14,16 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     anyhow::ensure!(!files.is_empty(), "no SVG files in {:?}", a.paths);
     let ctx = JobCtx::default();
     let mut rows = Vec::new();
+    let mut failed = Vec::new();
     for f in &files {
         eprintln!("galvoplan: bench {}", f.display());
-        rows.push(run_instance(f, &profile, &settings, &opts, a.repeat, &ctx)?);
+        match run_instance(f, &profile, &settings, &opts, a.repeat, &ctx) {
+            Ok(row) => rows.push(row),
+            Err(e) => {
+                eprintln!("galvoplan: error: {e}");
+                failed.push(f.display().to_string());
+            }
+        }
     }
     print!("{}", format_table(&rows));
     if let Some(p) = &a.json {

@@ -31,6 +31,10 @@ enum Command {
 /// Field placement, as on the command line.
 #[derive(Debug, Clone, Copy, ValueEnum)]
 enum FieldsArg {
+    /// Set cover: fewest fields, least overlap, centred.
+    Auto,
+    /// Seed 000 §3.1: random fields, removal test, unit moves (slow).
+    Paper,
     /// Greedy serpentine cover (baseline).
     Greedy,
 }
@@ -49,7 +53,7 @@ struct JobOpts {
     #[arg(long, default_value = "seed000")]
     profile: String,
     /// Scan-field placement.
-    #[arg(long, value_enum, default_value = "greedy")]
+    #[arg(long, value_enum, default_value = "auto")]
     fields: FieldsArg,
     /// Ordering algorithm.
     #[arg(long, value_enum, default_value = "baseline")]
@@ -60,6 +64,9 @@ struct JobOpts {
     /// Time limit for the ordering stage, s.
     #[arg(long)]
     time_limit: Option<f64>,
+    /// Cut geometries larger than a scan field at field borders (else they are an error).
+    #[arg(long)]
+    split_oversize: bool,
     /// Chord tolerance for flattening curves, mm.
     #[arg(long, default_value_t = 0.01)]
     chord_tol: f64,
@@ -78,6 +85,8 @@ impl JobOpts {
         }
         Ok(SolverSettings {
             fields: match self.fields {
+                FieldsArg::Auto => FieldsMode::Auto,
+                FieldsArg::Paper => FieldsMode::Paper,
                 FieldsArg::Greedy => FieldsMode::Greedy,
             },
             algo: match self.algo {
@@ -85,6 +94,7 @@ impl JobOpts {
             },
             seed: self.seed,
             time_limit_s: self.time_limit,
+            split_oversize: self.split_oversize,
             ..SolverSettings::default()
         })
     }

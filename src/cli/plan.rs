@@ -20,8 +20,12 @@ pub fn run(a: &PlanArgs) -> Result<()> {
     }
     let progress = Arc::new(BarProgress::new());
     let ctx = JobCtx::new(CancelToken::new(), progress.clone());
+    let imported_warnings = doc.warnings.len();
     let result = plan_document(&mut doc, &ctx);
     progress.finish();
+    for w in doc.warnings.iter().skip(imported_warnings) {
+        eprintln!("galvoplan: warning: {}: {w}", a.input.display());
+    }
     let mut plan = result?;
     let t0 = Instant::now();
     let source = a.input.display().to_string();

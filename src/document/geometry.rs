@@ -55,7 +55,7 @@ impl Geometry {
     /// Centroid of the vertices (used as the geometry's representative point).
     pub fn centroid(&self) -> Pt {
         let n = self.points.len().max(1) as f64;
-        let s = self.points.iter().fold(Pt::default(), |a, &p| a.add(p));
+        let s = self.points.iter().fold(Pt::default(), |a, &p| a.plus(p));
         s.scale(1.0 / n)
     }
     /// Number of possible start choices: every vertex of a closed geometry, both ends of an open one.

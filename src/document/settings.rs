@@ -7,8 +7,12 @@ use serde::{Deserialize, Serialize};
 #[serde(rename_all = "lowercase")]
 pub enum FieldsMode {
     /// Greedy cover in serpentine order (baseline).
-    #[default]
     Greedy,
+    /// Set cover: fewest fields, then least overlap, then best centring.
+    #[default]
+    Auto,
+    /// Seed 000 §3.1: random fields, removal test, unit moves.
+    Paper,
 }
 
 /// Which ordering algorithm runs.

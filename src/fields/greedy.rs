@@ -9,17 +9,22 @@ use crate::job::JobCtx;
 /// (bands one field high; left to right, then right to left), open a field whose corner sits at
 /// the first one's bounding-box corner (top-left going right, top-right going left; shifted back
 /// into the base stroke while that geometry stays covered), assign to it every unassigned
-/// geometry lying wholly inside, repeat. Assumes [`super::check_reach`] passed.
+/// geometry lying wholly inside, repeat. Only the geometries in `subset` are covered (field ids
+/// count from 0). Assumes [`super::check_reach`] passed.
 pub fn greedy_fields(
     geometries: &[Geometry],
+    subset: &[usize],
     profile: &MachineProfile,
     ctx: &JobCtx,
 ) -> Result<Vec<ScanField>, FieldError> {
     let [fw, fh] = profile.field_mm;
     let boxes: Vec<BBox> = geometries.iter().map(Geometry::bbox).collect();
-    let top = boxes.iter().map(|b| b.min_y).fold(f64::INFINITY, f64::min);
+    let top = subset
+        .iter()
+        .map(|&i| boxes[i].min_y)
+        .fold(f64::INFINITY, f64::min);
     let band = |b: &BBox| ((b.min_y - top) / fh).floor().max(0.0) as i64;
-    let mut order: Vec<usize> = (0..geometries.len()).collect();
+    let mut order: Vec<usize> = subset.to_vec();
     order.sort_by(|&a, &b| {
         let (ba, bb) = (&boxes[a], &boxes[b]);
         let (ra, rb) = (band(ba), band(bb));

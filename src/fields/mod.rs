@@ -1,10 +1,26 @@
-//! Scan-field placement and allocation of geometries to fields.
+//! Scan-field placement, allocation of geometries to fields, and operator edits.
+//!
+//! Modes (`SolverSettings::fields`): `greedy` (baseline serpentine cover), `auto` (set cover with
+//! least overlap and best centring, [`auto`]), `paper` (seed 000 §3.1, [`paper`]). Locked fields
+//! are kept as they are; a mode only adds fields for what they leave uncovered.
 
+mod allocate;
+pub mod auto;
+pub mod cover;
+mod edit;
 mod greedy;
+pub mod paper;
+pub mod position;
 mod reach;
+mod split;
 
+pub use allocate::{allocate, holders, Allocation};
+pub use edit::{
+    add_field, delete_field, move_field, reallocate, replace_automatically, set_locked, EditError,
+};
 pub use greedy::greedy_fields;
 pub use reach::{center_range, check_reach, Span};
+pub use split::{is_oversize, split_geometry, split_oversize};
 
 use crate::document::{FieldsMode, Geometry, MachineProfile, ScanField, SolverSettings};
 use crate::job::{Cancelled, JobCtx};
@@ -17,7 +33,7 @@ pub const INSIDE_EPS_MM: f64 = 1e-7;
 #[derive(Debug, Error)]
 pub enum FieldError {
     /// Geometries larger than one scan field.
-    #[error("{} {} larger than the {:.1} × {:.1} mm scan field: {}", .list.len(), if .list.len() == 1 { "geometry is" } else { "geometries are" }, .field_mm[0], .field_mm[1], .list.join("; "))]
+    #[error("{} {} larger than the {:.1} × {:.1} mm scan field (use --split-oversize to cut them at field borders): {}", .list.len(), if .list.len() == 1 { "geometry is" } else { "geometries are" }, .field_mm[0], .field_mm[1], .list.join("; "))]
     Oversize {
         /// Each offending geometry, described with its size.
         list: Vec<String>,
@@ -34,23 +50,92 @@ pub enum FieldError {
         /// Field size.
         field_mm: [f64; 2],
     },
+    /// Internal consistency failure: a placement left geometries uncovered.
+    #[error("{0} geometries left uncovered by the field placement (first: geometry {1})")]
+    Uncovered(usize, usize),
     /// The operator cancelled.
     #[error("cancelled")]
     Cancelled(#[from] Cancelled),
 }
 
-/// Places scan fields for `geometries` with the mode in `settings` and allocates every geometry
-/// to exactly one field (`ScanField::geometries`).
+/// The result of a placement.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Placement {
+    /// Locked fields first (unchanged), then the new ones; geometries allocated.
+    pub fields: Vec<ScanField>,
+    /// A lower bound on the number of fields any placement needs.
+    pub lower_bound: usize,
+}
+
+/// Places scan fields for `geometries` with the mode in `settings`, keeping `locked` fields, and
+/// allocates every geometry to exactly one field (`ScanField::geometries`).
 pub fn place_fields(
     geometries: &[Geometry],
     profile: &MachineProfile,
     settings: &SolverSettings,
+    locked: &[ScanField],
     ctx: &JobCtx,
-) -> Result<Vec<ScanField>, FieldError> {
+) -> Result<Placement, FieldError> {
     check_reach(geometries, profile)?;
+    let locked: Vec<ScanField> = locked
+        .iter()
+        .map(|f| ScanField {
+            locked: true,
+            geometries: Vec::new(),
+            ..f.clone()
+        })
+        .collect();
+    let held = holders(geometries, &locked);
+    let rest: Vec<usize> = (0..geometries.len())
+        .filter(|&g| held[g].is_empty())
+        .collect();
+    let first_id = locked.iter().map(|f| f.id + 1).max().unwrap_or(0);
+    let mut fields = locked.clone();
     match settings.fields {
-        FieldsMode::Greedy => greedy_fields(geometries, profile, ctx),
+        FieldsMode::Greedy => {
+            // locked fields take what they hold; the baseline sweep keeps its own allocation
+            allocate(geometries, &mut fields);
+            let mut new = greedy_fields(geometries, &rest, profile, ctx)?;
+            for f in &mut new {
+                f.id += first_id;
+            }
+            fields.extend(new);
+        }
+        FieldsMode::Auto => {
+            fields.extend(auto::auto_fields(
+                geometries, &rest, profile, &locked, first_id, ctx,
+            )?);
+            allocate(geometries, &mut fields);
+        }
+        FieldsMode::Paper => {
+            fields.extend(paper::paper_fields(
+                geometries,
+                &rest,
+                profile,
+                settings.seed,
+                first_id,
+                ctx,
+            )?);
+            allocate(geometries, &mut fields);
+        }
     }
+    fields.retain(|f| f.locked || !f.geometries.is_empty());
+    let covered: usize = fields.iter().map(|f| f.geometries.len()).sum();
+    if covered != geometries.len() {
+        let alloc = holders(geometries, &fields);
+        let missing: Vec<usize> = (0..geometries.len())
+            .filter(|&g| alloc[g].is_empty())
+            .collect();
+        return Err(FieldError::Uncovered(
+            missing.len(),
+            missing.first().copied().unwrap_or(0),
+        ));
+    }
+    let lower_bound = cover::lower_bound(&auto::feasible_rects(geometries, profile));
+    Ok(Placement {
+        fields,
+        lower_bound,
+    })
 }
 
 #[cfg(test)]

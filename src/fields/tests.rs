@@ -1,6 +1,14 @@
 use super::tests_support::rect;
 use super::*;
 
+fn place(gs: &[Geometry], p: &MachineProfile) -> Result<Placement, FieldError> {
+    let settings = SolverSettings {
+        fields: FieldsMode::Greedy,
+        ..SolverSettings::default()
+    };
+    place_fields(gs, p, &settings, &[], &JobCtx::default())
+}
+
 fn covered_once(gs: &[Geometry], fields: &[ScanField]) {
     let mut seen = vec![0; gs.len()];
     for f in fields {
@@ -25,7 +33,7 @@ fn greedy_covers_everything_once() {
         .map(|i| rect((i % 10) as f64 * 29.0, (i / 10) as f64 * 55.0, 5.0, 3.0))
         .collect();
     let p = MachineProfile::default();
-    let fields = place_fields(&gs, &p, &SolverSettings::default(), &JobCtx::default()).unwrap();
+    let fields = place(&gs, &p).unwrap().fields;
     covered_once(&gs, &fields);
     assert!(fields.len() < 50);
 }
@@ -35,7 +43,7 @@ fn edge_artwork_shifts_field_into_stroke() {
     // artwork at the far corner: the laser reaches it only with the base at its limit
     let gs = vec![rect(-30.0, 320.0, 4.0, 4.0), rect(330.0, -34.0, 3.0, 3.0)];
     let p = MachineProfile::default();
-    let fields = place_fields(&gs, &p, &SolverSettings::default(), &JobCtx::default()).unwrap();
+    let fields = place(&gs, &p).unwrap().fields;
     covered_once(&gs, &fields);
 }
 
@@ -47,7 +55,7 @@ fn oversize_and_out_of_reach_are_listed() {
         rect(100.0, 100.0, 5.0, 5.0),
         rect(10.0, 10.0, 5.0, 75.0),
     ];
-    let e = place_fields(&gs, &p, &SolverSettings::default(), &JobCtx::default()).unwrap_err();
+    let e = place(&gs, &p).unwrap_err();
     let msg = e.to_string();
     assert!(msg.starts_with("2 geometries are larger"), "{msg}");
     assert!(
@@ -55,9 +63,7 @@ fn oversize_and_out_of_reach_are_listed() {
         "{msg}"
     );
     let gs = vec![rect(340.0, 10.0, 5.0, 5.0)];
-    let msg = place_fields(&gs, &p, &SolverSettings::default(), &JobCtx::default())
-        .unwrap_err()
-        .to_string();
+    let msg = place(&gs, &p).unwrap_err().to_string();
     assert!(
         msg.contains("out of reach") && msg.contains("geometry 0"),
         "{msg}"

@@ -23,23 +23,23 @@ fn chords_for(second_derivative_bound: f64, tol_mm: f64) -> usize {
 
 /// Appends the flattened quadratic Bézier `p0`–`p1`–`p2` to `out`, excluding `p0`.
 pub fn flatten_quad(p0: Pt, p1: Pt, p2: Pt, tol_mm: f64, out: &mut Vec<Pt>) {
-    let dd = p0.sub(p1.scale(2.0)).add(p2).norm() * 2.0;
+    let dd = p0.minus(p1.scale(2.0)).plus(p2).norm() * 2.0;
     let n = chords_for(dd, tol_mm);
     for i in 1..=n {
         let t = i as f64 / n as f64;
         let u = 1.0 - t;
         out.push(
             p0.scale(u * u)
-                .add(p1.scale(2.0 * u * t))
-                .add(p2.scale(t * t)),
+                .plus(p1.scale(2.0 * u * t))
+                .plus(p2.scale(t * t)),
         );
     }
 }
 
 /// Appends the flattened cubic Bézier `p0`–`p1`–`p2`–`p3` to `out`, excluding `p0`.
 pub fn flatten_cubic(p0: Pt, p1: Pt, p2: Pt, p3: Pt, tol_mm: f64, out: &mut Vec<Pt>) {
-    let a = p0.sub(p1.scale(2.0)).add(p2).norm();
-    let b = p1.sub(p2.scale(2.0)).add(p3).norm();
+    let a = p0.minus(p1.scale(2.0)).plus(p2).norm();
+    let b = p1.minus(p2.scale(2.0)).plus(p3).norm();
     let n = chords_for(6.0 * a.max(b), tol_mm);
     for i in 1..=n {
         out.push(cubic_at(p0, p1, p2, p3, i as f64 / n as f64));
@@ -50,9 +50,9 @@ pub fn flatten_cubic(p0: Pt, p1: Pt, p2: Pt, p3: Pt, tol_mm: f64, out: &mut Vec<
 pub fn cubic_at(p0: Pt, p1: Pt, p2: Pt, p3: Pt, t: f64) -> Pt {
     let u = 1.0 - t;
     p0.scale(u * u * u)
-        .add(p1.scale(3.0 * u * u * t))
-        .add(p2.scale(3.0 * u * t * t))
-        .add(p3.scale(t * t * t))
+        .plus(p1.scale(3.0 * u * u * t))
+        .plus(p2.scale(3.0 * u * t * t))
+        .plus(p3.scale(t * t * t))
 }
 
 #[cfg(test)]
@@ -105,7 +105,7 @@ mod tests {
             for i in 0..=400 {
                 let t = i as f64 / 400.0;
                 let u = 1.0 - t;
-                let q = p0.scale(u * u).add(p1.scale(2.0 * u * t)).add(p2.scale(t * t));
+                let q = p0.scale(u * u).plus(p1.scale(2.0 * u * t)).plus(p2.scale(t * t));
                 prop_assert!(dist_to_polyline(q, p0, &out) <= tol * 1.0001 + 1e-9);
             }
         }

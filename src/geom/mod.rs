@@ -32,11 +32,11 @@ impl Pt {
         dx * dx + dy * dy
     }
     /// Vector difference `self - o`.
-    pub fn sub(self, o: Pt) -> Pt {
+    pub fn minus(self, o: Pt) -> Pt {
         Pt::new(self.x - o.x, self.y - o.y)
     }
     /// Vector sum `self + o`.
-    pub fn add(self, o: Pt) -> Pt {
+    pub fn plus(self, o: Pt) -> Pt {
         Pt::new(self.x + o.x, self.y + o.y)
     }
     /// Scales by `k`.
@@ -165,13 +165,13 @@ pub fn polyline_length(points: &[Pt], closed: bool) -> f64 {
 
 /// Distance from `p` to the segment `a`–`b`, in mm.
 pub fn point_segment_dist(p: Pt, a: Pt, b: Pt) -> f64 {
-    let ab = b.sub(a);
+    let ab = b.minus(a);
     let len2 = ab.dot(ab);
     if len2 <= 0.0 {
         return p.dist(a);
     }
-    let t = (p.sub(a).dot(ab) / len2).clamp(0.0, 1.0);
-    p.dist(a.add(ab.scale(t)))
+    let t = (p.minus(a).dot(ab) / len2).clamp(0.0, 1.0);
+    p.dist(a.plus(ab.scale(t)))
 }
 
 #[cfg(test)]

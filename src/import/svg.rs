@@ -16,6 +16,8 @@ fn snap(v: f64) -> f64 {
     (v / SNAP_MM).round() * SNAP_MM
 }
 
+/// Subpaths shorter than this (mm) are degenerate: below the exported G-code's resolution.
+const MIN_LENGTH_MM: f64 = 1e-3;
 /// Points closer than this are one point (mm).
 const SAME_POINT_MM: f64 = 1e-6;
 
@@ -304,8 +306,8 @@ fn normalise(pts: Vec<Pt>, closed: bool) -> Result<(Vec<Pt>, bool), &'static str
             }
         }
     }
-    if out.len() < 2 || polyline_length(&out, closed) <= SAME_POINT_MM {
-        return Err("zero length");
+    if out.len() < 2 || polyline_length(&out, closed) < MIN_LENGTH_MM {
+        return Err("zero length (shorter than 1 µm)");
     }
     Ok((out, closed))
 }

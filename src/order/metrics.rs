@@ -130,7 +130,7 @@ pub fn direction_changes(
         .map(|s| geometries[s.geometry].centroid())
         .collect();
     let fallback = {
-        let d = centroids[centroids.len() - 1].sub(centroids[0]);
+        let d = centroids[centroids.len() - 1].minus(centroids[0]);
         if d.norm() > 0.0 {
             d.scale(1.0 / d.norm())
         } else {
@@ -144,7 +144,7 @@ pub fn direction_changes(
             Some(k) if k > 0 => (fields[k - 1].center, fields[k].center),
             _ => return fallback,
         };
-        let d = b.sub(a);
+        let d = b.minus(a);
         if d.norm() > 0.0 {
             d.scale(1.0 / d.norm())
         } else {
@@ -155,7 +155,7 @@ pub fn direction_changes(
     let mut last_sign = 0.0f64;
     let mut changes = 0;
     for (w, s) in centroids.windows(2).zip(steps) {
-        let p = w[1].sub(w[0]).dot(dir_of(s.field));
+        let p = w[1].minus(w[0]).dot(dir_of(s.field));
         if p.abs() < dead_band {
             continue;
         }
@@ -193,7 +193,7 @@ pub fn job_time_s(
     let base: f64 = fields
         .windows(2)
         .map(|w| {
-            let d = w[1].center.sub(w[0].center);
+            let d = w[1].center.minus(w[0].center);
             axis_time_s(
                 d.x,
                 profile.axis_x.max_velocity_mm_s,

@@ -1,9 +1,9 @@
 ; galvoplan 0.1.0 — small.svg
-; 6 strokes in 5 fields, marked 261.876 mm, idle 310.882 mm, base 310.395 mm
+; 6 strokes in 5 fields, marked 261.876 mm, idle 360.217 mm, base 401.077 mm
 G21
 G90
 M5
-; field 0 centre 30 90
+; field 0 centre 20 105
 G0 X10 Y110
 M4 S80
 G1 X30 Y110 F48000
@@ -11,7 +11,7 @@ G1 X30 Y100
 G1 X10 Y100
 G1 X10 Y110
 M5
-; field 1 centre 65 90
+; field 1 centre 62.5 97.5
 G0 X45.0336 Y105.5831
 M4 S80
 G1 X45.1321 Y106.1465 F48000
@@ -75,14 +75,21 @@ G0 X60 Y90
 M4 S80
 G1 X80 Y85 F48000
 M5
-; field 2 centre 140 80
+; field 2 centre 135 95
 G0 X120 Y100
 M4 S80
 G1 X130 Y90 F48000
 G1 X140 Y100
 G1 X150 Y90
 M5
-; field 3 centre 170 30
+; field 3 centre 20 25
+G0 X30 Y20
+M4 S80
+G1 X10 Y20 F48000
+G1 X20 Y30
+G1 X30 Y20
+M5
+; field 4 centre 170 40
 G0 X150 Y40
 M4 S80
 G1 X150.625 Y41.2109 F48000
@@ -149,12 +156,5 @@ G1 X188.125 Y36.6016
 G1 X188.75 Y37.6562
 G1 X189.375 Y38.7891
 G1 X190 Y40
-M5
-; field 4 centre 30 10
-G0 X30 Y20
-M4 S80
-G1 X10 Y20 F48000
-G1 X20 Y30
-G1 X30 Y20
 M5
 ; end

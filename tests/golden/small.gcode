@@ -1,9 +1,9 @@
 ; galvoplan 0.1.0 — small.svg
-; 6 strokes in 3 fields, marked 261.876 mm, idle 310.882 mm, base 280.527 mm
+; 6 strokes in 3 fields, marked 261.876 mm, idle 310.882 mm, base 255.502 mm
 G21
 G90
 M5
-; field 0 centre 45 45
+; field 0 centre 45 22.5
 G0 X10 Y10
 M3
 G1 X30 Y10 F60000
@@ -148,7 +148,7 @@ G1 X188.75 Y82.3438
 G1 X189.375 Y81.2109
 G1 X190 Y80
 M5
-; field 2 centre 0 125
+; field 2 centre 20 95
 G0 X30 Y100
 M3
 G1 X10 Y100 F60000
