@@ -9,29 +9,65 @@ use serde::Serialize;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-/// One instance's figures. Times are medians over the repeats, in ms.
+/// Mean and standard deviation of a figure over seeds.
+#[derive(Debug, Clone, Copy, Default, Serialize, PartialEq)]
+pub struct Stat {
+    /// Mean.
+    pub mean: f64,
+    /// Sample standard deviation (0 for one run).
+    pub sd: f64,
+}
+
+impl Stat {
+    /// Mean and sample standard deviation of `v`.
+    pub fn of(v: &[f64]) -> Stat {
+        if v.is_empty() {
+            return Stat::default();
+        }
+        let n = v.len() as f64;
+        let mean = v.iter().sum::<f64>() / n;
+        let sd = if v.len() > 1 {
+            (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt()
+        } else {
+            0.0
+        };
+        Stat { mean, sd }
+    }
+    fn show(&self, decimals: usize, with_sd: bool) -> String {
+        if with_sd {
+            format!("{:.*} ± {:.*}", decimals, self.mean, decimals, self.sd)
+        } else {
+            format!("{:.*}", decimals, self.mean)
+        }
+    }
+}
+
+/// One instance's figures: quality as mean ± sd over the seeds, times as medians over all runs
+/// (ms).
 #[derive(Debug, Clone, Serialize)]
 pub struct BenchRow {
     /// File stem.
     pub instance: String,
     /// Geometries imported.
     pub geometries: usize,
+    /// Seeds run.
+    pub seeds: usize,
     /// Scan fields.
-    pub fields: usize,
-    /// Lower bound on fields, when known.
+    pub fields: Stat,
+    /// Lower bound on fields.
     pub fields_lower_bound: Option<usize>,
     /// Overlap, %.
-    pub overlap_pct: f64,
+    pub overlap_pct: Stat,
     /// Idle travel, mm.
-    pub idle_mm: f64,
+    pub idle_mm: Stat,
     /// Base travel, mm.
-    pub base_mm: f64,
+    pub base_mm: Stat,
     /// Marked length, mm.
     pub marked_mm: f64,
     /// Direction changes.
-    pub direction_changes: usize,
+    pub direction_changes: Stat,
     /// Estimated job time, s.
-    pub job_time_s: Option<f64>,
+    pub job_time_s: Stat,
     /// Import, ms.
     pub import_ms: f64,
     /// Field placement, ms.
@@ -75,60 +111,82 @@ fn median(v: &mut [f64]) -> f64 {
     }
 }
 
-/// Runs the pipeline `repeat` times on one SVG (import, fields, order, export to memory).
+/// Runs the pipeline on one SVG for `seeds` consecutive seeds (from the settings' seed), each
+/// `repeat` times (import, fields, order, export to memory).
 pub fn run_instance(
     path: &Path,
     profile: &MachineProfile,
     settings: &SolverSettings,
     opts: &ImportOptions,
+    seeds: usize,
     repeat: usize,
     ctx: &JobCtx,
 ) -> Result<BenchRow, PipelineError> {
     let mut times: [Vec<f64>; 5] = Default::default();
-    let mut last = None;
-    for _ in 0..repeat.max(1) {
-        let t_all = Instant::now();
-        let (mut doc, import_s) = load_svg(path, profile.clone(), settings.clone(), opts)?;
-        let plan = plan_document(&mut doc, ctx)?;
-        let t0 = Instant::now();
-        let g = write_gcode(
-            &doc.geometries,
-            &plan,
-            &doc.profile,
-            doc.page_mm[1],
-            "bench",
-        );
-        let r = report_json("bench", &plan, &doc.settings, &doc.warnings);
-        std::hint::black_box((g.len(), r.len()));
-        let export_s = t0.elapsed().as_secs_f64();
-        times[0].push(import_s * 1e3);
-        times[1].push(plan.metrics.solve_s.fields * 1e3);
-        times[2].push(plan.metrics.solve_s.order * 1e3);
-        times[3].push(export_s * 1e3);
-        times[4].push(t_all.elapsed().as_secs_f64() * 1e3);
-        last = Some((doc.geometries.len(), plan));
+    let mut quality: [Vec<f64>; 6] = Default::default();
+    let (mut geometries, mut marked_mm, mut lower) = (0, 0.0, None);
+    for k in 0..seeds.max(1) {
+        let mut s = settings.clone();
+        s.seed = settings.seed.wrapping_add(k as u64);
+        for r in 0..repeat.max(1) {
+            let t_all = Instant::now();
+            let (mut doc, import_s) = load_svg(path, profile.clone(), s.clone(), opts)?;
+            let plan = plan_document(&mut doc, ctx)?;
+            let t0 = Instant::now();
+            let g = write_gcode(
+                &doc.geometries,
+                &plan,
+                &doc.profile,
+                doc.page_mm[1],
+                "bench",
+            );
+            let rep = report_json("bench", &plan, &doc.settings, &doc.warnings);
+            std::hint::black_box((g.len(), rep.len()));
+            let export_s = t0.elapsed().as_secs_f64();
+            for (v, x) in times.iter_mut().zip([
+                import_s,
+                plan.metrics.solve_s.fields,
+                plan.metrics.solve_s.order,
+                export_s,
+                t_all.elapsed().as_secs_f64(),
+            ]) {
+                v.push(x * 1e3);
+            }
+            if r == 0 {
+                let m = &plan.metrics;
+                for (v, x) in quality.iter_mut().zip([
+                    m.fields as f64,
+                    m.overlap_pct,
+                    m.idle_mm,
+                    m.base_mm,
+                    m.direction_changes as f64,
+                    m.job_time_s.unwrap_or(0.0),
+                ]) {
+                    v.push(x);
+                }
+                geometries = doc.geometries.len();
+                marked_mm = m.marked_mm;
+                lower = m.fields_lower_bound;
+            }
+        }
     }
-    let (geometries, plan) = last.ok_or_else(|| {
-        PipelineError::Import(crate::import::ImportError::Empty {
-            file: path.display().to_string(),
-        })
-    })?;
-    let m = &plan.metrics;
     let [mut a, mut b, mut c, mut d, mut e] = times;
+    let [f, o, i, bm, dc, jt] = quality;
     Ok(BenchRow {
         instance: path
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_default(),
         geometries,
-        fields: m.fields,
-        fields_lower_bound: m.fields_lower_bound,
-        overlap_pct: m.overlap_pct,
-        idle_mm: m.idle_mm,
-        base_mm: m.base_mm,
-        marked_mm: m.marked_mm,
-        direction_changes: m.direction_changes,
-        job_time_s: m.job_time_s,
+        seeds: seeds.max(1),
+        fields: Stat::of(&f),
+        fields_lower_bound: lower,
+        overlap_pct: Stat::of(&o),
+        idle_mm: Stat::of(&i),
+        base_mm: Stat::of(&bm),
+        marked_mm,
+        direction_changes: Stat::of(&dc),
+        job_time_s: Stat::of(&jt),
         import_ms: median(&mut a),
         fields_ms: median(&mut b),
         order_ms: median(&mut c),
@@ -137,24 +195,25 @@ pub fn run_instance(
     })
 }
 
-/// Formats rows as a Markdown table.
+/// Formats rows as a Markdown table (quality as mean ± sd when several seeds ran).
 pub fn format_table(rows: &[BenchRow]) -> String {
     let mut s = String::from(
         "| instance | geometries | fields | LB | overlap % | idle mm | base mm | marked mm | dir. changes | job s | import ms | fields ms | order ms | export ms | total ms |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
+        let sd = r.seeds > 1;
         s.push_str(&format!(
-            "| {} | {} | {} | {} | {:.1} | {:.1} | {:.1} | {:.1} | {} | {} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} |\n",
+            "| {} | {} | {} | {} | {} | {} | {} | {:.1} | {} | {} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} |\n",
             r.instance,
             r.geometries,
-            r.fields,
+            r.fields.show(if sd { 1 } else { 0 }, sd),
             r.fields_lower_bound.map_or("–".to_string(), |v| v.to_string()),
-            r.overlap_pct,
-            r.idle_mm,
-            r.base_mm,
+            r.overlap_pct.show(1, sd),
+            r.idle_mm.show(1, sd),
+            r.base_mm.show(1, sd),
             r.marked_mm,
-            r.direction_changes,
-            r.job_time_s.map_or("–".to_string(), |v| format!("{v:.2}")),
+            r.direction_changes.show(if sd { 1 } else { 0 }, sd),
+            r.job_time_s.show(2, sd),
             r.import_ms,
             r.fields_ms,
             r.order_ms,

@@ -17,7 +17,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     let mut failed = Vec::new();
     for f in &files {
         eprintln!("galvoplan: bench {}", f.display());
-        match run_instance(f, &profile, &settings, &opts, a.repeat, &ctx) {
+        match run_instance(f, &profile, &settings, &opts, a.seeds, a.repeat, &ctx) {
             Ok(row) => rows.push(row),
             Err(e) => {
                 eprintln!("galvoplan: error: {e}");

@@ -138,9 +138,12 @@ struct BenchArgs {
     /// Also write the rows as JSON.
     #[arg(long)]
     json: Option<PathBuf>,
-    /// Runs per instance; times are medians.
+    /// Runs per instance and seed; times are medians.
     #[arg(long, default_value_t = 1)]
     repeat: usize,
+    /// Seeds per instance (from --seed on); quality is reported as mean ± sd.
+    #[arg(long, default_value_t = 1)]
+    seeds: usize,
     #[command(flatten)]
     job: JobOpts,
 }
