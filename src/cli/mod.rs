@@ -6,7 +6,7 @@ mod progress;
 
 use anyhow::Result;
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use galvoplan::document::{Algo, FieldsMode, MachineProfile, SolverSettings};
+use galvoplan::document::{Algo, FieldsMode, MachineProfile, SolverSettings, VertexMode};
 use galvoplan::import::ImportOptions;
 use std::path::PathBuf;
 
@@ -42,8 +42,19 @@ enum FieldsArg {
 /// Ordering algorithm, as on the command line.
 #[derive(Debug, Clone, Copy, ValueEnum)]
 enum AlgoArg {
+    /// Hierarchical heuristic (seed 000 §3.2) with exact vertices and local search.
+    Hha,
     /// Fields in creation order, nearest neighbour inside each.
     Baseline,
+}
+
+/// Start-vertex choice, as on the command line.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+enum VertexArg {
+    /// VEA, then the exact layered-graph shortest path.
+    Exact,
+    /// Seed 000's vertex enhancement algorithm only.
+    Vea,
 }
 
 /// Options shared by `plan` and `bench`.
@@ -56,8 +67,17 @@ struct JobOpts {
     #[arg(long, value_enum, default_value = "auto")]
     fields: FieldsArg,
     /// Ordering algorithm.
-    #[arg(long, value_enum, default_value = "baseline")]
+    #[arg(long, value_enum, default_value = "hha")]
     algo: AlgoArg,
+    /// Start vertices: exact (layered-graph DP after VEA) or vea (seed 000 only).
+    #[arg(long, value_enum, default_value = "exact")]
+    vertex: VertexArg,
+    /// Directional penalty weight w (seed 000 Eq. 7; 0.1 is used with one field).
+    #[arg(long, default_value_t = 0.5)]
+    direction_weight: f64,
+    /// Run HHA as seed 000 describes it (no local search, no alternation), for comparison.
+    #[arg(long)]
+    seed_hha: bool,
     /// Random seed.
     #[arg(long, default_value_t = 1)]
     seed: u64,
@@ -77,6 +97,11 @@ impl JobOpts {
         Ok(MachineProfile::load(&self.profile)?)
     }
     fn settings(&self) -> Result<SolverSettings> {
+        anyhow::ensure!(
+            self.direction_weight.is_finite() && self.direction_weight >= 0.0,
+            "--direction-weight must be zero or positive, got {}",
+            self.direction_weight
+        );
         if let Some(t) = self.time_limit {
             anyhow::ensure!(
                 t.is_finite() && t > 0.0,
@@ -90,11 +115,18 @@ impl JobOpts {
                 FieldsArg::Greedy => FieldsMode::Greedy,
             },
             algo: match self.algo {
+                AlgoArg::Hha => Algo::Hha,
                 AlgoArg::Baseline => Algo::Baseline,
             },
             seed: self.seed,
             time_limit_s: self.time_limit,
             split_oversize: self.split_oversize,
+            vertex: match self.vertex {
+                VertexArg::Exact => VertexMode::Exact,
+                VertexArg::Vea => VertexMode::Vea,
+            },
+            hha_improve: !self.seed_hha,
+            direction_weight: self.direction_weight,
             ..SolverSettings::default()
         })
     }

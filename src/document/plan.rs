@@ -90,6 +90,9 @@ pub struct StageTimes {
     pub export: f64,
     /// Sum of the stages.
     pub total: f64,
+    /// Sub-stages of the ordering (name, s), in run order.
+    #[serde(default)]
+    pub order_detail: Vec<(String, f64)>,
 }
 
 /// Metrics of a plan (definitions in DESIGN.md and [`crate::order::metrics`]).

@@ -20,8 +20,10 @@ pub enum FieldsMode {
 #[serde(rename_all = "lowercase")]
 pub enum Algo {
     /// Fields in creation order, nearest neighbour inside each field.
-    #[default]
     Baseline,
+    /// Hierarchical heuristic algorithm (seed 000 §3.2).
+    #[default]
+    Hha,
 }
 
 /// How start vertices are chosen once the order is fixed.
@@ -96,6 +98,9 @@ pub struct SolverSettings {
     pub direction_weight: f64,
     /// Start-vertex choice.
     pub vertex: VertexMode,
+    /// HHA beyond the seed: directional local search, exact vertices, alternation. Off: the
+    /// seed's HHA (path cheapest arc on Eq. 7 costs, VEA) for comparison.
+    pub hha_improve: bool,
     /// Cost model.
     pub cost_model: CostModel,
     /// Cut geometries larger than a field at field borders instead of failing.
@@ -113,6 +118,7 @@ impl Default for SolverSettings {
             time_limit_s: None,
             direction_weight: 0.5,
             vertex: VertexMode::default(),
+            hha_improve: true,
             cost_model: CostModel::default(),
             split_oversize: false,
             ga: GaParams::default(),

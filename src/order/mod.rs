@@ -1,7 +1,10 @@
 //! Ordering: which field after which, which geometry after which, where each one starts.
 
 mod baseline;
+pub mod hha;
 pub mod metrics;
+pub mod tsp;
+pub mod vertex;
 
 pub use baseline::baseline_order;
 
@@ -40,8 +43,10 @@ pub fn order_plan(
 ) -> Result<Plan, OrderError> {
     check_allocation(geometries.len(), fields)?;
     let t0 = std::time::Instant::now();
+    let mut detail = Vec::new();
     let ordering = match settings.algo {
         Algo::Baseline => baseline_order(geometries, fields, ctx)?,
+        Algo::Hha => hha::hha_order(geometries, fields, profile, settings, ctx, &mut detail)?,
     };
     let order_s = t0.elapsed().as_secs_f64();
     let by_id = |id: usize| fields.iter().find(|f| f.id == id).cloned();
@@ -52,6 +57,7 @@ pub fn order_plan(
         .collect();
     let mut m = metrics::compute(geometries, &plan_fields, &ordering.steps, profile);
     m.solve_s.order = order_s;
+    m.solve_s.order_detail = detail;
     Ok(Plan {
         name: format!("{:?}", settings.algo).to_lowercase(),
         algo: settings.algo,

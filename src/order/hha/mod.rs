@@ -1,0 +1,507 @@
+//! The hierarchical heuristic algorithm (seed 000 §3.2) and its improvements.
+//!
+//! 1. Fields: an open path over the field centres from the field nearest the work area's top-left
+//!    corner, free end (a virtual end node at zero cost) — exact (Held–Karp) up to 12 fields,
+//!    cheapest arc plus 2-opt/Or-opt beyond.
+//! 2. Per field, a start and an end geometry: nearest the previous / next field's geometries; the
+//!    first field starts with the geometry farthest from where the line to the second field leaves
+//!    it, the last ends with the one farthest from where the line from the previous field enters
+//!    it; a lone field runs from its top-left to its bottom-right geometry.
+//! 3. Per field (in parallel), the geometries' centroids are ordered from the start to the end
+//!    geometry by path-cheapest-arc on the penalised cost of Eq. 7,
+//!    `D = d + w·(|AB|max − |AB|)`, which prefers geometries far from the exit first, so the path
+//!    sweeps towards the next field (w = 0.5; 0.1 with one field).
+//! 4. Start vertices by the vertex enhancement algorithm (VEA, §3.2.3).
+//!
+//! Beyond the seed (`SolverSettings::hha_improve`, on by default): the per-field order is improved
+//! by 2-opt/Or-opt under `d + λ·(backward travel along the sweep)` (λ = w), which keeps the
+//! sweep; the start vertices are then chosen exactly (layered-graph DP, `VertexMode::Exact`); then
+//! local search on the real stroke ends (open geometries may flip) and the exact vertex choice
+//! alternate while the idle travel falls.
+
+use super::tsp::{
+    cheapest_arc, exact_path, local_search, LocalSearch, LsOptions, Node, PathProblem, Tour,
+};
+use super::vertex::{optimal_vertices, vea};
+use super::{OrderError, Ordering};
+use crate::document::{Geometry, MachineProfile, ScanField, SolverSettings, Step, VertexMode};
+use crate::geom::Pt;
+use crate::job::{Cancelled, JobCtx};
+use rayon::prelude::*;
+use std::time::Instant;
+
+/// Fields up to this count are ordered exactly.
+pub const EXACT_FIELDS: usize = 12;
+
+/// Iterated-local-search kicks for a path of `m` nodes.
+pub fn ils_kicks(m: usize) -> usize {
+    (4 * m).clamp(64, 2000)
+}
+
+fn unit(v: Pt) -> Option<Pt> {
+    let n = v.norm();
+    (n > 1e-12).then(|| v.scale(1.0 / n))
+}
+
+/// Where the ray from `c` along `u` leaves the field of size `f` centred at `c`.
+fn exit_point(c: Pt, u: Pt, f: [f64; 2]) -> Pt {
+    let tx = if u.x.abs() > 1e-12 {
+        f[0] / 2.0 / u.x.abs()
+    } else {
+        f64::INFINITY
+    };
+    let ty = if u.y.abs() > 1e-12 {
+        f[1] / 2.0 / u.y.abs()
+    } else {
+        f64::INFINITY
+    };
+    c.plus(u.scale(tx.min(ty)))
+}
+
+/// Field visiting order (field slots): open path from the field nearest the work area's top-left.
+pub fn field_order(
+    fields: &[ScanField],
+    profile: &MachineProfile,
+    ctx: &JobCtx,
+) -> Result<Vec<usize>, Cancelled> {
+    let n = fields.len();
+    if n == 0 {
+        return Ok(Vec::new());
+    }
+    let corner = Pt::new(-profile.field_mm[0] / 2.0, -profile.field_mm[1] / 2.0);
+    let first = (0..n)
+        .min_by(|&a, &b| {
+            fields[a]
+                .center
+                .dist2(corner)
+                .total_cmp(&fields[b].center.dist2(corner))
+                .then(a.cmp(&b))
+        })
+        .unwrap_or(0);
+    let c: Vec<Pt> = fields.iter().map(|f| f.center).collect();
+    let dist = |i: usize, j: usize| c[i].dist(c[j]);
+    if n <= EXACT_FIELDS {
+        return Ok(exact_path(&dist, n, first, None));
+    }
+    let order = cheapest_arc(n, first, None, &dist);
+    let mut prob = PathProblem::points(&c, &vec![0.0; n], 0.0);
+    prob.fixed_first = true;
+    let mut tour = Tour {
+        order,
+        flipped: vec![false; n],
+    };
+    local_search(&prob, &mut tour, LsOptions::default(), ctx)?;
+    Ok(tour.order)
+}
+
+/// The sweep direction of each field in visiting order: towards the next field (the last field:
+/// away from the previous one; a lone field: towards its bottom-right).
+fn sweep_dirs(centers: &[Pt]) -> Vec<Pt> {
+    let n = centers.len();
+    let diag = Pt::new(
+        std::f64::consts::FRAC_1_SQRT_2,
+        std::f64::consts::FRAC_1_SQRT_2,
+    );
+    (0..n)
+        .map(|j| {
+            let d = if j + 1 < n {
+                centers[j + 1].minus(centers[j])
+            } else if j > 0 {
+                centers[j].minus(centers[j - 1])
+            } else {
+                diag
+            };
+            unit(d).unwrap_or(diag)
+        })
+        .collect()
+}
+
+/// The member of `a` and of `b` closest to each other (centroids; each side pruned to the 64
+/// members nearest the other field's centre).
+fn closest_pair(a: &[usize], b: &[usize], cent: &[Pt], ca: Pt, cb: Pt) -> (usize, usize) {
+    let prune = |v: &[usize], towards: Pt| -> Vec<usize> {
+        let mut w: Vec<(f64, usize)> = v.iter().map(|&g| (cent[g].dist2(towards), g)).collect();
+        w.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+        w.truncate(64);
+        w.into_iter().map(|x| x.1).collect()
+    };
+    let (pa, pb) = (prune(a, cb), prune(b, ca));
+    let mut best = (f64::INFINITY, a[0], b[0]);
+    for &x in &pa {
+        for &y in &pb {
+            let d = cent[x].dist2(cent[y]);
+            if d < best.0 {
+                best = (d, x, y);
+            }
+        }
+    }
+    (best.1, best.2)
+}
+
+/// Start and end geometry of every field (in visiting order), seed 000 §3.2.2.
+fn start_end(fields: &[&ScanField], cent: &[Pt], profile: &MachineProfile) -> Vec<(usize, usize)> {
+    let n = fields.len();
+    let f = profile.field_mm;
+    let mut se: Vec<(Option<usize>, Option<usize>)> = vec![(None, None); n];
+    if n == 1 {
+        let b = fields[0].bbox();
+        let (tl, br) = (Pt::new(b.min_x, b.min_y), Pt::new(b.max_x, b.max_y));
+        let g = &fields[0].geometries;
+        let near = |p: Pt, skip: Option<usize>| {
+            g.iter()
+                .copied()
+                .filter(|&x| Some(x) != skip || g.len() == 1)
+                .min_by(|&x, &y| {
+                    cent[x]
+                        .dist2(p)
+                        .total_cmp(&cent[y].dist2(p))
+                        .then(x.cmp(&y))
+                })
+        };
+        let s = near(tl, None);
+        return vec![(s.unwrap_or(0), near(br, s).unwrap_or(0))];
+    }
+    for j in 0..n - 1 {
+        let (a, b) = closest_pair(
+            &fields[j].geometries,
+            &fields[j + 1].geometries,
+            cent,
+            fields[j].center,
+            fields[j + 1].center,
+        );
+        se[j].1 = Some(a);
+        se[j + 1].0 = Some(b);
+    }
+    let farthest = |g: &[usize], p: Pt, skip: Option<usize>| {
+        g.iter()
+            .copied()
+            .filter(|&x| Some(x) != skip || g.len() == 1)
+            .max_by(|&x, &y| {
+                cent[x]
+                    .dist2(p)
+                    .total_cmp(&cent[y].dist2(p))
+                    .then(y.cmp(&x))
+            })
+    };
+    // first field: farthest from where the line to the second field leaves it
+    let u = unit(fields[1].center.minus(fields[0].center)).unwrap_or(Pt::new(1.0, 0.0));
+    let exit = exit_point(fields[0].center, u, f);
+    se[0].0 = farthest(&fields[0].geometries, exit, se[0].1);
+    // last field: farthest from where the line from the previous field enters it
+    let u = unit(fields[n - 2].center.minus(fields[n - 1].center)).unwrap_or(Pt::new(-1.0, 0.0));
+    let entry = exit_point(fields[n - 1].center, u, f);
+    se[n - 1].1 = farthest(&fields[n - 1].geometries, entry, se[n - 1].0);
+    // a start that equals the end in a field with more members: the end takes the next nearest
+    for j in 0..n {
+        let g = &fields[j].geometries;
+        if g.len() > 1 && se[j].0 == se[j].1 {
+            let target = if j + 1 < n {
+                fields[j + 1].center
+            } else {
+                entry
+            };
+            let s = se[j].0;
+            let alt = g
+                .iter()
+                .copied()
+                .filter(|&x| Some(x) != s)
+                .min_by(|&x, &y| {
+                    cent[x]
+                        .dist2(target)
+                        .total_cmp(&cent[y].dist2(target))
+                        .then(x.cmp(&y))
+                });
+            se[j].1 = alt;
+        }
+    }
+    se.into_iter()
+        .zip(fields)
+        .map(|((s, e), fl)| {
+            let g0 = fl.geometries.first().copied().unwrap_or(0);
+            (s.unwrap_or(g0), e.unwrap_or(g0))
+        })
+        .collect()
+}
+
+/// Orders one field's geometries from `start` to `end`: cheapest arc on Eq. 7's cost, then (when
+/// `improve`) local search under the directional cost.
+#[allow(clippy::too_many_arguments)]
+fn order_field(
+    members: &[usize],
+    start: usize,
+    end: usize,
+    cent: &[Pt],
+    exit: Pt,
+    dir: Pt,
+    weight: f64,
+    diag: f64,
+    improve: bool,
+    seed: u64,
+    ctx: &JobCtx,
+) -> Result<Vec<usize>, Cancelled> {
+    let m = members.len();
+    if m <= 2 {
+        let mut v = vec![start];
+        v.extend(members.iter().copied().filter(|&g| g != start));
+        return Ok(v);
+    }
+    let pts: Vec<Pt> = members.iter().map(|&g| cent[g]).collect();
+    let local = |g: usize| members.iter().position(|&x| x == g).unwrap_or(0);
+    let (s, e) = (local(start), local(end));
+    // Eq. 7: |AB| = distance from the exit point B to the projection A of the next centroid on the
+    // line through the field along the sweep direction
+    let ab: Vec<f64> = pts.iter().map(|p| p.minus(exit).dot(dir).abs()).collect();
+    let arc = |i: usize, j: usize| pts[i].dist(pts[j]) + weight * (diag - ab[j]);
+    let order = cheapest_arc(m, s, (e != s).then_some(e), &arc);
+    let order = if improve {
+        let proj: Vec<f64> = pts.iter().map(|p| p.dot(dir)).collect();
+        let mut prob = PathProblem::points(&pts, &proj, weight);
+        prob.fixed_first = true;
+        prob.fixed_last = e != s;
+        let mut tour = Tour {
+            order,
+            flipped: vec![false; m],
+        };
+        LocalSearch::new(&prob, LsOptions::default()).iterated(
+            &mut tour,
+            ils_kicks(m),
+            seed,
+            ctx,
+        )?;
+        tour.order
+    } else {
+        order
+    };
+    Ok(order.into_iter().map(|k| members[k]).collect())
+}
+
+/// Local search of one field's strokes on their real ends, between fixed anchor points.
+#[allow(clippy::too_many_arguments)]
+fn refine_field(
+    geometries: &[Geometry],
+    run: &[Step],
+    before: Option<Pt>,
+    after: Option<Pt>,
+    dir: Pt,
+    lambda: f64,
+    seed: u64,
+    ctx: &JobCtx,
+) -> Result<Vec<Step>, Cancelled> {
+    let mut nodes = Vec::with_capacity(run.len() + 2);
+    let mut flippable = Vec::with_capacity(run.len() + 2);
+    if let Some(a) = before {
+        nodes.push(Node::point(a, f64::NEG_INFINITY));
+        flippable.push(false);
+    }
+    for s in run {
+        let g = &geometries[s.geometry];
+        let (a, b) = g.ends(s.choice(g));
+        // open geometries are stored forwards so that flipping means reversing
+        let (ns, ne) = if g.closed || !s.reversed {
+            (a, b)
+        } else {
+            (b, a)
+        };
+        nodes.push(Node {
+            s: ns,
+            e: ne,
+            p: g.centroid().dot(dir),
+        });
+        flippable.push(!g.closed);
+    }
+    if let Some(z) = after {
+        nodes.push(Node::point(z, f64::INFINITY));
+        flippable.push(false);
+    }
+    // anchors must not add penalties: give them the projections of their neighbours
+    let k0 = usize::from(before.is_some());
+    if before.is_some() {
+        nodes[0].p = nodes.get(k0).map_or(0.0, |q| q.p);
+    }
+    if after.is_some() {
+        let last = nodes.len() - 1;
+        nodes[last].p = nodes[last - 1].p;
+    }
+    let n = nodes.len();
+    let prob = PathProblem {
+        nodes,
+        lambda,
+        fixed_first: before.is_some(),
+        fixed_last: after.is_some(),
+        flippable,
+    };
+    let mut flipped = vec![false; n];
+    for (k, s) in run.iter().enumerate() {
+        flipped[k0 + k] = !geometries[s.geometry].closed && s.reversed;
+    }
+    let mut tour = Tour {
+        order: (0..n).collect(),
+        flipped,
+    };
+    LocalSearch::new(&prob, LsOptions::default()).iterated(
+        &mut tour,
+        ils_kicks(run.len()),
+        seed,
+        ctx,
+    )?;
+    Ok(tour
+        .order
+        .iter()
+        .filter(|&&v| v >= k0 && v < k0 + run.len())
+        .map(|&v| {
+            let s = run[v - k0];
+            let g = &geometries[s.geometry];
+            if g.closed {
+                s
+            } else {
+                Step::from_choice(s.geometry, s.field, g, usize::from(tour.flipped[v]))
+            }
+        })
+        .collect())
+}
+
+/// Runs HHA on allocated fields. `stage_s` receives the time of each sub-stage.
+pub fn hha_order(
+    geometries: &[Geometry],
+    fields: &[ScanField],
+    profile: &MachineProfile,
+    settings: &SolverSettings,
+    ctx: &JobCtx,
+    stage_s: &mut Vec<(String, f64)>,
+) -> Result<Ordering, OrderError> {
+    let t = Instant::now();
+    let live: Vec<&ScanField> = fields.iter().filter(|f| !f.geometries.is_empty()).collect();
+    let live_owned: Vec<ScanField> = live.iter().map(|f| (*f).clone()).collect();
+    let fo = field_order(&live_owned, profile, ctx)?;
+    let ordered: Vec<&ScanField> = fo.iter().map(|&k| live[k]).collect();
+    stage_s.push(("field_order".into(), t.elapsed().as_secs_f64()));
+    ctx.progress("order", 1, 4, "HHA: field order");
+
+    let t = Instant::now();
+    let cent: Vec<Pt> = geometries.iter().map(Geometry::centroid).collect();
+    let centers: Vec<Pt> = ordered.iter().map(|f| f.center).collect();
+    let dirs = sweep_dirs(&centers);
+    let se = start_end(&ordered, &cent, profile);
+    let single = ordered.len() == 1;
+    let weight = if single {
+        0.1
+    } else {
+        settings.direction_weight
+    };
+    let diag = profile.field_mm[0].hypot(profile.field_mm[1]);
+    let improve = settings.hha_improve || single;
+    let per_field: Vec<Result<Vec<usize>, Cancelled>> = ordered
+        .par_iter()
+        .enumerate()
+        .map(|(j, f)| {
+            let (exit, dir) = if single {
+                (cent[se[0].1], dirs[0])
+            } else {
+                (exit_point(f.center, dirs[j], profile.field_mm), dirs[j])
+            };
+            let seed = settings.seed ^ ((j as u64) << 32);
+            order_field(
+                &f.geometries,
+                se[j].0,
+                se[j].1,
+                &cent,
+                exit,
+                dir,
+                weight,
+                diag,
+                improve,
+                seed,
+                ctx,
+            )
+        })
+        .collect();
+    let mut steps = Vec::with_capacity(geometries.len());
+    for (j, r) in per_field.into_iter().enumerate() {
+        for g in r? {
+            steps.push(Step::from_choice(g, ordered[j].id, &geometries[g], 0));
+        }
+    }
+    stage_s.push(("field_paths".into(), t.elapsed().as_secs_f64()));
+    ctx.progress("order", 2, 4, "HHA: vertices");
+
+    let t = Instant::now();
+    vea(geometries, &mut steps, ctx)?;
+    if settings.vertex == VertexMode::Exact {
+        optimal_vertices(geometries, &mut steps, ctx)?;
+    }
+    stage_s.push(("vertices".into(), t.elapsed().as_secs_f64()));
+    ctx.progress("order", 3, 4, "HHA: refine");
+
+    if settings.hha_improve {
+        let t = Instant::now();
+        let lambda = weight;
+        let mut best = super::metrics::idle_mm(geometries, &steps);
+        for round in 0..6 {
+            let mut next = steps.clone();
+            for parity in 0..2 {
+                let runs = field_runs(&next);
+                let updates: Vec<Result<(usize, Vec<Step>), Cancelled>> = runs
+                    .par_iter()
+                    .enumerate()
+                    .filter(|(j, _)| j % 2 == parity)
+                    .map(|(j, &(a, b))| {
+                        let before =
+                            (a > 0).then(|| super::metrics::step_ends(geometries, &next[a - 1]).1);
+                        let after = (b < next.len())
+                            .then(|| super::metrics::step_ends(geometries, &next[b]).0);
+                        let seed = settings.seed ^ ((j as u64) << 32) ^ ((round as u64) << 16);
+                        refine_field(
+                            geometries,
+                            &next[a..b],
+                            before,
+                            after,
+                            dirs[j],
+                            lambda,
+                            seed,
+                            ctx,
+                        )
+                        .map(|r| (a, r))
+                    })
+                    .collect();
+                for u in updates {
+                    let (a, r) = u?;
+                    next[a..a + r.len()].copy_from_slice(&r);
+                }
+            }
+            let idle = if settings.vertex == VertexMode::Exact {
+                optimal_vertices(geometries, &mut next, ctx)?
+            } else {
+                vea(geometries, &mut next, ctx)?;
+                super::metrics::idle_mm(geometries, &next)
+            };
+            if idle < best - 1e-6 {
+                best = idle;
+                steps = next;
+            } else {
+                break;
+            }
+        }
+        stage_s.push(("refine".into(), t.elapsed().as_secs_f64()));
+    }
+    ctx.progress("order", 4, 4, "HHA: done");
+    Ok(Ordering {
+        field_order: ordered.iter().map(|f| f.id).collect(),
+        steps,
+    })
+}
+
+/// Position ranges `[a, b)` of each field's run in a step list (in order).
+pub fn field_runs(steps: &[Step]) -> Vec<(usize, usize)> {
+    let mut out = Vec::new();
+    let mut a = 0;
+    for k in 1..=steps.len() {
+        if k == steps.len() || steps[k].field != steps[a].field {
+            out.push((a, k));
+            a = k;
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,149 @@
+use super::*;
+use crate::document::Source;
+use crate::fields::tests_support::rect;
+
+fn field(id: usize, x: f64, y: f64, geometries: Vec<usize>) -> ScanField {
+    ScanField {
+        id,
+        center: Pt::new(x, y),
+        size: [70.0, 70.0],
+        locked: false,
+        geometries,
+    }
+}
+
+#[test]
+fn field_path_starts_top_left_with_a_free_end() {
+    // a row of fields listed in scrambled order; the open path runs from the top-left one to the
+    // far end without returning (a closed tour would come back)
+    let xs = [210.0, 35.0, 140.0, 280.0, 70.0];
+    let fields: Vec<ScanField> = xs
+        .iter()
+        .enumerate()
+        .map(|(k, &x)| field(k, x, 35.0, vec![]))
+        .collect();
+    let order = field_order(&fields, &MachineProfile::default(), &JobCtx::default()).unwrap();
+    let visited: Vec<f64> = order.iter().map(|&k| xs[k]).collect();
+    assert_eq!(visited, vec![35.0, 70.0, 140.0, 210.0, 280.0]);
+}
+
+#[test]
+fn field_path_with_many_fields_is_a_permutation_from_top_left() {
+    let mut fields = Vec::new();
+    for k in 0..30 {
+        fields.push(field(
+            k,
+            ((k * 7919) % 300) as f64,
+            ((k * 104729) % 300) as f64,
+            vec![],
+        ));
+    }
+    let order = field_order(&fields, &MachineProfile::default(), &JobCtx::default()).unwrap();
+    let mut s = order.clone();
+    s.sort();
+    assert_eq!(s, (0..30).collect::<Vec<_>>());
+    let first = &fields[order[0]];
+    let corner = Pt::new(-35.0, -35.0);
+    assert!(fields
+        .iter()
+        .all(|f| f.center.dist(corner) >= first.center.dist(corner)));
+}
+
+#[test]
+fn start_and_end_geometries_follow_the_seed_rules() {
+    // two fields side by side; field 0 holds geometries 0..3, field 1 holds 3..6
+    let gs: Vec<Geometry> = [10.0, 40.0, 60.0, 80.0, 100.0, 130.0]
+        .iter()
+        .map(|&x| rect(x, 30.0, 2.0, 2.0))
+        .collect();
+    let cent: Vec<Pt> = gs.iter().map(Geometry::centroid).collect();
+    let f0 = field(0, 35.0, 35.0, vec![0, 1, 2]);
+    let f1 = field(1, 105.0, 35.0, vec![3, 4, 5]);
+    let se = start_end(&[&f0, &f1], &cent, &MachineProfile::default());
+    // first field: starts farthest from its exit towards field 1 (geometry 0), ends nearest field 1
+    assert_eq!(se[0], (0, 2));
+    // last field: starts nearest field 0 (geometry 3), ends farthest from its entry (geometry 5)
+    assert_eq!(se[1], (3, 5));
+    // a lone field runs from top-left to bottom-right
+    let lone = field(0, 35.0, 35.0, vec![0, 1, 2]);
+    let gs2 = [
+        rect(50.0, 50.0, 1.0, 1.0),
+        rect(5.0, 5.0, 1.0, 1.0),
+        rect(30.0, 30.0, 1.0, 1.0),
+    ];
+    let cent2: Vec<Pt> = gs2.iter().map(Geometry::centroid).collect();
+    assert_eq!(
+        start_end(&[&lone], &cent2, &MachineProfile::default()),
+        vec![(1, 0)]
+    );
+}
+
+#[test]
+fn eq7_construction_sweeps_towards_the_exit() {
+    // a 5 × 4 grid of dots in one field that exits to the right: the penalised cheapest arc
+    // visits columns left to right (few backward steps), plain nearest neighbour need not
+    let mut cent = Vec::new();
+    let mut members = Vec::new();
+    for c in 0..5 {
+        for r in 0..4 {
+            members.push(cent.len());
+            cent.push(Pt::new(10.0 + c as f64 * 12.0, 10.0 + r as f64 * 3.0));
+        }
+    }
+    let dir = Pt::new(1.0, 0.0);
+    let exit = exit_point(Pt::new(35.0, 35.0), dir, [70.0, 70.0]);
+    let diag = 70f64.hypot(70.0);
+    let order = order_field(
+        &members,
+        0,
+        19,
+        &cent,
+        exit,
+        dir,
+        0.5,
+        diag,
+        false,
+        1,
+        &JobCtx::default(),
+    )
+    .unwrap();
+    assert_eq!((order[0], order[19]), (0, 19));
+    let back: f64 = order
+        .windows(2)
+        .map(|w| (cent[w[0]].x - cent[w[1]].x).max(0.0))
+        .sum();
+    assert!(back < 1e-9, "moves backwards by {back} mm");
+}
+
+#[test]
+fn hha_orders_every_geometry_once_field_by_field() {
+    let gs: Vec<Geometry> = (0..40)
+        .map(|k| {
+            rect(
+                (k % 10) as f64 * 25.0 + 5.0,
+                (k / 10) as f64 * 15.0 + 5.0,
+                3.0,
+                3.0,
+            )
+        })
+        .collect();
+    let p = MachineProfile::default();
+    let settings = SolverSettings::default();
+    let placed = crate::fields::place_fields(&gs, &p, &settings, &[], &JobCtx::default()).unwrap();
+    let mut detail = Vec::new();
+    let o = hha_order(
+        &gs,
+        &placed.fields,
+        &p,
+        &settings,
+        &JobCtx::default(),
+        &mut detail,
+    )
+    .unwrap();
+    let mut seen: Vec<usize> = o.steps.iter().map(|s| s.geometry).collect();
+    seen.sort();
+    assert_eq!(seen, (0..40).collect::<Vec<_>>());
+    assert_eq!(field_runs(&o.steps).len(), o.field_order.len());
+    assert!(detail.iter().any(|(n, _)| n == "vertices"));
+    let _ = Source::default();
+}
