@@ -61,8 +61,20 @@ pub fn load_svg(
 /// `split_oversize`, geometries larger than a field are first cut into pieces (and reported as
 /// warnings). The plan is not added to `doc.plans`.
 pub fn plan_document(doc: &mut Document, ctx: &JobCtx) -> Result<Plan, PipelineError> {
-    let file = doc.source.clone().unwrap_or_else(|| "document".into());
     let t0 = Instant::now();
+    let lower_bound = place_document_fields(doc, ctx)?;
+    let fields_s = t0.elapsed().as_secs_f64();
+    let mut plan = order_document(doc, ctx)?;
+    plan.metrics.solve_s.fields = fields_s;
+    plan.metrics.fields_lower_bound = Some(lower_bound);
+    plan.metrics.solve_s.total = plan.metrics.solve_s.fields + plan.metrics.solve_s.order;
+    Ok(plan)
+}
+
+/// The field stage alone: splits oversize geometries when the settings say so, then places the
+/// fields (keeping locked ones) and allocates the geometries. Returns the lower bound on fields.
+pub fn place_document_fields(doc: &mut Document, ctx: &JobCtx) -> Result<usize, PipelineError> {
+    let file = doc.source.clone().unwrap_or_else(|| "document".into());
     if doc.settings.split_oversize {
         let warnings = split_oversize(&mut doc.geometries, doc.profile.field_mm);
         if !warnings.is_empty() {
@@ -74,27 +86,22 @@ pub fn plan_document(doc: &mut Document, ctx: &JobCtx) -> Result<Plan, PipelineE
     }
     let locked: Vec<ScanField> = doc.fields.iter().filter(|f| f.locked).cloned().collect();
     let placement = place_fields(&doc.geometries, &doc.profile, &doc.settings, &locked, ctx)
-        .map_err(|source| PipelineError::Fields {
-            file: file.clone(),
-            source,
-        })?;
-    let fields_s = t0.elapsed().as_secs_f64();
-    doc.fields = placement.fields.clone();
+        .map_err(|source| PipelineError::Fields { file, source })?;
+    doc.fields = placement.fields;
+    Ok(placement.lower_bound)
+}
+
+/// The ordering stage alone, on the document's current fields and allocation (as the operator
+/// left them). Takes `&Document` so that it can run on a snapshot in a background thread.
+pub fn order_document(doc: &Document, ctx: &JobCtx) -> Result<Plan, PipelineError> {
+    let file = doc.source.clone().unwrap_or_else(|| "document".into());
     if let Some(r) = ctx.recorder() {
         r.geometry(&doc.geometries);
         r.fields(&doc.fields);
     }
-    let mut plan = order_plan(
-        &doc.geometries,
-        &doc.fields,
-        &doc.profile,
-        &doc.settings,
-        ctx,
-    )
-    .map_err(|source| PipelineError::Order { file, source })?;
-    plan.metrics.solve_s.fields = fields_s;
-    plan.metrics.fields_lower_bound = Some(placement.lower_bound);
-    plan.metrics.solve_s.total = plan.metrics.solve_s.fields + plan.metrics.solve_s.order;
+    let mut plan = order_plan(&doc.geometries, &doc.fields, &doc.profile, &doc.settings, ctx)
+        .map_err(|source| PipelineError::Order { file, source })?;
+    plan.metrics.solve_s.total = plan.metrics.solve_s.order;
     if let Some(r) = ctx.recorder() {
         r.plan(&doc.geometries, &plan);
     }
