@@ -107,15 +107,20 @@ pub fn coverage(fields: &[ScanField], field_mm: [f64; 2]) -> (f64, f64) {
     (once, overlap_pct)
 }
 
+/// Share of the field width the path may fall back before it counts as a direction change.
+pub const DIRECTION_HYSTERESIS: f64 = 0.1;
+
 /// Number of direction changes of the TCP path along the base path (seed 000 §2.3).
 ///
 /// The sweep is followed through the geometries' centroids in marking order. Each move from one
 /// centroid to the next is projected onto the *local base direction* of the field being left:
 /// the unit vector from that field's centre to the next field's centre (for the last field, from
-/// the previous field's centre; with a single field, from the first to the last centroid). Moves
-/// whose projection is shorter than 1 % of the field width are ignored (sideways steps within a
-/// row); every sign reversal between the remaining projections counts as one direction change.
-/// A plan that sweeps steadily from field to field scores 0; a nearest-neighbour zigzag scores high.
+/// the previous field's centre; with a single field, from the first to the last centroid). The
+/// projections add up to the progress `s` along the base path. A direction change is counted
+/// when `s` falls back from its running extreme by more than [`DIRECTION_HYSTERESIS`] × the
+/// field width (7 mm on a 70 mm field) — local back-and-forth the scanner absorbs inside its
+/// field is not a change; turning back across the work is. A plan that sweeps steadily from field
+/// to field scores 0; a nearest-neighbour order that wanders back and forth scores high.
 pub fn direction_changes(
     geometries: &[Geometry],
     fields: &[ScanField],
@@ -151,19 +156,38 @@ pub fn direction_changes(
             fallback
         }
     };
-    let dead_band = 0.01 * field_mm[0];
-    let mut last_sign = 0.0f64;
+    let band = DIRECTION_HYSTERESIS * field_mm[0];
+    let mut progress = 0.0f64;
+    // heading: +1 forwards, −1 backwards, 0 not yet known; `extreme` is the running max (heading
+    // forwards) or min (backwards) since the last change
+    let mut heading = 0.0f64;
+    let (mut hi, mut lo) = (0.0f64, 0.0f64);
     let mut changes = 0;
     for (w, s) in centroids.windows(2).zip(steps) {
-        let p = w[1].minus(w[0]).dot(dir_of(s.field));
-        if p.abs() < dead_band {
-            continue;
+        progress += w[1].minus(w[0]).dot(dir_of(s.field));
+        if heading >= 0.0 {
+            hi = hi.max(progress);
         }
-        let sign = p.signum();
-        if last_sign != 0.0 && sign != last_sign {
+        if heading <= 0.0 {
+            lo = lo.min(progress);
+        }
+        if heading > 0.0 && progress < hi - band {
             changes += 1;
+            heading = -1.0;
+            lo = progress;
+        } else if heading < 0.0 && progress > lo + band {
+            changes += 1;
+            heading = 1.0;
+            hi = progress;
+        } else if heading == 0.0 {
+            if progress > lo + band {
+                heading = 1.0;
+                hi = progress;
+            } else if progress < hi - band {
+                heading = -1.0;
+                lo = progress;
+            }
         }
-        last_sign = sign;
     }
     changes
 }
@@ -268,6 +292,15 @@ mod tests {
         assert_eq!(direction_changes(&gs, &f, &sweep, [70.0, 70.0]), 0);
         let zig = steps(&[0, 2, 1, 3]);
         assert_eq!(direction_changes(&gs, &f, &zig, [70.0, 70.0]), 2);
+        // falling back less than 7 mm is not a change
+        let gs2: Vec<Geometry> = [0.0, 10.0, 5.0, 20.0]
+            .iter()
+            .map(|&x| rect(x, 0.0, 2.0, 2.0))
+            .collect();
+        assert_eq!(
+            direction_changes(&gs2, &f, &steps(&[0, 1, 2, 3]), [70.0, 70.0]),
+            0
+        );
     }
 
     #[test]

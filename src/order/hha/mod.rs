@@ -33,9 +33,10 @@ use std::time::Instant;
 /// Fields up to this count are ordered exactly.
 pub const EXACT_FIELDS: usize = 12;
 
-/// Iterated-local-search kicks for a path of `m` nodes.
+/// Iterated-local-search kicks for a path of `m` nodes: two per node, at least 32, at most 1000,
+/// and at most 300,000 / m so that the work (each kick costs O(m)) stays bounded on huge fields.
 pub fn ils_kicks(m: usize) -> usize {
-    (4 * m).clamp(64, 2000)
+    (2 * m).clamp(32, 1000).min(300_000 / m.max(1)).max(8)
 }
 
 fn unit(v: Pt) -> Option<Pt> {
@@ -434,8 +435,26 @@ pub fn hha_order(
 
     if settings.hha_improve {
         let t = Instant::now();
-        let lambda = weight;
-        let mut best = super::metrics::idle_mm(geometries, &steps);
+        let lambda = weight * 2.0;
+        // rounds are judged by the same directional objective the local search optimises
+        let cent_dir: Vec<f64> = {
+            let runs = field_runs(&steps);
+            let mut p = vec![0.0; geometries.len()];
+            for (j, &(a, b)) in runs.iter().enumerate() {
+                for s in &steps[a..b] {
+                    p[s.geometry] = cent[s.geometry].dot(dirs[j]);
+                }
+            }
+            p
+        };
+        let objective = |st: &[Step], idle: f64| -> f64 {
+            idle + lambda
+                * st.windows(2)
+                    .filter(|w| w[0].field == w[1].field)
+                    .map(|w| (cent_dir[w[0].geometry] - cent_dir[w[1].geometry]).max(0.0))
+                    .sum::<f64>()
+        };
+        let mut best = objective(&steps, super::metrics::idle_mm(geometries, &steps));
         for round in 0..6 {
             let mut next = steps.clone();
             for parity in 0..2 {
@@ -474,10 +493,15 @@ pub fn hha_order(
                 vea(geometries, &mut next, ctx)?;
                 super::metrics::idle_mm(geometries, &next)
             };
-            if idle < best - 1e-6 {
-                best = idle;
-                steps = next;
-            } else {
+            let idle = objective(&next, idle);
+            if idle >= best - 1e-9 {
+                break;
+            }
+            // keep the gain; another round only while it gains at least 0.1 %
+            let small = idle > best * (1.0 - 1e-3);
+            best = idle;
+            steps = next;
+            if small {
                 break;
             }
         }
