@@ -1,12 +1,14 @@
 //! Command-line front end (clap). Errors print as one line: `galvoplan: error: FILE: what`.
 
 mod bench;
+mod hatch_bench;
 mod plan;
 mod progress;
 
 use anyhow::Result;
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use galvoplan::document::{Algo, FieldsMode, MachineProfile, SolverSettings, VertexMode};
+use galvoplan::hatch::{HatchSettings, OutlineMode};
 use galvoplan::import::ImportOptions;
 use std::path::PathBuf;
 
@@ -26,6 +28,8 @@ enum Command {
     Plan(PlanArgs),
     /// Run the pipeline over SVG files or folders and print one row per instance.
     Bench(BenchArgs),
+    /// Seed 003's hatch experiment: counts, lengths and times of zigzag and contour fills.
+    HatchBench(hatch_bench::HatchBenchArgs),
 }
 
 /// Field placement, as on the command line.
@@ -44,6 +48,8 @@ enum FieldsArg {
 enum AlgoArg {
     /// Hierarchical heuristic (seed 000 §3.2) with exact vertices and local search.
     Hha,
+    /// Hybrid genetic algorithm (seed 000 §3.3), seeded with the HHA plan.
+    Hga,
     /// Fields in creation order, nearest neighbour inside each.
     Baseline,
 }
@@ -75,6 +81,9 @@ struct JobOpts {
     /// Directional penalty weight w (seed 000 Eq. 7; 0.1 is used with one field).
     #[arg(long, default_value_t = 0.5)]
     direction_weight: f64,
+    /// HGA: do not put the HHA plan into the initial population (seed 000's HGA).
+    #[arg(long)]
+    no_hha_seed: bool,
     /// Run HHA as seed 000 describes it (no local search, no alternation), for comparison.
     #[arg(long)]
     seed_hha: bool,
@@ -90,6 +99,27 @@ struct JobOpts {
     /// Chord tolerance for flattening curves, mm.
     #[arg(long, default_value_t = 0.01)]
     chord_tol: f64,
+    /// Hatch the closed shapes: STYLE:SPACING_MM[:ANGLE_DEG], STYLE = zigzag | lines | cross |
+    /// contour (closed paths of one SVG element form one region, even-odd).
+    #[arg(long, value_name = "STYLE:SPACING_MM[:ANGLE_DEG]")]
+    hatch: Option<String>,
+    /// Hatch edge offset from the outline, mm (default: one spacing).
+    #[arg(long, value_name = "MM", requires = "hatch")]
+    hatch_edge: Option<f64>,
+    /// Outlines of hatched shapes: marked before the hatch, after it, or not at all.
+    #[arg(long, value_enum, requires = "hatch")]
+    hatch_outline: Option<OutlineArg>,
+}
+
+/// Outline handling of hatched shapes, as on the command line.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+enum OutlineArg {
+    /// Outline first, then the hatch.
+    Before,
+    /// Hatch first, then the outline.
+    After,
+    /// Hatch only.
+    None,
 }
 
 impl JobOpts {
@@ -116,6 +146,7 @@ impl JobOpts {
             },
             algo: match self.algo {
                 AlgoArg::Hha => Algo::Hha,
+                AlgoArg::Hga => Algo::Hga,
                 AlgoArg::Baseline => Algo::Baseline,
             },
             seed: self.seed,
@@ -127,8 +158,29 @@ impl JobOpts {
             },
             hha_improve: !self.seed_hha,
             direction_weight: self.direction_weight,
+            ga: galvoplan::document::GaParams {
+                seed_with_hha: !self.no_hha_seed,
+                ..Default::default()
+            },
+            hatch: self.hatch()?,
             ..SolverSettings::default()
         })
+    }
+    fn hatch(&self) -> Result<Option<HatchSettings>> {
+        let Some(spec) = &self.hatch else {
+            return Ok(None);
+        };
+        let mut h = HatchSettings::parse_spec(spec)?;
+        h.edge_offset_mm = self.hatch_edge;
+        if let Some(o) = self.hatch_outline {
+            h.outline = match o {
+                OutlineArg::Before => OutlineMode::Before,
+                OutlineArg::After => OutlineMode::After,
+                OutlineArg::None => OutlineMode::None,
+            };
+        }
+        h.validate()?;
+        Ok(Some(h))
     }
     fn import(&self) -> Result<ImportOptions> {
         anyhow::ensure!(
@@ -186,6 +238,7 @@ pub fn main() -> std::process::ExitCode {
     let result = match cli.command {
         Some(Command::Plan(a)) => plan::run(&a),
         Some(Command::Bench(a)) => bench::run(&a),
+        Some(Command::HatchBench(a)) => hatch_bench::run(&a),
         None => open_gui(cli.file),
     };
     match result {

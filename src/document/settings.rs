@@ -24,6 +24,8 @@ pub enum Algo {
     /// Hierarchical heuristic algorithm (seed 000 §3.2).
     #[default]
     Hha,
+    /// Hybrid genetic algorithm (seed 000 §3.3).
+    Hga,
 }
 
 /// How start vertices are chosen once the order is fixed.
@@ -77,7 +79,7 @@ impl Default for GaParams {
             elite_fraction: 0.2,
             mutation_rate: 0.3,
             stall_generations: 5,
-            seed_with_hha: false,
+            seed_with_hha: true,
         }
     }
 }
@@ -107,6 +109,9 @@ pub struct SolverSettings {
     pub split_oversize: bool,
     /// GA parameters.
     pub ga: GaParams,
+    /// Hatch fills for closed regions (none: outlines only).
+    #[serde(default)]
+    pub hatch: Option<crate::hatch::HatchSettings>,
 }
 
 impl Default for SolverSettings {
@@ -122,6 +127,7 @@ impl Default for SolverSettings {
             cost_model: CostModel::default(),
             split_oversize: false,
             ga: GaParams::default(),
+            hatch: None,
         }
     }
 }

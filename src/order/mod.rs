@@ -1,6 +1,7 @@
 //! Ordering: which field after which, which geometry after which, where each one starts.
 
 mod baseline;
+pub mod hga;
 pub mod hha;
 pub mod metrics;
 pub mod tsp;
@@ -44,9 +45,38 @@ pub fn order_plan(
     check_allocation(geometries.len(), fields)?;
     let t0 = std::time::Instant::now();
     let mut detail = Vec::new();
+    let mut history = Vec::new();
     let ordering = match settings.algo {
         Algo::Baseline => baseline_order(geometries, fields, ctx)?,
         Algo::Hha => hha::hha_order(geometries, fields, profile, settings, ctx, &mut detail)?,
+        Algo::Hga => {
+            let t = std::time::Instant::now();
+            let seed_plan = if settings.ga.seed_with_hha {
+                Some(hha::hha_order(
+                    geometries,
+                    fields,
+                    profile,
+                    settings,
+                    ctx,
+                    &mut detail,
+                )?)
+            } else {
+                None
+            };
+            detail.push(("hha_seed".into(), t.elapsed().as_secs_f64()));
+            let t = std::time::Instant::now();
+            let r = hga::hga_order(
+                geometries,
+                fields,
+                profile,
+                settings,
+                seed_plan.as_ref(),
+                ctx,
+            )?;
+            detail.push(("ga".into(), t.elapsed().as_secs_f64()));
+            history = r.history;
+            r.ordering
+        }
     };
     let order_s = t0.elapsed().as_secs_f64();
     let by_id = |id: usize| fields.iter().find(|f| f.id == id).cloned();
@@ -64,7 +94,7 @@ pub fn order_plan(
         fields: plan_fields,
         order: ordering.steps,
         metrics: m,
-        history: Vec::new(),
+        history,
     })
 }
 

@@ -330,6 +330,8 @@ fn refine_field(
         fixed_first: before.is_some(),
         fixed_last: after.is_some(),
         flippable,
+        cluster: Vec::new(),
+        cluster_penalty: 0.0,
     };
     let mut flipped = vec![false; n];
     for (k, s) in run.iter().enumerate() {

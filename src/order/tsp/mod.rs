@@ -48,7 +48,14 @@ pub struct PathProblem {
     pub fixed_last: bool,
     /// Nodes that may be flipped (open geometries); others keep their orientation.
     pub flippable: Vec<bool>,
+    /// Cluster (scan field) of each node, or empty for none; [`NO_CLUSTER`] marks a node outside.
+    pub cluster: Vec<u32>,
+    /// Added to every edge between two different clusters (seed 000 Algorithm 1).
+    pub cluster_penalty: f64,
 }
+
+/// Cluster of a node that belongs to none (e.g. a start point): its edges carry no penalty.
+pub const NO_CLUSTER: u32 = u32::MAX;
 
 /// A tour: node order plus orientation per node.
 #[derive(Debug, Clone, PartialEq)]
@@ -72,6 +79,8 @@ impl PathProblem {
             fixed_first: false,
             fixed_last: false,
             flippable: vec![false; points.len()],
+            cluster: Vec::new(),
+            cluster_penalty: 0.0,
         }
     }
     fn start(&self, t: &Tour, i: usize) -> Pt {
@@ -92,12 +101,22 @@ impl PathProblem {
     pub fn cost(&self, t: &Tour, i: usize, j: usize) -> f64 {
         self.end(t, i).dist(self.start(t, j))
             + self.lambda * (self.nodes[i].p - self.nodes[j].p).max(0.0)
+            + self.cross(i, j)
+    }
+    /// The cluster penalty of an edge (symmetric, so reversals leave it unchanged).
+    fn cross(&self, i: usize, j: usize) -> f64 {
+        match (self.cluster.get(i), self.cluster.get(j)) {
+            (Some(&a), Some(&b)) if a != b && a != NO_CLUSTER && b != NO_CLUSTER => {
+                self.cluster_penalty
+            }
+            _ => 0.0,
+        }
     }
     /// Cost of `i → j` when `i` has orientation `fi` and `j` has `fj`.
     fn cost_o(&self, i: usize, fi: bool, j: usize, fj: bool) -> f64 {
         let a = if fi { self.nodes[i].s } else { self.nodes[i].e };
         let b = if fj { self.nodes[j].e } else { self.nodes[j].s };
-        a.dist(b) + self.lambda * (self.nodes[i].p - self.nodes[j].p).max(0.0)
+        a.dist(b) + self.lambda * (self.nodes[i].p - self.nodes[j].p).max(0.0) + self.cross(i, j)
     }
     /// Total cost of a tour.
     pub fn tour_cost(&self, t: &Tour) -> f64 {
@@ -299,7 +318,7 @@ impl EndGrid {
 /// points (so that long open strokes find the nodes near either end), plus the two nearest in
 /// each quadrant around each end point (so that clusters of coincident points do not hide the
 /// rest of the instance). Deterministic: ties by index.
-fn neighbour_lists(prob: &PathProblem, k: usize) -> Vec<Vec<usize>> {
+pub fn neighbour_lists(prob: &PathProblem, k: usize) -> Vec<Vec<usize>> {
     let n = prob.nodes.len();
     let k = k.min(n.saturating_sub(1));
     let near = |a: &Node, b: &Node| -> f64 {
@@ -394,7 +413,7 @@ pub fn local_search(
 /// the GA's chromosome enhancement).
 pub struct LocalSearch<'a> {
     prob: &'a PathProblem,
-    nbr: Vec<Vec<usize>>,
+    nbr: std::borrow::Cow<'a, [Vec<usize>]>,
     opts: LsOptions,
 }
 
@@ -403,7 +422,17 @@ impl<'a> LocalSearch<'a> {
     pub fn new(prob: &'a PathProblem, opts: LsOptions) -> Self {
         Self {
             prob,
-            nbr: neighbour_lists(prob, opts.neighbours),
+            nbr: std::borrow::Cow::Owned(neighbour_lists(prob, opts.neighbours)),
+            opts,
+        }
+    }
+
+    /// A local search with neighbour lists supplied by the caller (shared between runs whose nodes
+    /// keep their neighbourhoods, e.g. the GA's chromosomes).
+    pub fn with_neighbours(prob: &'a PathProblem, nbr: &'a [Vec<usize>], opts: LsOptions) -> Self {
+        Self {
+            prob,
+            nbr: std::borrow::Cow::Borrowed(nbr),
             opts,
         }
     }

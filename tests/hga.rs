@@ -1,0 +1,105 @@
+//! HGA end to end: valid, deterministic, never worse than the HHA plan it starts from, with a
+//! convergence history; a cancel returns the best plan so far at once.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+mod common;
+
+use galvoplan::document::{Algo, Document, MachineProfile, SolverSettings};
+use galvoplan::job::{CancelToken, JobCtx, NoProgress};
+use galvoplan::pipeline::{load_svg, order_document, place_document_fields};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+fn demo(settings: SolverSettings) -> Document {
+    let path = common::root().join("assets/examples/demo.svg");
+    let (mut doc, _) = load_svg(
+        &path,
+        MachineProfile::default(),
+        settings,
+        &Default::default(),
+    )
+    .unwrap();
+    place_document_fields(&mut doc, &JobCtx::default()).unwrap();
+    doc
+}
+
+fn hga(seed: u64) -> SolverSettings {
+    SolverSettings {
+        algo: Algo::Hga,
+        seed,
+        ..SolverSettings::default()
+    }
+}
+
+#[test]
+fn hga_is_valid_deterministic_and_no_worse_than_hha() {
+    let doc = demo(hga(3));
+    let a = order_document(&doc, &JobCtx::default()).unwrap();
+    common::check_plan(&doc, &a);
+    let b = order_document(&doc, &JobCtx::default()).unwrap();
+    assert_eq!(a.order, b.order, "same seed, same plan");
+    let mut hha_doc = doc.clone();
+    hha_doc.settings.algo = Algo::Hha;
+    let h = order_document(&hha_doc, &JobCtx::default()).unwrap();
+    assert!(
+        a.metrics.idle_mm <= h.metrics.idle_mm + 1e-9,
+        "HGA {} vs HHA {}",
+        a.metrics.idle_mm,
+        h.metrics.idle_mm
+    );
+    // convergence history: generation 0 first, best never gets worse, times increase
+    assert!(
+        a.history.len() >= 6,
+        "stops after 5 generations without improvement"
+    );
+    assert_eq!(a.history[0].generation, 0);
+    for w in a.history.windows(2) {
+        assert!(w[1].best_idle_mm <= w[0].best_idle_mm + 1e-9);
+        assert!(w[1].elapsed_s >= w[0].elapsed_s);
+        assert!(w[1].mean_idle_mm >= w[1].best_idle_mm - 1e-9);
+    }
+    assert!((a.history.last().unwrap().best_idle_mm - a.metrics.idle_mm).abs() < 1e-6);
+}
+
+#[test]
+fn seed_ga_without_hha_is_valid_too() {
+    let mut s = hga(5);
+    s.ga.seed_with_hha = false;
+    s.time_limit_s = Some(5.0);
+    let doc = demo(s);
+    let p = order_document(&doc, &JobCtx::default()).unwrap();
+    common::check_plan(&doc, &p);
+}
+
+#[test]
+fn cancel_returns_the_best_plan_so_far_quickly() {
+    let mut s = hga(7);
+    s.ga.stall_generations = 1_000; // would run for a long time
+    let doc = demo(s);
+    let token = CancelToken::new();
+    let ctx = JobCtx::new(token.clone(), Arc::new(NoProgress));
+    let (tx, rx) = std::sync::mpsc::channel();
+    let worker_doc = doc.clone();
+    let worker = std::thread::spawn(move || {
+        let r = order_document(&worker_doc, &ctx);
+        tx.send(Instant::now()).unwrap();
+        r
+    });
+    std::thread::sleep(Duration::from_millis(1500));
+    let asked = Instant::now();
+    token.cancel();
+    let done = rx
+        .recv_timeout(Duration::from_secs(10))
+        .expect("the run stops after a cancel");
+    let plan = worker
+        .join()
+        .unwrap()
+        .expect("a cancelled HGA still returns its best plan");
+    let latency = done.saturating_duration_since(asked);
+    assert!(
+        latency < Duration::from_millis(200),
+        "cancel took {latency:?}"
+    );
+    common::check_plan(&doc, &plan);
+    assert!(!plan.history.is_empty());
+}
