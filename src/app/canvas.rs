@@ -1,10 +1,14 @@
-//! The work-area canvas: base stroke, artwork, scan fields and the planned path.
+//! The work-area canvas: pan and zoom, field selection and dragging, hover information.
+//! Drawing is in [`super::paint`]; the canvas never changes the document, it returns
+//! [`CanvasAction`]s that the app turns into commands.
 
-use crate::document::{Document, Plan};
-use crate::geom::Pt;
-use egui::{Color32, Pos2, Rect, Sense, Shape, Stroke, Vec2};
+use super::paint;
+use crate::document::{Geometry, MachineProfile, Plan, ScanField};
+use crate::geom::{point_segment_dist, Pt};
+use egui::{Color32, PointerButton, Pos2, Rect, Sense, Vec2};
+use serde::{Deserialize, Serialize};
 
-/// Pan and zoom of a canvas: screen = origin + mm × scale.
+/// Pan and zoom of a canvas: screen = rect corner + offset + mm × scale.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct View {
     /// Pixels per mm (0 until the first fit).
@@ -40,135 +44,323 @@ impl View {
     }
     /// screen → mm.
     pub fn to_mm(&self, rect: Rect, p: Pos2) -> Pt {
-        let v = (p - rect.min - self.offset) / self.scale;
+        let v = (p - rect.min - self.offset) / self.scale.max(1e-6);
         Pt::new(f64::from(v.x), f64::from(v.y))
     }
 }
 
-/// Draws a document and optionally a plan.
-pub struct Canvas<'a> {
-    /// The document.
-    pub doc: &'a Document,
-    /// The plan to draw over it.
-    pub plan: Option<&'a Plan>,
+/// Which layers a canvas draws (kept between runs).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Layers {
+    /// Scan fields.
+    pub fields: bool,
+    /// The planned path: idle moves and start/end markers.
+    pub path: bool,
+    /// Direction arrows on idle moves long enough to carry one.
+    pub arrows: bool,
+    /// The base path through the field centres in visiting order.
+    pub base_path: bool,
+    /// Marks coloured by their position in the order (else: by open/closed).
+    pub order_colours: bool,
 }
 
+impl Default for Layers {
+    fn default() -> Self {
+        Self {
+            fields: true,
+            path: true,
+            arrows: true,
+            base_path: true,
+            order_colours: true,
+        }
+    }
+}
+
+/// What a drag is doing.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+enum Drag {
+    #[default]
+    None,
+    Pan,
+    /// Moving a field; `grab` is the field centre minus the pointer position at the start.
+    Field {
+        id: usize,
+        grab: Pt,
+    },
+}
+
+/// Pan/zoom and gesture state of a canvas (shared by synchronised canvases).
+#[derive(Debug, Clone, Default)]
+pub struct CanvasState {
+    /// The view.
+    pub view: View,
+    /// The rectangle of the last frame (screen coordinates).
+    pub rect: Option<Rect>,
+    /// Fit to the reach of the machine on the next frame.
+    pub fit_requested: bool,
+    drag: Drag,
+}
+
+/// What the operator did on an editable canvas.
+#[derive(Debug, Clone, PartialEq)]
+pub enum CanvasAction {
+    /// Selected a field (or nothing).
+    Select(Option<usize>),
+    /// Dragged a field to a new centre (every frame of the drag).
+    Move {
+        /// Field id.
+        id: usize,
+        /// Requested centre, mm.
+        center: Pt,
+    },
+    /// A field drag ended.
+    EndDrag,
+    /// Asked for a new field there (add tool click or double-click).
+    Add(Pt),
+}
+
+/// One planned path to draw.
+#[derive(Debug, Clone, Copy)]
+pub struct PathLayer<'a> {
+    /// The plan.
+    pub plan: &'a Plan,
+    /// Colour of its idle moves and markers.
+    pub colour: Color32,
+}
+
+/// A canvas over the machine's work area.
+pub struct Canvas<'a> {
+    /// Accessible name and caption.
+    pub label: &'a str,
+    /// The artwork.
+    pub geometries: &'a [Geometry],
+    /// The machine (stroke and field size).
+    pub profile: &'a MachineProfile,
+    /// Fields to draw.
+    pub fields: &'a [ScanField],
+    /// Number fields by their position in this list (visiting order) instead of by id.
+    pub number_by_order: bool,
+    /// Planned paths to draw (one, or two overlaid).
+    pub paths: Vec<PathLayer<'a>>,
+    /// Geometries no field holds (drawn in red).
+    pub uncovered: &'a [usize],
+    /// The selected field id.
+    pub selected: Option<usize>,
+    /// Fields can be selected, dragged and added.
+    pub editable: bool,
+    /// The add tool is active: a click adds a field.
+    pub add_tool: bool,
+    /// Layers.
+    pub layers: Layers,
+    /// The path was planned on other fields than those shown.
+    pub stale: bool,
+}
+
+/// Screen distance within which the pointer "hovers" a geometry, px.
+const HOVER_PX: f32 = 6.0;
+
 impl Canvas<'_> {
-    /// Shows the canvas filling the available space; drag pans, the wheel zooms about the cursor,
-    /// a double-click fits the view.
-    pub fn show(&self, ui: &mut egui::Ui, view: &mut View) -> egui::Response {
-        let (rect, response) = ui.allocate_exact_size(ui.available_size(), Sense::click_and_drag());
-        let p = &self.doc.profile;
-        let (lo, hi) = (
-            Pt::new(-p.field_mm[0] / 2.0, -p.field_mm[1] / 2.0),
-            Pt::new(
-                p.stroke_mm[0] + p.field_mm[0] / 2.0,
-                p.stroke_mm[1] + p.field_mm[1] / 2.0,
-            ),
-        );
-        if view.scale == 0.0 || response.double_clicked() {
-            view.fit(rect, lo, hi);
+    /// Reach of the laser: the base stroke grown by half a field.
+    pub fn reach(profile: &MachineProfile) -> (Pt, Pt) {
+        let [fw, fh] = profile.field_mm;
+        let [sw, sh] = profile.stroke_mm;
+        (
+            Pt::new(-fw / 2.0, -fh / 2.0),
+            Pt::new(sw + fw / 2.0, sh + fh / 2.0),
+        )
+    }
+
+    /// Shows the canvas in `size` (the available space when `None`); returns the response and
+    /// the operator's actions. Drag pans (or moves the field under the pointer when editable),
+    /// the middle button always pans, the wheel zooms about the cursor.
+    pub fn show(
+        &self,
+        ui: &mut egui::Ui,
+        state: &mut CanvasState,
+        size: Option<Vec2>,
+    ) -> (egui::Response, Vec<CanvasAction>) {
+        let size = size.unwrap_or_else(|| ui.available_size());
+        let (rect, response) = ui.allocate_exact_size(size, Sense::click_and_drag());
+        let label = self.label.to_string();
+        response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Canvas, true, &label));
+        let mut actions = Vec::new();
+        let (lo, hi) = Self::reach(self.profile);
+        if let Some(old) = state.rect {
+            // keep the content anchored to the centre when the canvas is resized
+            state.view.offset += (rect.size() - old.size()) / 2.0;
+        }
+        if state.view.scale == 0.0 || state.fit_requested {
+            state.view.fit(rect, lo, hi);
+            state.fit_requested = false;
+        }
+        state.rect = Some(rect);
+        self.interact(ui, &response, rect, state, &mut actions);
+        let painter = ui.painter_at(rect);
+        paint::paint(&painter, self, &state.view, rect);
+        let response = if state.drag == Drag::None {
+            self.hover_info(response, rect, &state.view)
+        } else {
+            response
+        };
+        (response, actions)
+    }
+
+    fn interact(
+        &self,
+        ui: &egui::Ui,
+        response: &egui::Response,
+        rect: Rect,
+        state: &mut CanvasState,
+        actions: &mut Vec<CanvasAction>,
+    ) {
+        let view = &mut state.view;
+        if response.drag_started() {
+            let origin = ui.input(|i| i.pointer.press_origin());
+            state.drag = Drag::Pan;
+            if self.editable && response.drag_started_by(PointerButton::Primary) && !self.add_tool {
+                if let Some(f) = origin.and_then(|o| self.field_at(view.to_mm(rect, o))) {
+                    actions.push(CanvasAction::Select(Some(f.id)));
+                    if !f.locked {
+                        let o = origin.map(|o| view.to_mm(rect, o)).unwrap_or(f.center);
+                        state.drag = Drag::Field {
+                            id: f.id,
+                            grab: f.center.minus(o),
+                        };
+                    }
+                }
+            }
         }
         if response.dragged() {
-            view.offset += response.drag_delta();
+            match state.drag {
+                Drag::Field { id, grab } => {
+                    if let Some(p) = response.interact_pointer_pos() {
+                        let center = view.to_mm(rect, p).plus(grab);
+                        actions.push(CanvasAction::Move { id, center });
+                    }
+                }
+                Drag::Pan | Drag::None => view.offset += response.drag_delta(),
+            }
+        }
+        if response.drag_stopped() {
+            if matches!(state.drag, Drag::Field { .. }) {
+                actions.push(CanvasAction::EndDrag);
+            }
+            state.drag = Drag::None;
+        }
+        if self.editable {
+            if let Some(p) = response.interact_pointer_pos() {
+                let mm = view.to_mm(rect, p);
+                if response.double_clicked() || (response.clicked() && self.add_tool) {
+                    actions.push(CanvasAction::Add(mm));
+                } else if response.clicked() {
+                    actions.push(CanvasAction::Select(self.field_at(mm).map(|f| f.id)));
+                }
+            }
         }
         if response.hovered() {
-            let scroll = ui.ctx().input(|i| i.smooth_scroll_delta.y);
-            if scroll != 0.0 {
+            let (scroll, zoom) = ui.input(|i| (i.smooth_scroll_delta.y, i.zoom_delta()));
+            let factor = zoom * (scroll / 200.0).exp();
+            if (factor - 1.0).abs() > 1e-4 {
                 if let Some(cursor) = response.hover_pos() {
                     let before = view.to_mm(rect, cursor);
-                    view.scale = (view.scale * (scroll / 200.0).exp()).clamp(0.01, 500.0);
+                    view.scale = (view.scale * factor).clamp(0.01, 1000.0);
                     let after = view.to_screen(rect, before);
                     view.offset += cursor - after;
                 }
             }
         }
-        let painter = ui.painter_at(rect);
-        painter.rect_filled(rect, 0.0, Color32::from_gray(250));
-        let v = *view;
-        let s = |q: Pt| v.to_screen(rect, q);
-        // reach of the laser, and the base stroke
-        painter.rect_stroke(
-            Rect::from_two_pos(s(lo), s(hi)),
-            0.0,
-            Stroke::new(1.0, Color32::from_gray(200)),
-            egui::StrokeKind::Middle,
-        );
-        painter.rect_stroke(
-            Rect::from_two_pos(
-                s(Pt::new(0.0, 0.0)),
-                s(Pt::new(p.stroke_mm[0], p.stroke_mm[1])),
-            ),
-            0.0,
-            Stroke::new(1.0, Color32::from_gray(150)),
-            egui::StrokeKind::Middle,
-        );
-        let fields = self
-            .plan
-            .map(|pl| &pl.fields[..])
-            .unwrap_or(&self.doc.fields[..]);
-        for (k, f) in fields.iter().enumerate() {
-            let b = f.bbox();
-            let r = Rect::from_two_pos(s(Pt::new(b.min_x, b.min_y)), s(Pt::new(b.max_x, b.max_y)));
-            painter.rect_filled(r, 0.0, Color32::from_rgba_unmultiplied(59, 130, 246, 20));
-            painter.rect_stroke(
-                r,
-                0.0,
-                Stroke::new(1.0, Color32::from_rgb(59, 130, 246)),
-                egui::StrokeKind::Middle,
-            );
-            painter.text(
-                r.min + Vec2::new(4.0, 2.0),
-                egui::Align2::LEFT_TOP,
-                format!("{}", k + 1),
-                egui::FontId::proportional(14.0),
-                Color32::from_rgb(29, 78, 216),
-            );
-        }
-        for g in &self.doc.geometries {
-            let mut pts: Vec<Pos2> = g.points.iter().map(|&q| s(q)).collect();
-            let color = if g.closed {
-                Color32::from_gray(30)
+    }
+
+    /// The field under a point: of those holding it, the one with the nearest centre.
+    pub fn field_at(&self, p: Pt) -> Option<&ScanField> {
+        self.fields
+            .iter()
+            .filter(|f| f.bbox().contains_pt(p, 0.0))
+            .min_by(|a, b| p.dist2(a.center).total_cmp(&p.dist2(b.center)))
+    }
+
+    /// The geometry nearest to `p` within `tol_mm`.
+    pub fn geometry_at(&self, p: Pt, tol_mm: f64) -> Option<usize> {
+        let mut best: Option<(f64, usize)> = None;
+        for (k, g) in self.geometries.iter().enumerate() {
+            let b = g.bbox();
+            if p.x < b.min_x - tol_mm
+                || p.x > b.max_x + tol_mm
+                || p.y < b.min_y - tol_mm
+                || p.y > b.max_y + tol_mm
+            {
+                continue;
+            }
+            let n = g.points.len();
+            let segs = if g.closed { n } else { n.saturating_sub(1) };
+            let d = if n == 1 {
+                p.dist(g.points[0])
             } else {
-                Color32::from_rgb(120, 60, 0)
+                (0..segs)
+                    .map(|i| point_segment_dist(p, g.points[i], g.points[(i + 1) % n]))
+                    .fold(f64::INFINITY, f64::min)
             };
-            if g.closed {
-                if let Some(&f) = pts.first() {
-                    pts.push(f);
-                }
-            }
-            painter.add(Shape::line(pts, Stroke::new(1.0, color)));
-        }
-        if let Some(plan) = self.plan {
-            let mut prev: Option<Pt> = None;
-            for st in &plan.order {
-                let Some(g) = self.doc.geometries.get(st.geometry) else {
-                    continue;
-                };
-                let (a, z) = g.ends(st.choice(g));
-                if let Some(pz) = prev {
-                    painter.line_segment(
-                        [s(pz), s(a)],
-                        Stroke::new(1.0, Color32::from_rgb(220, 38, 38)),
-                    );
-                }
-                prev = Some(z);
-            }
-            if let (Some(first), Some(last)) = (plan.order.first(), plan.order.last()) {
-                let g0 = &self.doc.geometries[first.geometry];
-                let gl = &self.doc.geometries[last.geometry];
-                painter.circle_filled(
-                    s(g0.ends(first.choice(g0)).0),
-                    5.0,
-                    Color32::from_rgb(22, 163, 74),
-                );
-                painter.circle_filled(
-                    s(gl.ends(last.choice(gl)).1),
-                    5.0,
-                    Color32::from_rgb(220, 38, 38),
-                );
+            if d <= tol_mm && best.is_none_or(|(bd, _)| d < bd) {
+                best = Some((d, k));
             }
         }
-        response
+        best.map(|b| b.1)
+    }
+
+    fn hover_info(&self, response: egui::Response, rect: Rect, view: &View) -> egui::Response {
+        let Some(pos) = response.hover_pos() else {
+            return response;
+        };
+        let p = view.to_mm(rect, pos);
+        let tol = f64::from(HOVER_PX / view.scale.max(1e-6));
+        let geometry = self.geometry_at(p, tol);
+        let field = self.field_at(p).filter(|_| self.layers.fields);
+        let mut lines = vec![format!("x {:.2} mm, y {:.2} mm", p.x, p.y)];
+        if let Some(k) = geometry {
+            let g = &self.geometries[k];
+            lines.push(format!(
+                "geometry {k}: {}, {}, {} vertices, {:.2} mm long",
+                g.describe(),
+                if g.closed { "closed" } else { "open" },
+                g.points.len(),
+                g.length_mm()
+            ));
+            match self.fields.iter().find(|f| f.geometries.contains(&k)) {
+                Some(f) => lines.push(format!("  allocated to field {}", f.id)),
+                None if self.uncovered.contains(&k) => {
+                    lines.push("  not covered by any field".into())
+                }
+                None => {}
+            }
+            for path in &self.paths {
+                if let Some(i) = path.plan.order.iter().position(|s| s.geometry == k) {
+                    lines.push(format!(
+                        "  {}: stroke {} of {}",
+                        path.plan.name,
+                        i + 1,
+                        path.plan.order.len()
+                    ));
+                }
+            }
+        }
+        if let Some(f) = field {
+            lines.push(format!(
+                "field {}: centre ({:.2}, {:.2}) mm, {} geometries{}",
+                f.id,
+                f.center.x,
+                f.center.y,
+                f.geometries.len(),
+                if f.locked { ", locked" } else { "" }
+            ));
+        }
+        if geometry.is_none() && field.is_none() {
+            return response;
+        }
+        response.on_hover_ui_at_pointer(|ui| {
+            for l in &lines {
+                ui.label(l);
+            }
+        })
     }
 }

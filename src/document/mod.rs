@@ -9,7 +9,7 @@ mod settings;
 pub use geometry::{Geometry, Source};
 pub use plan::{GenerationRecord, Metrics, Plan, ScanField, StageTimes, Step};
 pub use profile::{
-    AxisLimits, GcodeDialect, LaserTiming, MachineProfile, ProfileError, ScannerSpeeds,
+    AxisLimits, GcodeDialect, LaserTiming, MachineProfile, ProfileError, ScannerSpeeds, BUILTIN,
 };
 pub use project::{load_project, save_project, write_atomic, ProjectError, PROJECT_VERSION};
 pub use settings::{Algo, CostModel, FieldsMode, GaParams, SolverSettings, VertexMode};

@@ -1,0 +1,340 @@
+//! Edit commands: the only way the GUI changes a [`Document`], and the undo/redo history.
+//!
+//! Every command is applied by [`History::execute`], which first takes a snapshot of what the
+//! command can change (fields, profile, settings; for a re-placement also the geometries, plans
+//! and warnings, since splitting oversize geometries rewrites them). Undo restores the snapshot.
+//! Consecutive commands of one gesture (the moves of one field drag) share a group and so undo
+//! together.
+
+use crate::document::{Document, Geometry, MachineProfile, Plan, ScanField, SolverSettings};
+use crate::fields::{add_field, delete_field, move_field, reallocate, set_locked};
+use crate::geom::Pt;
+use crate::import::Warning;
+use crate::job::JobCtx;
+use crate::pipeline::place_document_fields;
+
+/// Number of undo steps kept.
+pub const UNDO_LIMIT: usize = 200;
+
+/// An edit of the document.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Command {
+    /// Moves a field's centre (clamped into the base stroke); locked fields refuse.
+    MoveField {
+        /// Field id.
+        id: usize,
+        /// New centre, mm.
+        center: Pt,
+    },
+    /// Adds an unlocked field at a centre.
+    AddField {
+        /// Centre, mm.
+        center: Pt,
+    },
+    /// Deletes a field.
+    DeleteField {
+        /// Field id.
+        id: usize,
+    },
+    /// Locks or unlocks a field.
+    SetLocked {
+        /// Field id.
+        id: usize,
+        /// New state.
+        locked: bool,
+    },
+    /// Replaces the unlocked fields by the automatic placement of the settings (keeps locked
+    /// fields; splits oversize geometries first when the settings say so), as the CLI does.
+    ReplaceAutomatically,
+    /// Replaces the machine profile (already validated); fields take the new size and stay
+    /// inside the new stroke.
+    SetProfile(Box<MachineProfile>),
+    /// Replaces the solver settings (already validated).
+    SetSettings(Box<SolverSettings>),
+}
+
+impl Command {
+    /// A short description for the status line and the undo menu.
+    pub fn describe(&self) -> String {
+        match self {
+            Command::MoveField { id, .. } => format!("move field {id}"),
+            Command::AddField { .. } => "add field".into(),
+            Command::DeleteField { id } => format!("delete field {id}"),
+            Command::SetLocked { id, locked: true } => format!("lock field {id}"),
+            Command::SetLocked { id, locked: false } => format!("unlock field {id}"),
+            Command::ReplaceAutomatically => "re-place fields automatically".into(),
+            Command::SetProfile(_) => "change machine profile".into(),
+            Command::SetSettings(_) => "change solver settings".into(),
+        }
+    }
+}
+
+/// What an applied command reports.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Outcome {
+    /// Geometries no field holds after the command.
+    pub uncovered: Vec<usize>,
+    /// The id of a field the command added.
+    pub added: Option<usize>,
+}
+
+/// Applies a command to the document (no history); errors leave the document unchanged.
+pub fn apply(doc: &mut Document, cmd: &Command) -> Result<Outcome, String> {
+    let uncovered = |a: crate::fields::Allocation| Outcome {
+        uncovered: a.uncovered,
+        added: None,
+    };
+    match cmd {
+        Command::MoveField { id, center } => move_field(doc, *id, *center)
+            .map(uncovered)
+            .map_err(|e| e.to_string()),
+        Command::AddField { center } => {
+            let (id, a) = add_field(doc, *center);
+            Ok(Outcome {
+                uncovered: a.uncovered,
+                added: Some(id),
+            })
+        }
+        Command::DeleteField { id } => delete_field(doc, *id)
+            .map(uncovered)
+            .map_err(|e| e.to_string()),
+        Command::SetLocked { id, locked } => {
+            set_locked(doc, *id, *locked).map_err(|e| e.to_string())?;
+            Ok(uncovered(reallocate(doc)))
+        }
+        Command::ReplaceAutomatically => {
+            let mut work = doc.clone();
+            place_document_fields(&mut work, &JobCtx::default()).map_err(|e| e.to_string())?;
+            *doc = work;
+            Ok(uncovered(reallocate(doc)))
+        }
+        Command::SetProfile(p) => {
+            p.validate()?;
+            doc.profile = (**p).clone();
+            let [sw, sh] = doc.profile.stroke_mm;
+            for f in &mut doc.fields {
+                f.size = doc.profile.field_mm;
+                f.center = Pt::new(f.center.x.clamp(0.0, sw), f.center.y.clamp(0.0, sh));
+            }
+            Ok(uncovered(reallocate(doc)))
+        }
+        Command::SetSettings(s) => {
+            doc.settings = (**s).clone();
+            Ok(uncovered(reallocate(doc)))
+        }
+    }
+}
+
+/// What a command may change, saved before it runs.
+#[derive(Debug, Clone)]
+struct Snapshot {
+    fields: Vec<ScanField>,
+    profile: MachineProfile,
+    settings: SolverSettings,
+    /// Geometries, plans and warnings, for commands that can rewrite them.
+    content: Option<(Vec<Geometry>, Vec<Plan>, Vec<Warning>)>,
+    what: String,
+}
+
+impl Snapshot {
+    fn take(doc: &Document, cmd: &Command) -> Self {
+        let content = matches!(cmd, Command::ReplaceAutomatically).then(|| {
+            (
+                doc.geometries.clone(),
+                doc.plans.clone(),
+                doc.warnings.clone(),
+            )
+        });
+        Self {
+            fields: doc.fields.clone(),
+            profile: doc.profile.clone(),
+            settings: doc.settings.clone(),
+            content,
+            what: cmd.describe(),
+        }
+    }
+    /// Puts the snapshot into the document and returns the snapshot of what it replaced.
+    fn swap(self, doc: &mut Document) -> Snapshot {
+        let content = self.content.map(|(g, p, w)| {
+            (
+                std::mem::replace(&mut doc.geometries, g),
+                std::mem::replace(&mut doc.plans, p),
+                std::mem::replace(&mut doc.warnings, w),
+            )
+        });
+        Snapshot {
+            fields: std::mem::replace(&mut doc.fields, self.fields),
+            profile: std::mem::replace(&mut doc.profile, self.profile),
+            settings: std::mem::replace(&mut doc.settings, self.settings),
+            content,
+            what: self.what,
+        }
+    }
+}
+
+/// Undo and redo stacks.
+#[derive(Debug, Default)]
+pub struct History {
+    undo: Vec<Snapshot>,
+    redo: Vec<Snapshot>,
+    /// Group of the newest undo entry, while its gesture may still add to it.
+    open_group: Option<u64>,
+}
+
+impl History {
+    /// Runs a command; on success records the state before it (unless `group` equals the
+    /// group of the newest entry, which then covers this command too). Clears the redo stack.
+    pub fn execute(
+        &mut self,
+        doc: &mut Document,
+        cmd: Command,
+        group: Option<u64>,
+    ) -> Result<Outcome, String> {
+        let coalesce = group.is_some() && group == self.open_group && !self.undo.is_empty();
+        let before = (!coalesce).then(|| Snapshot::take(doc, &cmd));
+        let outcome = apply(doc, &cmd)?;
+        if let Some(s) = before {
+            self.undo.push(s);
+            if self.undo.len() > UNDO_LIMIT {
+                self.undo.remove(0);
+            }
+        }
+        self.redo.clear();
+        self.open_group = group;
+        Ok(outcome)
+    }
+    /// Ends the current gesture: the next command starts a new undo entry.
+    pub fn close_group(&mut self) {
+        self.open_group = None;
+    }
+    /// Undoes the newest entry; returns its description.
+    pub fn undo(&mut self, doc: &mut Document) -> Option<String> {
+        let s = self.undo.pop()?;
+        let what = s.what.clone();
+        self.redo.push(s.swap(doc));
+        self.open_group = None;
+        Some(what)
+    }
+    /// Redoes the newest undone entry; returns its description.
+    pub fn redo(&mut self, doc: &mut Document) -> Option<String> {
+        let s = self.redo.pop()?;
+        let what = s.what.clone();
+        self.undo.push(s.swap(doc));
+        self.open_group = None;
+        Some(what)
+    }
+    /// Description of what Undo would undo.
+    pub fn undo_label(&self) -> Option<&str> {
+        self.undo.last().map(|s| s.what.as_str())
+    }
+    /// Description of what Redo would redo.
+    pub fn redo_label(&self) -> Option<&str> {
+        self.redo.last().map(|s| s.what.as_str())
+    }
+    /// Forgets everything (a new document).
+    pub fn clear(&mut self) {
+        *self = Self::default();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::document::{Geometry, Source};
+
+    fn doc() -> Document {
+        let sq = |x: f64, y: f64| {
+            Geometry::new(
+                vec![
+                    Pt::new(x, y),
+                    Pt::new(x + 2.0, y),
+                    Pt::new(x + 2.0, y + 2.0),
+                    Pt::new(x, y + 2.0),
+                ],
+                true,
+                Source::default(),
+            )
+        };
+        Document {
+            geometries: vec![sq(10.0, 10.0), sq(150.0, 150.0)],
+            ..Document::default()
+        }
+    }
+
+    #[test]
+    fn undo_redo_and_grouped_drag() {
+        let mut d = doc();
+        let mut h = History::default();
+        let out = h
+            .execute(
+                &mut d,
+                Command::AddField {
+                    center: Pt::new(35.0, 35.0),
+                },
+                None,
+            )
+            .unwrap();
+        assert_eq!(out.uncovered, vec![1]);
+        let id = out.added.unwrap();
+        // a drag of three moves is one undo step
+        for x in [60.0, 100.0, 151.0] {
+            h.execute(
+                &mut d,
+                Command::MoveField {
+                    id,
+                    center: Pt::new(x, 151.0),
+                },
+                Some(7),
+            )
+            .unwrap();
+        }
+        h.close_group();
+        assert_eq!(d.fields[0].geometries, vec![1]);
+        assert_eq!(h.undo(&mut d).as_deref(), Some("move field 0"));
+        assert_eq!(d.fields[0].center, Pt::new(35.0, 35.0));
+        assert_eq!(d.fields[0].geometries, vec![0]);
+        assert_eq!(h.redo(&mut d).as_deref(), Some("move field 0"));
+        assert_eq!(d.fields[0].center, Pt::new(151.0, 151.0));
+        h.undo(&mut d);
+        h.undo(&mut d);
+        assert!(d.fields.is_empty());
+        assert!(h.undo(&mut d).is_none());
+    }
+
+    #[test]
+    fn failed_commands_change_nothing() {
+        let mut d = doc();
+        let mut h = History::default();
+        assert!(h
+            .execute(&mut d, Command::DeleteField { id: 3 }, None)
+            .is_err());
+        assert!(h.undo_label().is_none());
+        let mut bad = MachineProfile::default();
+        bad.field_mm[0] = -1.0;
+        assert!(h
+            .execute(&mut d, Command::SetProfile(Box::new(bad)), None)
+            .is_err());
+        assert_eq!(d.profile, MachineProfile::default());
+    }
+
+    #[test]
+    fn profile_change_resizes_fields_and_undoes() {
+        let mut d = doc();
+        let mut h = History::default();
+        h.execute(&mut d, Command::ReplaceAutomatically, None)
+            .unwrap();
+        assert!(!d.fields.is_empty());
+        let mut p = d.profile.clone();
+        p.field_mm = [30.0, 30.0];
+        p.stroke_mm = [100.0, 100.0];
+        h.execute(&mut d, Command::SetProfile(Box::new(p)), None)
+            .unwrap();
+        assert!(d
+            .fields
+            .iter()
+            .all(|f| f.size == [30.0, 30.0] && f.center.x <= 100.0 && f.center.y <= 100.0));
+        h.undo(&mut d);
+        assert!(d.fields.iter().all(|f| f.size == [70.0, 70.0]));
+        assert_eq!(d.profile, MachineProfile::default());
+    }
+}

@@ -1,0 +1,153 @@
+//! Files: opening SVGs and projects, saving projects (atomically), exports, recent files.
+//! Dialogs (rfd) are optional: without a desktop portal they return `None` at once, and every
+//! operation is also reachable through the [`App`](super::App) methods that take a path.
+
+use crate::document::{load_project, write_atomic, Document, MachineProfile, Plan, SolverSettings};
+use crate::export::{preview_svg, report_json, write_gcode};
+use crate::import::ImportOptions;
+use crate::job::JobCtx;
+use crate::pipeline::{load_svg, place_document_fields};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// How many recent files are kept.
+pub const RECENT_MAX: usize = 10;
+
+/// File extension of project files.
+pub const PROJECT_EXT: &str = "galvoplan";
+
+/// Recently opened or saved files, newest first.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Recent(pub Vec<PathBuf>);
+
+impl Recent {
+    /// Puts `path` first (once).
+    pub fn push(&mut self, path: &Path) {
+        let p = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
+        self.0.retain(|q| *q != p);
+        self.0.insert(0, p);
+        self.0.truncate(RECENT_MAX);
+    }
+}
+
+/// True for an SVG (by extension); everything else is read as a project file.
+pub fn is_svg(path: &Path) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("svg") || e.eq_ignore_ascii_case("svgz"))
+}
+
+/// The result of opening a file.
+pub struct Opened {
+    /// The document.
+    pub doc: Document,
+    /// A problem that did not prevent opening (e.g. fields could not be placed).
+    pub problem: Option<String>,
+    /// True for a project file (Save writes back to it).
+    pub is_project: bool,
+}
+
+/// Opens an SVG (imported with `profile` and `settings`, fields placed automatically as the CLI
+/// places them) or a project file (with its own profile, settings, fields and plans).
+pub fn open(
+    path: &Path,
+    profile: &MachineProfile,
+    settings: &SolverSettings,
+) -> Result<Opened, String> {
+    if is_svg(path) {
+        let (mut doc, _) = load_svg(
+            path,
+            profile.clone(),
+            settings.clone(),
+            &ImportOptions::default(),
+        )
+        .map_err(|e| e.to_string())?;
+        let problem = place_document_fields(&mut doc, &JobCtx::default())
+            .err()
+            .map(|e| e.to_string());
+        Ok(Opened {
+            doc,
+            problem,
+            is_project: false,
+        })
+    } else {
+        let doc = load_project(path).map_err(|e| e.to_string())?;
+        Ok(Opened {
+            doc,
+            problem: None,
+            is_project: true,
+        })
+    }
+}
+
+/// What can be exported from a plan.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ExportKind {
+    /// G-code of the TCP path.
+    Gcode,
+    /// The JSON report.
+    Report,
+    /// An SVG preview of the planned path.
+    Preview,
+}
+
+impl ExportKind {
+    /// (dialog filter name, extension).
+    pub fn filter(self) -> (&'static str, &'static str) {
+        match self {
+            ExportKind::Gcode => ("G-code", "gcode"),
+            ExportKind::Report => ("JSON report", "json"),
+            ExportKind::Preview => ("SVG preview", "svg"),
+        }
+    }
+}
+
+/// The text of an export.
+pub fn export_text(doc: &Document, plan: &Plan, kind: ExportKind) -> String {
+    let source = doc.source.clone().unwrap_or_else(|| "document".into());
+    match kind {
+        ExportKind::Gcode => {
+            write_gcode(&doc.geometries, plan, &doc.profile, doc.page_mm[1], &source)
+        }
+        ExportKind::Report => report_json(&source, plan, &doc.settings, &doc.warnings),
+        ExportKind::Preview => preview_svg(&doc.geometries, plan, doc.page_mm),
+    }
+}
+
+/// Writes an export atomically.
+pub fn export(doc: &Document, plan: &Plan, kind: ExportKind, path: &Path) -> Result<(), String> {
+    write_atomic(path, export_text(doc, plan, kind).as_bytes())
+        .map_err(|e| format!("{}: cannot write: {e}", path.display()))
+}
+
+/// The open dialog (SVG or project).
+pub fn pick_open() -> Option<PathBuf> {
+    rfd::FileDialog::new()
+        .add_filter(
+            "SVG or galvoplan project",
+            &["svg", "svgz", PROJECT_EXT, "json"],
+        )
+        .add_filter("SVG", &["svg", "svgz"])
+        .add_filter("galvoplan project", &[PROJECT_EXT, "json"])
+        .pick_file()
+}
+
+/// A save dialog for one kind of file.
+pub fn pick_save(filter: &str, ext: &str, default_name: &str) -> Option<PathBuf> {
+    rfd::FileDialog::new()
+        .add_filter(filter, &[ext])
+        .set_file_name(default_name)
+        .save_file()
+}
+
+/// A default file name next to the source: `demo.svg` → `demo.<ext>`.
+pub fn default_name(doc: &Document, ext: &str) -> String {
+    let stem = doc
+        .source
+        .as_deref()
+        .map(Path::new)
+        .and_then(Path::file_stem)
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "job".into());
+    format!("{stem}.{ext}")
+}

@@ -1,0 +1,173 @@
+//! Background solves: the ordering stage runs on a snapshot of the document in a named thread;
+//! the GUI polls the result each frame and never blocks on the worker.
+
+use crate::document::{Algo, Document, Plan};
+use crate::job::{CancelToken, JobCtx, Progress, ProgressSink};
+use crate::pipeline::order_document;
+use std::sync::mpsc::{self, Receiver, TryRecvError};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+/// Keeps the latest progress report and wakes the GUI.
+struct SharedProgress {
+    latest: Mutex<Option<Progress>>,
+    repaint: egui::Context,
+}
+
+impl ProgressSink for SharedProgress {
+    fn report(&self, progress: &Progress) {
+        if let Ok(mut l) = self.latest.lock() {
+            *l = Some(progress.clone());
+        }
+        self.repaint.request_repaint();
+    }
+}
+
+/// How a finished job ended.
+#[derive(Debug)]
+pub enum JobOutcome {
+    /// A plan (for HGA possibly the best one found before a cancel).
+    Plan(Box<Plan>),
+    /// The solve failed or was cancelled without a plan.
+    Failed(String),
+}
+
+/// A running solve.
+pub struct Job {
+    /// The algorithm.
+    pub algo: Algo,
+    /// The name the plan will get.
+    pub name: String,
+    started: Instant,
+    time_limit_s: Option<f64>,
+    cancel: CancelToken,
+    progress: Arc<SharedProgress>,
+    rx: Receiver<Result<Plan, String>>,
+}
+
+impl Job {
+    /// Starts ordering a snapshot of `doc` (geometries, fields, profile, settings) with `algo`
+    /// in a new thread; `repaint` is woken on progress and when the job ends.
+    pub fn start(
+        doc: &Document,
+        algo: Algo,
+        name: String,
+        repaint: &egui::Context,
+    ) -> std::io::Result<Job> {
+        let mut snapshot = Document {
+            source: doc.source.clone(),
+            page_mm: doc.page_mm,
+            geometries: doc.geometries.clone(),
+            warnings: Vec::new(),
+            profile: doc.profile.clone(),
+            settings: doc.settings.clone(),
+            fields: doc.fields.clone(),
+            plans: Vec::new(),
+        };
+        snapshot.settings.algo = algo;
+        let progress = Arc::new(SharedProgress {
+            latest: Mutex::new(None),
+            repaint: repaint.clone(),
+        });
+        let cancel = CancelToken::new();
+        let ctx = JobCtx::new(cancel.clone(), progress.clone());
+        let (tx, rx) = mpsc::channel();
+        let wake = repaint.clone();
+        std::thread::Builder::new()
+            .name(format!(
+                "galvoplan-solve-{}",
+                format!("{algo:?}").to_lowercase()
+            ))
+            .spawn(move || {
+                let result = order_document(&snapshot, &ctx).map_err(|e| e.to_string());
+                // the receiver is gone only when the GUI dropped the job; nothing to tell then
+                let _ = tx.send(result);
+                wake.request_repaint();
+            })?;
+        Ok(Job {
+            algo,
+            name,
+            started: Instant::now(),
+            time_limit_s: doc.settings.time_limit_s,
+            cancel,
+            progress,
+            rx,
+        })
+    }
+
+    /// The result once the worker is done (then the job is over); `None` while it runs.
+    pub fn poll(&self) -> Option<JobOutcome> {
+        match self.rx.try_recv() {
+            Ok(Ok(plan)) => Some(JobOutcome::Plan(Box::new(plan))),
+            Ok(Err(e)) => Some(JobOutcome::Failed(e)),
+            Err(TryRecvError::Empty) => None,
+            Err(TryRecvError::Disconnected) => Some(JobOutcome::Failed(
+                "the solver thread ended without a result".into(),
+            )),
+        }
+    }
+
+    /// Asks the worker to stop (HGA returns its best plan so far).
+    pub fn cancel(&self) {
+        self.cancel.cancel();
+    }
+
+    /// True once Cancel was pressed.
+    pub fn is_cancelled(&self) -> bool {
+        self.cancel.is_cancelled()
+    }
+
+    /// Time since the start.
+    pub fn elapsed(&self) -> Duration {
+        self.started.elapsed()
+    }
+
+    /// The latest progress report.
+    pub fn progress(&self) -> Option<Progress> {
+        self.progress.latest.lock().ok().and_then(|l| l.clone())
+    }
+
+    /// Draws the progress bar, elapsed time and a Cancel button.
+    pub fn show(&self, ui: &mut egui::Ui) {
+        let p = self.progress();
+        let (fraction, text) = match &p {
+            Some(p) if p.total > 0 => (
+                (p.done as f32 / p.total as f32).clamp(0.0, 1.0),
+                format!("{}: {}", self.name, p.message),
+            ),
+            // unknown total (GA generations): the share of the time limit, when there is one
+            Some(p) => (
+                self.time_limit_s.map_or(0.0, |t| {
+                    (self.elapsed().as_secs_f64() / t.max(1e-9)).clamp(0.0, 1.0) as f32
+                }),
+                format!("{}: {}", self.name, p.message),
+            ),
+            None => (0.0, format!("{}: starting", self.name)),
+        };
+        ui.add(
+            egui::ProgressBar::new(fraction)
+                .desired_width(260.0)
+                .text(text)
+                .animate(true),
+        );
+        ui.label(format!("{:.1} s", self.elapsed().as_secs_f64()));
+        let label = if self.is_cancelled() {
+            "Cancelling…"
+        } else {
+            "Cancel"
+        };
+        if ui
+            .add_enabled(!self.is_cancelled(), egui::Button::new(label))
+            .clicked()
+        {
+            self.cancel();
+        }
+    }
+}
+
+impl Drop for Job {
+    fn drop(&mut self) {
+        // a dropped job (document closed) should not keep a core busy
+        self.cancel.cancel();
+    }
+}

@@ -1,0 +1,487 @@
+//! The window layout: menu bar, toolbar, side panels, status bar and the central view.
+
+use super::canvas::{Canvas, PathLayer};
+use super::commands::Command;
+use super::files::{self, ExportKind, PROJECT_EXT};
+use super::paint::colour;
+use super::{compare, is_stale, App, Tab, SOLVERS};
+use egui::{Color32, RichText};
+
+const ERROR: Color32 = Color32::from_rgb(200, 30, 30);
+
+impl App {
+    /// Lays out the whole window.
+    pub(super) fn layout(&mut self, ui: &mut egui::Ui) {
+        egui::Panel::top("menu").show(ui, |ui| self.menu_bar(ui));
+        egui::Panel::top("toolbar").show(ui, |ui| self.toolbar(ui));
+        egui::Panel::bottom("status").show(ui, |ui| self.status_bar(ui));
+        if self.tab == Tab::Workbench {
+            egui::Panel::left("left")
+                .resizable(true)
+                .default_size(290.0)
+                .show(ui, |ui| {
+                    egui::ScrollArea::vertical().show(ui, |ui| self.left_panel(ui));
+                });
+        }
+        egui::Panel::right("right")
+            .resizable(true)
+            .default_size(330.0)
+            .show(ui, |ui| {
+                egui::ScrollArea::vertical().show(ui, |ui| self.right_panel(ui));
+            });
+        egui::CentralPanel::default().show(ui, |ui| match self.tab {
+            Tab::Workbench => self.workbench_view(ui),
+            Tab::Compare => {
+                if self.has_document() {
+                    compare::show(ui, &mut self.compare, &self.doc, self.layers);
+                } else {
+                    ui.label("Open a document first.");
+                }
+            }
+        });
+    }
+
+    fn open_dialog(&mut self) {
+        if let Some(p) = files::pick_open() {
+            self.open(&p);
+        }
+    }
+
+    fn save_dialog(&mut self, save_as: bool) {
+        let path = match (&self.project_path, save_as) {
+            (Some(p), false) => Some(p.clone()),
+            _ => files::pick_save(
+                "galvoplan project",
+                PROJECT_EXT,
+                &files::default_name(&self.doc, PROJECT_EXT),
+            ),
+        };
+        if let Some(p) = path {
+            if let Err(e) = self.save_project(&p) {
+                self.set_status(e, true);
+            }
+        }
+    }
+
+    fn export_dialog(&mut self, kind: ExportKind) {
+        let (filter, ext) = kind.filter();
+        if let Some(p) = files::pick_save(filter, ext, &files::default_name(&self.doc, ext)) {
+            if let Err(e) = self.export(kind, &p) {
+                self.set_status(e, true);
+            }
+        }
+    }
+
+    fn menu_bar(&mut self, ui: &mut egui::Ui) {
+        egui::MenuBar::new().ui(ui, |ui| {
+            ui.menu_button("File", |ui| {
+                if ui.button("Open SVG or project…").clicked() {
+                    self.open_dialog();
+                }
+                ui.menu_button("Open recent", |ui| {
+                    if self.recent.0.is_empty() {
+                        ui.label("(none)");
+                    }
+                    for p in self.recent.0.clone() {
+                        if ui.button(p.display().to_string()).clicked() {
+                            self.open(&p);
+                        }
+                    }
+                });
+                ui.separator();
+                let doc = self.has_document();
+                if ui
+                    .add_enabled(doc, egui::Button::new("Save project"))
+                    .clicked()
+                {
+                    self.save_dialog(false);
+                }
+                if ui
+                    .add_enabled(doc, egui::Button::new("Save project as…"))
+                    .clicked()
+                {
+                    self.save_dialog(true);
+                }
+                ui.separator();
+                let plan = self.active_plan().is_some();
+                for (kind, label) in [
+                    (ExportKind::Gcode, "Export G-code…"),
+                    (ExportKind::Report, "Export report (JSON)…"),
+                    (ExportKind::Preview, "Export SVG preview…"),
+                ] {
+                    if ui.add_enabled(plan, egui::Button::new(label)).clicked() {
+                        self.export_dialog(kind);
+                    }
+                }
+            });
+            ui.menu_button("Edit", |ui| {
+                let u = self.history.undo_label().map(|w| format!("Undo {w}"));
+                if ui
+                    .add_enabled(
+                        u.is_some(),
+                        egui::Button::new(u.unwrap_or("Undo".into())).shortcut_text("Ctrl+Z"),
+                    )
+                    .clicked()
+                {
+                    self.undo();
+                }
+                let r = self.history.redo_label().map(|w| format!("Redo {w}"));
+                if ui
+                    .add_enabled(
+                        r.is_some(),
+                        egui::Button::new(r.unwrap_or("Redo".into())).shortcut_text("Ctrl+Shift+Z"),
+                    )
+                    .clicked()
+                {
+                    self.redo();
+                }
+            });
+            ui.menu_button("View", |ui| {
+                self.layer_toggles(ui);
+                if ui
+                    .add(egui::Button::new("Fit to view").shortcut_text("F"))
+                    .clicked()
+                {
+                    self.workbench.fit_requested = true;
+                    self.compare.canvas.fit_requested = true;
+                }
+            });
+        });
+    }
+
+    fn layer_toggles(&mut self, ui: &mut egui::Ui) {
+        let l = &mut self.layers;
+        ui.checkbox(&mut l.fields, "Scan fields");
+        ui.checkbox(&mut l.path, "Planned path");
+        ui.checkbox(&mut l.arrows, "Direction arrows");
+        ui.checkbox(&mut l.base_path, "Base path");
+        ui.checkbox(&mut l.order_colours, "Colour marks by order");
+    }
+
+    fn toolbar(&mut self, ui: &mut egui::Ui) {
+        ui.horizontal_wrapped(|ui| {
+            if ui
+                .button("Open…")
+                .on_hover_text("Open an SVG or a project (or drop a file on the window)")
+                .clicked()
+            {
+                self.open_dialog();
+            }
+            if ui
+                .add_enabled(self.has_document(), egui::Button::new("Save"))
+                .on_hover_text("Save the project")
+                .clicked()
+            {
+                self.save_dialog(false);
+            }
+            ui.separator();
+            let can_undo = self.history.undo_label().is_some();
+            if ui
+                .add_enabled(can_undo, egui::Button::new("Undo"))
+                .on_hover_text("Ctrl+Z")
+                .clicked()
+            {
+                self.undo();
+            }
+            let can_redo = self.history.redo_label().is_some();
+            if ui
+                .add_enabled(can_redo, egui::Button::new("Redo"))
+                .on_hover_text("Ctrl+Shift+Z")
+                .clicked()
+            {
+                self.redo();
+            }
+            ui.separator();
+            ui.selectable_value(&mut self.add_tool, false, "Select")
+                .on_hover_text(
+                    "Click a field to select it, drag it to move it; drag empty space to pan",
+                );
+            ui.selectable_value(&mut self.add_tool, true, "Add field")
+                .on_hover_text(
+                    "Click to add a field (double-click also adds one with the select tool)",
+                );
+            let sel = self
+                .selected
+                .and_then(|id| self.doc.fields.iter().find(|f| f.id == id))
+                .map(|f| (f.id, f.locked));
+            if ui
+                .add_enabled(sel.is_some(), egui::Button::new("Delete field"))
+                .on_hover_text("Delete key")
+                .clicked()
+            {
+                if let Some((id, _)) = sel {
+                    let _ = self.execute(Command::DeleteField { id });
+                }
+            }
+            let lock_label = if sel.is_some_and(|s| s.1) {
+                "Unlock"
+            } else {
+                "Lock"
+            };
+            if ui
+                .add_enabled(sel.is_some(), egui::Button::new(lock_label))
+                .on_hover_text("Locked fields do not move and survive automatic re-placement")
+                .clicked()
+            {
+                if let Some((id, locked)) = sel {
+                    let _ = self.execute(Command::SetLocked {
+                        id,
+                        locked: !locked,
+                    });
+                }
+            }
+            if ui
+                .add_enabled(
+                    self.has_document(),
+                    egui::Button::new("Re-place automatically"),
+                )
+                .on_hover_text(
+                    "Replace the unlocked fields by the automatic placement; locked fields stay",
+                )
+                .clicked()
+            {
+                let _ = self.execute(Command::ReplaceAutomatically);
+            }
+            ui.separator();
+            let blocker = self.solve_blocker();
+            for (algo, label) in SOLVERS {
+                let b = ui.add_enabled(blocker.is_none(), egui::Button::new(*label));
+                let b = match &blocker {
+                    Some(why) => b.on_disabled_hover_text(why),
+                    None => b.on_hover_text(
+                        "Order the geometries on the current fields, in the background",
+                    ),
+                };
+                if b.clicked() {
+                    self.start_solve(*algo, ui.ctx());
+                }
+            }
+            if let Some(job) = &self.job {
+                job.show(ui);
+            }
+            ui.separator();
+            ui.selectable_value(&mut self.tab, Tab::Workbench, "Workbench");
+            ui.selectable_value(&mut self.tab, Tab::Compare, "Compare");
+        });
+    }
+
+    fn status_bar(&mut self, ui: &mut egui::Ui) {
+        ui.horizontal(|ui| {
+            let t = RichText::new(&self.status.text);
+            ui.label(if self.status.error { t.color(ERROR) } else { t });
+            ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
+                let f = &self.frames;
+                let cpu = f
+                    .cpu_ms
+                    .map_or(String::new(), |c| format!(", whole frame {c:.1} ms"));
+                ui.label(
+                    RichText::new(format!(
+                        "ui {:.1} ms (max {:.1}){cpu}",
+                        f.last_ms(),
+                        f.recent_max_ms(120)
+                    ))
+                    .small()
+                    .weak(),
+                )
+                .on_hover_text(
+                    "time of App::ui in the last frame (and the maximum of the last 120 \
+                     frames); whole frame: the integration's CPU time including tessellation",
+                );
+                if self.has_document() {
+                    ui.separator();
+                    let u = self.uncovered.len();
+                    let t = RichText::new(format!(
+                        "{} fields · {} uncovered",
+                        self.doc.fields.len(),
+                        u
+                    ));
+                    ui.label(if u > 0 { t.color(ERROR) } else { t });
+                }
+            });
+        });
+    }
+
+    fn left_panel(&mut self, ui: &mut egui::Ui) {
+        egui::CollapsingHeader::new("Machine profile")
+            .default_open(true)
+            .show(ui, |ui| {
+                if let Some(cmd) = self.editors.profile_ui(ui, &self.doc.profile) {
+                    let _ = self.execute(cmd);
+                }
+            });
+        egui::CollapsingHeader::new("Solver settings")
+            .default_open(true)
+            .show(ui, |ui| {
+                if let Some(cmd) = self.editors.settings_ui(ui, &self.doc.settings) {
+                    let _ = self.execute(cmd);
+                }
+            });
+        egui::CollapsingHeader::new("View")
+            .default_open(false)
+            .show(ui, |ui| self.layer_toggles(ui));
+    }
+
+    fn right_panel(&mut self, ui: &mut egui::Ui) {
+        ui.heading("Document");
+        match &self.doc.source {
+            Some(s) => {
+                ui.label(RichText::new(s).small());
+            }
+            None => {
+                ui.label("No document. Open an SVG or a project.");
+            }
+        }
+        if self.has_document() {
+            let closed = self.doc.geometries.iter().filter(|g| g.closed).count();
+            ui.label(format!(
+                "{} geometries ({closed} closed, {} open), {} fields",
+                self.doc.geometries.len(),
+                self.doc.geometries.len() - closed,
+                self.doc.fields.len()
+            ));
+            if !self.uncovered.is_empty() {
+                ui.colored_label(
+                    ERROR,
+                    format!(
+                        "{} geometries not covered by any field",
+                        self.uncovered.len()
+                    ),
+                );
+            }
+        }
+        if let Some(p) = &self.problem {
+            ui.colored_label(ERROR, p);
+        }
+        self.selected_field_ui(ui);
+        ui.separator();
+        self.plans_ui(ui);
+        if let Some(plan) = self.active_plan() {
+            ui.separator();
+            ui.heading("Metrics");
+            compare::metrics_table(ui, "active-metrics", plan, None);
+        }
+        ui.separator();
+        let n = self.doc.warnings.len();
+        egui::CollapsingHeader::new(format!("Import warnings ({n})"))
+            .id_salt("warnings")
+            .default_open(n > 0)
+            .show(ui, |ui| {
+                if n == 0 {
+                    ui.label("none");
+                }
+                for w in &self.doc.warnings {
+                    ui.label(
+                        RichText::new(w.to_string())
+                            .small()
+                            .color(Color32::from_rgb(180, 83, 9)),
+                    );
+                }
+            });
+        egui::CollapsingHeader::new("Recent files")
+            .default_open(false)
+            .show(ui, |ui| {
+                for p in self.recent.0.clone() {
+                    if ui.link(p.display().to_string()).clicked() {
+                        self.open(&p);
+                    }
+                }
+            });
+    }
+
+    fn selected_field_ui(&mut self, ui: &mut egui::Ui) {
+        let Some(f) = self
+            .selected
+            .and_then(|id| self.doc.fields.iter().find(|f| f.id == id))
+        else {
+            return;
+        };
+        ui.separator();
+        ui.heading(format!("Field {}", f.id));
+        ui.label(format!(
+            "centre ({:.2}, {:.2}) mm, {} geometries{}",
+            f.center.x,
+            f.center.y,
+            f.geometries.len(),
+            if f.locked { ", locked" } else { "" }
+        ));
+    }
+
+    fn plans_ui(&mut self, ui: &mut egui::Ui) {
+        ui.heading("Plans");
+        if self.doc.plans.is_empty() {
+            ui.label("none yet: run a solver");
+        }
+        let mut remove = None;
+        for k in 0..self.doc.plans.len() {
+            let p = &self.doc.plans[k];
+            let stale = is_stale(p, &self.doc);
+            ui.horizontal(|ui| {
+                let text = format!("{}  idle {:.1} mm", p.name, p.metrics.idle_mm);
+                if ui.selectable_label(self.active == Some(k), text).clicked() {
+                    self.active = Some(k);
+                }
+                if stale {
+                    ui.label(RichText::new("stale").color(Color32::from_rgb(180, 83, 9)))
+                        .on_hover_text("planned on other fields than the current ones");
+                }
+                if ui
+                    .small_button("Remove")
+                    .on_hover_text(format!("Remove {}", p.name))
+                    .clicked()
+                {
+                    remove = Some(k);
+                }
+            });
+        }
+        if let Some(k) = remove {
+            let p = self.doc.plans.remove(k);
+            self.compare = super::CompareState {
+                canvas: std::mem::take(&mut self.compare.canvas),
+                ..Default::default()
+            };
+            self.active = self.active.and_then(|a| {
+                if a == k {
+                    None
+                } else if a > k {
+                    Some(a - 1)
+                } else {
+                    Some(a)
+                }
+            });
+            self.set_status(format!("removed {}", p.name), false);
+        }
+    }
+
+    fn workbench_view(&mut self, ui: &mut egui::Ui) {
+        if !self.has_document() {
+            ui.centered_and_justified(|ui| {
+                ui.label("Open an SVG or a project (File > Open, or drag and drop a file here).");
+            });
+            return;
+        }
+        let plan = self.active.and_then(|k| self.doc.plans.get(k));
+        let stale = plan.is_some_and(|p| is_stale(p, &self.doc));
+        let canvas = Canvas {
+            label: "Work area",
+            geometries: &self.doc.geometries,
+            profile: &self.doc.profile,
+            fields: &self.doc.fields,
+            number_by_order: false,
+            paths: plan
+                .map(|p| PathLayer {
+                    plan: p,
+                    colour: colour::PATH_A,
+                })
+                .into_iter()
+                .collect(),
+            uncovered: &self.uncovered,
+            selected: self.selected,
+            editable: true,
+            add_tool: self.add_tool,
+            layers: self.layers,
+            stale,
+        };
+        let (_, actions) = canvas.show(ui, &mut self.workbench, None);
+        self.on_canvas(actions);
+    }
+}

@@ -1,0 +1,337 @@
+//! Drawing of a [`Canvas`]: base stroke, fields, artwork, uncovered geometries, planned paths.
+
+use super::canvas::{Canvas, PathLayer, View};
+use crate::document::Plan;
+use crate::geom::Pt;
+use egui::{Align2, Color32, FontId, Painter, Pos2, Rect, Shape, Stroke, StrokeKind, Vec2};
+
+/// Colours of the canvas.
+pub mod colour {
+    use egui::Color32;
+    /// Closed geometries.
+    pub const CLOSED: Color32 = Color32::from_rgb(30, 41, 59);
+    /// Open geometries (also marked with dots at their ends).
+    pub const OPEN: Color32 = Color32::from_rgb(21, 128, 61);
+    /// Geometries no field holds.
+    pub const UNCOVERED: Color32 = Color32::from_rgb(220, 38, 38);
+    /// Scan fields.
+    pub const FIELD: Color32 = Color32::from_rgb(79, 70, 229);
+    /// The selected field.
+    pub const SELECTED: Color32 = Color32::from_rgb(245, 158, 11);
+    /// Idle moves of a single plan, and plan A when two are overlaid.
+    pub const PATH_A: Color32 = Color32::from_rgb(234, 88, 12);
+    /// Idle moves of plan B when two are overlaid.
+    pub const PATH_B: Color32 = Color32::from_rgb(37, 99, 235);
+    /// Start marker.
+    pub const START: Color32 = Color32::from_rgb(22, 163, 74);
+    /// End marker.
+    pub const END: Color32 = Color32::from_rgb(190, 18, 60);
+    /// First and last colours of marks coloured by order.
+    pub const ORDER: [Color32; 2] = [
+        Color32::from_rgb(8, 145, 178),
+        Color32::from_rgb(162, 28, 175),
+    ];
+}
+
+fn lerp(a: Color32, b: Color32, t: f32) -> Color32 {
+    let m = |x: u8, y: u8| (f32::from(x) + (f32::from(y) - f32::from(x)) * t).round() as u8;
+    Color32::from_rgb(m(a.r(), b.r()), m(a.g(), b.g()), m(a.b(), b.b()))
+}
+
+/// Paints the canvas content into `rect`.
+pub fn paint(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
+    painter.rect_filled(rect, 0.0, Color32::from_gray(252));
+    let s = |q: Pt| view.to_screen(rect, q);
+    let (lo, hi) = Canvas::reach(c.profile);
+    let [sw, sh] = c.profile.stroke_mm;
+    painter.rect_filled(Rect::from_two_pos(s(lo), s(hi)), 0.0, Color32::WHITE);
+    painter.rect_stroke(
+        Rect::from_two_pos(s(lo), s(hi)),
+        0.0,
+        Stroke::new(1.0, Color32::from_gray(210)),
+        StrokeKind::Middle,
+    );
+    let corners = [
+        Pt::new(0.0, 0.0),
+        Pt::new(sw, 0.0),
+        Pt::new(sw, sh),
+        Pt::new(0.0, sh),
+        Pt::new(0.0, 0.0),
+    ]
+    .map(s);
+    painter.extend(Shape::dashed_line(
+        &corners,
+        Stroke::new(1.0, Color32::from_gray(140)),
+        6.0,
+        4.0,
+    ));
+    painter.text(
+        s(Pt::new(0.0, 0.0)) + Vec2::new(2.0, -2.0),
+        Align2::LEFT_BOTTOM,
+        format!("base stroke {sw:.0} × {sh:.0} mm"),
+        FontId::proportional(11.0),
+        Color32::from_gray(120),
+    );
+    if c.layers.fields {
+        paint_fields(painter, c, view, rect);
+    }
+    paint_artwork(painter, c, view, rect);
+    for (k, path) in c.paths.iter().enumerate() {
+        if c.layers.base_path && k == 0 {
+            paint_base_path(painter, path.plan, view, rect);
+        }
+        if c.layers.path {
+            paint_path(painter, c, path, view, rect);
+        }
+    }
+    paint_caption(painter, c, rect);
+    paint_scale_bar(painter, view, rect);
+}
+
+fn paint_fields(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
+    let s = |q: Pt| view.to_screen(rect, q);
+    let fill = Color32::from_rgba_unmultiplied(79, 70, 229, 16);
+    for f in c.fields {
+        let b = f.bbox();
+        let r = Rect::from_two_pos(s(Pt::new(b.min_x, b.min_y)), s(Pt::new(b.max_x, b.max_y)));
+        painter.rect_filled(r, 0.0, fill);
+    }
+    for (k, f) in c.fields.iter().enumerate() {
+        let b = f.bbox();
+        let r = Rect::from_two_pos(s(Pt::new(b.min_x, b.min_y)), s(Pt::new(b.max_x, b.max_y)));
+        let selected = c.selected == Some(f.id);
+        let stroke = if selected {
+            Stroke::new(2.5, colour::SELECTED)
+        } else {
+            Stroke::new(
+                if f.locked { 2.0 } else { 1.0 },
+                colour::FIELD.gamma_multiply(0.8),
+            )
+        };
+        painter.rect_stroke(r, 0.0, stroke, StrokeKind::Middle);
+        painter.circle_filled(s(f.center), 2.0, stroke.color);
+        let number = if c.number_by_order { k + 1 } else { f.id };
+        let text = if f.locked {
+            format!("{number} locked")
+        } else {
+            format!("{number}")
+        };
+        let galley = painter.layout_no_wrap(text, FontId::proportional(13.0), Color32::WHITE);
+        let at = r.min + Vec2::new(3.0, 3.0);
+        let bg = Rect::from_min_size(at, galley.size() + Vec2::new(6.0, 2.0));
+        painter.rect_filled(
+            bg,
+            3.0,
+            if selected {
+                colour::SELECTED
+            } else {
+                colour::FIELD.gamma_multiply(0.85)
+            },
+        );
+        painter.galley(at + Vec2::new(3.0, 1.0), galley, Color32::WHITE);
+    }
+}
+
+fn paint_artwork(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
+    let s = |q: Pt| view.to_screen(rect, q);
+    // marks coloured by their position in the first plan's order
+    let rank: Option<Vec<f32>> = c
+        .paths
+        .first()
+        .filter(|_| c.layers.order_colours && c.layers.path)
+        .map(|p| {
+            let mut r = vec![-1.0; c.geometries.len()];
+            let n = (p.plan.order.len().max(2) - 1) as f32;
+            for (i, st) in p.plan.order.iter().enumerate() {
+                if let Some(x) = r.get_mut(st.geometry) {
+                    *x = i as f32 / n;
+                }
+            }
+            r
+        });
+    let mut shapes = Vec::with_capacity(c.geometries.len());
+    for (k, g) in c.geometries.iter().enumerate() {
+        if g.points.is_empty() {
+            continue;
+        }
+        let base = if g.closed {
+            colour::CLOSED
+        } else {
+            colour::OPEN
+        };
+        let col = match &rank {
+            Some(r) if r[k] >= 0.0 => lerp(colour::ORDER[0], colour::ORDER[1], r[k]),
+            _ => base,
+        };
+        let mut pts: Vec<Pos2> = g.points.iter().map(|&q| s(q)).collect();
+        if g.closed {
+            pts.push(pts[0]);
+        } else {
+            for end in [pts[0], pts[pts.len() - 1]] {
+                shapes.push(Shape::circle_filled(end, 1.8, col));
+            }
+        }
+        if pts.len() == 1 {
+            shapes.push(Shape::circle_filled(pts[0], 1.5, col));
+        } else {
+            shapes.push(Shape::line(pts, Stroke::new(1.2, col)));
+        }
+    }
+    for &k in c.uncovered {
+        if let Some(g) = c.geometries.get(k) {
+            let mut pts: Vec<Pos2> = g.points.iter().map(|&q| s(q)).collect();
+            if g.closed && !pts.is_empty() {
+                pts.push(pts[0]);
+            }
+            shapes.push(Shape::line(pts, Stroke::new(2.5, colour::UNCOVERED)));
+        }
+    }
+    painter.extend(shapes);
+}
+
+fn paint_base_path(painter: &Painter, plan: &Plan, view: &View, rect: Rect) {
+    let pts: Vec<Pos2> = plan
+        .fields
+        .iter()
+        .map(|f| view.to_screen(rect, f.center))
+        .collect();
+    if pts.len() > 1 {
+        painter.extend(Shape::dashed_line(
+            &pts,
+            Stroke::new(2.0, colour::FIELD.gamma_multiply(0.6)),
+            2.0,
+            4.0,
+        ));
+    }
+}
+
+fn paint_path(painter: &Painter, c: &Canvas<'_>, path: &PathLayer<'_>, view: &View, rect: Rect) {
+    let s = |q: Pt| view.to_screen(rect, q);
+    let col = if c.stale {
+        path.colour.gamma_multiply(0.45)
+    } else {
+        path.colour
+    };
+    let stroke = Stroke::new(1.3, col);
+    let mut shapes = Vec::new();
+    let mut prev: Option<Pt> = None;
+    let ends =
+        |st: &crate::document::Step| c.geometries.get(st.geometry).map(|g| g.ends(st.choice(g)));
+    for st in &path.plan.order {
+        let Some((a, z)) = ends(st) else { continue };
+        if let Some(pz) = prev {
+            let (p0, p1) = (s(pz), s(a));
+            let len = (p1 - p0).length();
+            if len > 0.5 {
+                shapes.extend(Shape::dashed_line(&[p0, p1], stroke, 5.0, 3.0));
+            }
+            if c.layers.arrows && len > 28.0 {
+                let dir = (p1 - p0) / len;
+                let tip = p0 + (p1 - p0) * 0.55;
+                let back = tip - dir * 7.0;
+                let side = Vec2::new(-dir.y, dir.x) * 3.5;
+                shapes.push(Shape::convex_polygon(
+                    vec![tip, back + side, back - side],
+                    col,
+                    Stroke::NONE,
+                ));
+            }
+        }
+        prev = Some(z);
+    }
+    painter.extend(shapes);
+    let order = &path.plan.order;
+    if let (Some((start, _)), Some((_, end))) =
+        (order.first().and_then(ends), order.last().and_then(ends))
+    {
+        let (ps, pe) = (s(start), s(end));
+        painter.circle(ps, 7.0, colour::START, Stroke::new(1.5, Color32::WHITE));
+        painter.text(
+            ps,
+            Align2::CENTER_CENTER,
+            "S",
+            FontId::proportional(10.0),
+            Color32::WHITE,
+        );
+        let r = Rect::from_center_size(pe, Vec2::splat(13.0));
+        painter.rect(
+            r,
+            2.0,
+            colour::END,
+            Stroke::new(1.5, Color32::WHITE),
+            StrokeKind::Outside,
+        );
+        painter.text(
+            pe,
+            Align2::CENTER_CENTER,
+            "E",
+            FontId::proportional(10.0),
+            Color32::WHITE,
+        );
+    }
+}
+
+fn paint_caption(painter: &Painter, c: &Canvas<'_>, rect: Rect) {
+    let mut y = rect.min.y + 6.0;
+    let mut line = |text: String, col: Color32| {
+        let galley = painter.layout_no_wrap(text, FontId::proportional(13.0), col);
+        let r = Rect::from_min_size(
+            Pos2::new(rect.min.x + 6.0, y),
+            galley.size() + Vec2::new(8.0, 4.0),
+        );
+        painter.rect_filled(r, 3.0, Color32::from_white_alpha(225));
+        painter.galley(r.min + Vec2::new(4.0, 2.0), galley, col);
+        y = r.max.y + 2.0;
+    };
+    line(c.label.to_string(), Color32::from_gray(40));
+    for p in &c.paths {
+        line(
+            format!(
+                "{}: idle {:.1} mm, base {:.1} mm, {} fields",
+                p.plan.name, p.plan.metrics.idle_mm, p.plan.metrics.base_mm, p.plan.metrics.fields
+            ),
+            p.colour,
+        );
+    }
+    if c.stale {
+        line(
+            "plan is stale: the fields changed since it was planned".into(),
+            Color32::from_rgb(180, 83, 9),
+        );
+    }
+    if !c.uncovered.is_empty() {
+        line(
+            format!("{} geometries not covered by a field", c.uncovered.len()),
+            colour::UNCOVERED,
+        );
+    }
+}
+
+fn paint_scale_bar(painter: &Painter, view: &View, rect: Rect) {
+    // the largest 1-2-5 length that stays under 120 px
+    let max_mm = 120.0 / view.scale.max(1e-6);
+    let mut len = 1e-3_f32;
+    for k in -3..5 {
+        for m in [1.0, 2.0, 5.0] {
+            let v = m * 10f32.powi(k);
+            if v <= max_mm {
+                len = v;
+            }
+        }
+    }
+    let px = len * view.scale;
+    let y = rect.max.y - 12.0;
+    let x0 = rect.min.x + 12.0;
+    let stroke = Stroke::new(2.0, Color32::from_gray(60));
+    painter.line_segment([Pos2::new(x0, y), Pos2::new(x0 + px, y)], stroke);
+    for x in [x0, x0 + px] {
+        painter.line_segment([Pos2::new(x, y - 4.0), Pos2::new(x, y + 1.0)], stroke);
+    }
+    painter.text(
+        Pos2::new(x0 + px / 2.0, y - 4.0),
+        Align2::CENTER_BOTTOM,
+        format!("{len} mm"),
+        FontId::proportional(11.0),
+        Color32::from_gray(60),
+    );
+}

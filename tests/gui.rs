@@ -1,0 +1,477 @@
+//! Headless GUI tests (egui_kittest): the real `App::ui` driven through the accessibility tree
+//! and synthetic pointer/keyboard events, no display or GPU needed.
+#![cfg(feature = "gui")]
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+mod common;
+
+use egui::{Event, Key, Modifiers, PointerButton, Vec2};
+use egui_kittest::kittest::Queryable;
+use egui_kittest::Harness;
+use galvoplan::app::commands::Command;
+use galvoplan::app::App;
+use galvoplan::document::{Algo, SolverSettings};
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+fn demo() -> PathBuf {
+    common::root().join("assets/examples/demo.svg")
+}
+
+fn harness(app: App) -> Harness<'static, App> {
+    Harness::builder()
+        .with_size(Vec2::new(1500.0, 950.0))
+        .build_ui_state(|ui, app: &mut App| app.ui(ui), app)
+}
+
+/// A harness with `path` opened through the public API (as the CLI argument does).
+fn opened(path: &Path) -> Harness<'static, App> {
+    let mut app = App::default();
+    assert!(app.open(path), "{}", app.status());
+    let mut h = harness(app);
+    h.run();
+    h
+}
+
+/// Steps the UI (with small sleeps) until no solve runs; panics after `limit`.
+fn wait_idle(h: &mut Harness<'_, App>, limit: Duration) {
+    let t0 = Instant::now();
+    while h.state().is_busy() {
+        assert!(t0.elapsed() < limit, "solve still running after {limit:?}");
+        std::thread::sleep(Duration::from_millis(20));
+        h.step();
+    }
+    h.run_ok();
+}
+
+fn ctrl() -> Modifiers {
+    Modifiers::COMMAND | Modifiers::CTRL
+}
+
+#[test]
+fn open_demo_run_hha_shows_metrics() {
+    let mut h = opened(&demo());
+    assert_eq!(h.state().doc.geometries.len(), 122);
+    assert!(!h.state().doc.fields.is_empty());
+    assert!(h.state().uncovered().is_empty());
+    assert!(h.query_by_label("idle_mm").is_none());
+    h.get_by_label("Run HHA").click();
+    h.step();
+    assert!(h.state().is_busy(), "the solve runs in the background");
+    wait_idle(&mut h, Duration::from_secs(120));
+    let plan = h.state().active_plan().expect("a plan").clone();
+    assert_eq!(plan.algo, Algo::Hha);
+    assert_eq!(plan.name, "HHA #1");
+    common::check_plan(&h.state().doc, &plan);
+    // the metrics table shows idle_mm with the plan's value
+    h.get_by_label("idle_mm");
+    h.get_by_label(&format!("{:.1}", plan.metrics.idle_mm));
+    h.get_by_label(&format!("{:.1}", plan.metrics.base_mm));
+}
+
+#[test]
+fn dragging_a_field_reallocates_and_undoes() {
+    let mut h = opened(&demo());
+    h.get_by_label("Run HHA").click();
+    h.step();
+    wait_idle(&mut h, Duration::from_secs(120));
+    assert!(h.query_by_label("stale").is_none());
+    let field = h.state().doc.fields[0].clone();
+    assert!(!field.geometries.is_empty());
+    let p0 = h.state().field_screen_pos(field.id).unwrap();
+    let d = Vec2::new(-120.0, 90.0);
+    h.hover_at(p0);
+    h.step();
+    h.drag_at(p0);
+    h.step();
+    for i in 1..=6 {
+        h.hover_at(p0 + d * (i as f32 / 6.0));
+        h.step();
+    }
+    h.drop_at(p0 + d);
+    h.run();
+    let moved = h
+        .state()
+        .doc
+        .fields
+        .iter()
+        .find(|f| f.id == field.id)
+        .unwrap()
+        .clone();
+    assert!(moved.center.x < field.center.x - 5.0, "{moved:?}");
+    assert!(moved.center.y > field.center.y + 5.0, "{moved:?}");
+    // the allocation followed the move: the field lost geometries (now uncovered or moved)
+    assert_ne!(moved.geometries, field.geometries);
+    assert!(!h.state().uncovered().is_empty());
+    assert!(
+        h.state().status().contains("uncovered"),
+        "{}",
+        h.state().status()
+    );
+    // the plan is marked stale, and Run is blocked while geometries are uncovered
+    h.get_by_label("stale");
+    assert!(h.state().solve_blocker().is_some());
+    // the whole drag is one undo step
+    h.key_press_modifiers(ctrl(), Key::Z);
+    h.run();
+    let back = h
+        .state()
+        .doc
+        .fields
+        .iter()
+        .find(|f| f.id == field.id)
+        .unwrap();
+    assert_eq!(back.center, field.center);
+    assert_eq!(back.geometries, field.geometries);
+    assert!(h.state().uncovered().is_empty());
+    assert!(h.query_by_label("stale").is_none());
+    h.key_press_modifiers(ctrl() | Modifiers::SHIFT, Key::Z);
+    h.run();
+    let again = h
+        .state()
+        .doc
+        .fields
+        .iter()
+        .find(|f| f.id == field.id)
+        .unwrap();
+    assert_eq!(again.center, moved.center);
+}
+
+#[test]
+fn add_lock_delete_and_replace_fields() {
+    let mut h = opened(&demo());
+    let n = h.state().doc.fields.len();
+    h.get_by_label("Add field").click();
+    h.run();
+    let canvas = h.get_by_label("Work area").rect();
+    let at = canvas.center() + Vec2::new(10.0, 10.0);
+    h.hover_at(at);
+    h.step();
+    for pressed in [true, false] {
+        h.event(Event::PointerButton {
+            pos: at,
+            button: PointerButton::Primary,
+            pressed,
+            modifiers: Modifiers::NONE,
+        });
+    }
+    h.run();
+    assert_eq!(h.state().doc.fields.len(), n + 1);
+    let id = h
+        .state()
+        .selected_field()
+        .expect("the new field is selected");
+    h.get_by_label("Lock").click();
+    h.run();
+    assert!(h.state().doc.fields.iter().any(|f| f.id == id && f.locked));
+    // re-placing keeps the locked field
+    h.get_by_label("Re-place automatically").click();
+    h.run();
+    assert!(h.state().doc.fields.iter().any(|f| f.id == id && f.locked));
+    assert!(h.state().uncovered().is_empty());
+    h.get_by_label("Delete field").click();
+    h.run();
+    assert!(!h.state().doc.fields.iter().any(|f| f.id == id));
+    // undo the delete, the re-placement, the lock and the add
+    for _ in 0..4 {
+        h.get_by_label("Undo").click();
+        h.run();
+    }
+    assert_eq!(h.state().doc.fields.len(), n);
+}
+
+fn set_text(h: &mut Harness<'_, App>, label: &str, text: &str) {
+    h.get_by_label(label).focus();
+    h.run();
+    h.key_press_modifiers(ctrl(), Key::A);
+    h.get_by_label(label).type_text(text);
+    h.run();
+    h.key_press(Key::Enter);
+    h.run();
+}
+
+#[test]
+fn invalid_profile_and_settings_input_is_rejected() {
+    let mut h = opened(&demo());
+    set_text(&mut h, "Field width (mm)", "-5");
+    h.get_by_label_contains("field_mm[0] = -5 must be a positive number");
+    assert_eq!(h.state().doc.profile.field_mm, [70.0, 70.0]);
+    set_text(&mut h, "Field width (mm)", "abc");
+    h.get_by_label_contains("'abc' is not a number");
+    assert_eq!(h.state().doc.profile.field_mm, [70.0, 70.0]);
+    set_text(&mut h, "GA mutation rate", "1.5");
+    h.get_by_label_contains("must lie in [0, 1]");
+    assert_eq!(
+        h.state().doc.settings.ga.mutation_rate,
+        SolverSettings::default().ga.mutation_rate
+    );
+    // a valid value is applied, resizes the fields and can be undone
+    set_text(&mut h, "Field width (mm)", "60");
+    assert!(h
+        .query_by_label_contains("must be a positive number")
+        .is_none());
+    assert_eq!(h.state().doc.profile.field_mm, [60.0, 70.0]);
+    assert!(h.state().doc.fields.iter().all(|f| f.size == [60.0, 70.0]));
+    h.get_by_label("Undo").click();
+    h.run();
+    assert_eq!(h.state().doc.profile.field_mm, [70.0, 70.0]);
+    // a built-in profile is selectable
+    h.get_by_label("Built-in").click();
+    h.run();
+    h.get_by_label("small-field").click();
+    h.run();
+    assert_ne!(h.state().doc.profile.field_mm, [70.0, 70.0]);
+    assert!(h
+        .state()
+        .doc
+        .fields
+        .iter()
+        .all(|f| f.size == h.state().doc.profile.field_mm));
+}
+
+#[test]
+fn gui_and_cli_make_the_same_plan() {
+    let dir = tempfile::tempdir().unwrap();
+    let report = dir.path().join("r.json");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_galvoplan"))
+        .args(["plan", &demo().display().to_string(), "-o"])
+        .arg(dir.path().join("x.gcode"))
+        .arg("--report")
+        .arg(&report)
+        .args(["--seed", "7"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let cli: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+
+    let mut h = opened(&demo());
+    set_text(&mut h, "Seed", "7");
+    assert_eq!(h.state().doc.settings.seed, 7);
+    h.get_by_label("Run HHA").click();
+    h.step();
+    wait_idle(&mut h, Duration::from_secs(120));
+    let plan = h.state().active_plan().unwrap();
+    let gui: Vec<serde_json::Value> = plan
+        .order
+        .iter()
+        .map(|s| {
+            serde_json::json!({"geometry": s.geometry, "field": s.field,
+                "start_vertex": s.start_vertex, "reversed": s.reversed})
+        })
+        .collect();
+    assert_eq!(cli["order"].as_array().unwrap(), &gui);
+    let idle = cli["metrics"]["idle_mm"].as_f64().unwrap();
+    assert!((idle - plan.metrics.idle_mm).abs() < 1e-9);
+    assert_eq!(cli["fields"].as_array().unwrap().len(), plan.fields.len());
+}
+
+#[test]
+fn cancel_an_hga_run() {
+    let mut h = opened(&demo());
+    // settings under which HGA would run for minutes
+    let mut s = h.state().doc.settings.clone();
+    s.ga.stall_generations = 1_000_000;
+    s.time_limit_s = Some(600.0);
+    h.state_mut()
+        .execute(Command::SetSettings(Box::new(s)))
+        .unwrap();
+    h.get_by_label("Run HGA").click();
+    h.step();
+    assert!(h.state().is_busy());
+    // let it get into the generations, with the GUI stepping all the while
+    let t0 = Instant::now();
+    while !h
+        .state()
+        .job_message()
+        .is_some_and(|m| m.contains("generation"))
+    {
+        assert!(
+            t0.elapsed() < Duration::from_secs(120),
+            "no generation reported"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+        h.step();
+    }
+    h.get_by_label("Cancel").click();
+    h.step();
+    let t1 = Instant::now();
+    wait_idle(&mut h, Duration::from_secs(60));
+    assert!(t1.elapsed() < Duration::from_secs(30));
+    // a cancelled HGA keeps its best plan so far, with its convergence history
+    let plan = h.state().active_plan().expect("best plan so far").clone();
+    assert_eq!(plan.algo, Algo::Hga);
+    assert!(plan.name.contains("stopped"), "{}", plan.name);
+    assert!(!plan.history.is_empty());
+    common::check_plan(&h.state().doc, &plan);
+}
+
+#[test]
+fn compare_view_shows_both_plans_and_the_difference() {
+    let mut h = opened(&demo());
+    for label in ["Run HHA", "Run baseline"] {
+        h.get_by_label(label).click();
+        h.step();
+        wait_idle(&mut h, Duration::from_secs(120));
+    }
+    h.get_by_label("Compare").click();
+    h.run();
+    h.get_by_label("B vs A");
+    // the compare table and the active plan's table in the side panel
+    assert_eq!(h.get_all_by_label("direction_changes").count(), 2);
+    let plans = &h.state().doc.plans;
+    let (a, b) = (&plans[0].metrics, &plans[1].metrics);
+    let pct = (b.idle_mm - a.idle_mm) / a.idle_mm * 100.0;
+    h.get_by_label(&format!("{pct:+.1} %"));
+    h.get_by_label("Overlay").click();
+    h.run();
+    h.get_by_label("Compare (overlay)");
+}
+
+#[test]
+fn project_round_trip_and_drag_and_drop() {
+    let dir = tempfile::tempdir().unwrap();
+    let project = dir.path().join("job.galvoplan");
+    let mut h = opened(&demo());
+    h.get_by_label("Run baseline").click();
+    h.step();
+    wait_idle(&mut h, Duration::from_secs(60));
+    h.state_mut().save_project(&project).unwrap();
+    let gcode = dir.path().join("job.gcode");
+    h.state_mut()
+        .export(galvoplan::app::files::ExportKind::Gcode, &gcode)
+        .unwrap();
+    assert!(std::fs::read_to_string(&gcode).unwrap().contains("G21"));
+
+    // a fresh window; the project is dropped on it
+    #[derive(Debug)]
+    struct Dropped(PathBuf);
+    impl egui::DroppedFile for Dropped {
+        fn path(&self) -> &Path {
+            &self.0
+        }
+        fn bytes(&self) -> Result<Vec<u8>, String> {
+            std::fs::read(&self.0).map_err(|e| e.to_string())
+        }
+    }
+    let mut h2 = harness(App::default());
+    h2.run();
+    h2.input_mut()
+        .dropped_files
+        .push(std::sync::Arc::new(Dropped(project.clone())));
+    h2.run();
+    let (a, b) = (&h.state().doc, &h2.state().doc);
+    assert_eq!(a.fields, b.fields);
+    assert_eq!(a.plans, b.plans);
+    assert_eq!(h2.state().active_plan().unwrap().name, "Baseline #1");
+    // a bad file is reported, not fatal
+    let mut app = App::default();
+    assert!(!app.open(&dir.path().join("missing.svg")));
+    assert!(app.status().contains("missing.svg"), "{}", app.status());
+}
+
+#[test]
+fn oversize_geometries_are_shown_uncovered_until_split() {
+    let path = common::root().join("assets/examples/oversize.svg");
+    let mut h = opened(&path);
+    let n = h.state().doc.geometries.len();
+    // fields could not be placed: the document is open, every geometry is uncovered (red)
+    assert_eq!(h.state().uncovered().len(), n);
+    assert!(
+        h.state().status().contains("larger than"),
+        "{}",
+        h.state().status()
+    );
+    assert!(h.state().solve_blocker().is_some());
+    h.get_by_label("Split oversize geometries (on re-place)")
+        .click();
+    h.run();
+    assert!(h.state().doc.settings.split_oversize);
+    h.get_by_label("Re-place automatically").click();
+    h.run();
+    assert!(h.state().doc.geometries.len() > n);
+    assert!(h.state().uncovered().is_empty());
+    // the split pieces are reported as warnings in the panel
+    let w = h.state().doc.warnings.len();
+    assert!(w > 0);
+    h.get_by_label(&format!("Import warnings ({w})"));
+    // undo restores the unsplit geometries
+    h.get_by_label("Undo").click();
+    h.run();
+    assert_eq!(h.state().doc.geometries.len(), n);
+    assert_eq!(h.state().uncovered().len(), n);
+}
+
+#[test]
+fn import_warnings_are_listed() {
+    let dir = tempfile::tempdir().unwrap();
+    let svg = dir.path().join("w.svg");
+    std::fs::write(
+        &svg,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="100mm" height="100mm" viewBox="0 0 100 100">
+<rect x="10" y="10" width="5" height="5" fill="none" stroke="black"/>
+<text id="caption" x="20" y="20">hello</text></svg>"#,
+    )
+    .unwrap();
+    let h = opened(&svg);
+    assert_eq!(h.state().doc.warnings.len(), 1);
+    h.get_by_label("Import warnings (1)");
+    h.get_by_label_contains("caption");
+}
+
+/// Frame time of `App::ui` while a solve runs on a large instance (not run by default):
+/// `GALVOPLAN_FRAME_SVG=path GALVOPLAN_FRAME_ALGO=hga cargo test --release --test gui -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn frame_time_while_solving() {
+    let path = std::env::var("GALVOPLAN_FRAME_SVG")
+        .map(PathBuf::from)
+        .unwrap_or_else(|_| common::root().join("../shared/bench/instances/ISW-1017.svg"));
+    let algo = std::env::var("GALVOPLAN_FRAME_ALGO").unwrap_or_else(|_| "hga".into());
+    let mut app = App::default();
+    assert!(app.open(&path), "{}", app.status());
+    let times = std::rc::Rc::new(std::cell::RefCell::new(Vec::new()));
+    let t = times.clone();
+    let mut h = Harness::builder()
+        .with_size(Vec2::new(1500.0, 950.0))
+        .build_ui_state(
+            move |ui, app: &mut App| {
+                let t0 = Instant::now();
+                app.ui(ui);
+                if app.is_busy() {
+                    t.borrow_mut().push(t0.elapsed().as_secs_f64() * 1e3);
+                }
+            },
+            app,
+        );
+    h.run();
+    let label = format!("Run {}", algo.to_uppercase());
+    h.get_by_label(&label).click();
+    h.step();
+    assert!(h.state().is_busy(), "{}", h.state().status());
+    // hover the canvas so that hover hit-testing is part of every frame
+    let centre = h.get_by_label("Work area").rect().center();
+    let t0 = Instant::now();
+    while h.state().is_busy() {
+        h.hover_at(centre + Vec2::new((t0.elapsed().as_secs_f32() * 3.0).sin() * 50.0, 0.0));
+        h.step();
+        std::thread::sleep(Duration::from_millis(16));
+    }
+    let mut v = times.borrow().clone();
+    v.sort_by(f64::total_cmp);
+    let median = v[v.len() / 2];
+    let p95 = v[(v.len() * 95 / 100).min(v.len() - 1)];
+    let max = v[v.len() - 1];
+    println!(
+        "{} on {}: solve {:.1} s, {} frames while solving, App::ui median {median:.2} ms, p95 {p95:.2} ms, max {max:.2} ms; plan: {}",
+        label,
+        path.display(),
+        t0.elapsed().as_secs_f64(),
+        v.len(),
+        h.state().status()
+    );
+}
