@@ -23,4 +23,6 @@ start=$(date +%s)
 cargo test --no-default-features --lib --bins
 # Everything: library, CLI, integration and GUI (egui_kittest) tests.
 cargo test --all-targets
+# The rerun recording (feature-gated: the rerun SDK is a third of the full build).
+cargo test --no-default-features --features rerun --test rerun
 echo "test.sh: done in $(( $(date +%s) - start )) s"

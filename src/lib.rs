@@ -22,6 +22,8 @@ pub mod import;
 pub mod job;
 pub mod order;
 pub mod pipeline;
+#[cfg(feature = "rerun")]
+pub mod record;
 
 #[cfg(feature = "gui")]
 pub mod app;

@@ -207,6 +207,10 @@ struct PlanArgs {
     /// SVG preview of the planned path.
     #[arg(long)]
     preview: Option<PathBuf>,
+    /// Record the run (geometry, fields, path, GA convergence) as a rerun .rrd file
+    /// (needs a build with `--features rerun`).
+    #[arg(long, value_name = "OUT.rrd")]
+    rerun: Option<PathBuf>,
     /// Write exactly the geometry to be marked as an SVG in mm.
     #[arg(long)]
     export_geometry: Option<PathBuf>,

@@ -19,7 +19,11 @@ pub fn run(a: &PlanArgs) -> Result<()> {
         eprintln!("galvoplan: warning: {}: {w}", a.input.display());
     }
     let progress = Arc::new(BarProgress::new());
-    let ctx = JobCtx::new(CancelToken::new(), progress.clone());
+    let mut ctx = JobCtx::new(CancelToken::new(), progress.clone());
+    let recorder = recorder(a.rerun.as_deref())?;
+    if let Some(r) = &recorder {
+        ctx = ctx.with_recorder(r.clone());
+    }
     let imported_warnings = doc.warnings.len();
     let result = plan_document(&mut doc, &ctx);
     progress.finish();
@@ -54,6 +58,7 @@ pub fn run(a: &PlanArgs) -> Result<()> {
             .with_context(|| format!("{}: cannot write", path.display()))
     };
     write(&a.output, &gcode)?;
+    finish_recording(recorder.as_ref())?;
     if let Some(p) = &a.report {
         write(
             p,
@@ -78,5 +83,40 @@ pub fn run(a: &PlanArgs) -> Result<()> {
         m.direction_changes,
         m.solve_s.total * 1e3
     );
+    Ok(())
+}
+
+#[cfg(feature = "rerun")]
+type Recorder = Arc<galvoplan::record::RerunRecorder>;
+#[cfg(not(feature = "rerun"))]
+type Recorder = Arc<dyn galvoplan::job::RunRecorder>;
+
+#[cfg(feature = "rerun")]
+fn recorder(path: Option<&std::path::Path>) -> Result<Option<Recorder>> {
+    path.map(|p| Ok(Arc::new(galvoplan::record::RerunRecorder::create(p)?)))
+        .transpose()
+}
+
+#[cfg(not(feature = "rerun"))]
+fn recorder(path: Option<&std::path::Path>) -> Result<Option<Recorder>> {
+    match path {
+        Some(p) => anyhow::bail!(
+            "{}: this build cannot record rerun files; rebuild with `--features rerun`",
+            p.display()
+        ),
+        None => Ok(None),
+    }
+}
+
+#[cfg(feature = "rerun")]
+fn finish_recording(r: Option<&Recorder>) -> Result<()> {
+    if let Some(r) = r {
+        r.finish()?;
+    }
+    Ok(())
+}
+
+#[cfg(not(feature = "rerun"))]
+fn finish_recording(_: Option<&Recorder>) -> Result<()> {
     Ok(())
 }

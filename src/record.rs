@@ -1,0 +1,137 @@
+//! Recording runs with rerun (feature `rerun`): geometry, scan fields, the planned path and the
+//! GA's convergence, written to an `.rrd` file without opening a viewer.
+
+use crate::document::{Geometry, Plan, ScanField};
+use crate::job::RunRecorder;
+use crate::order::metrics::step_ends;
+use thiserror::Error;
+
+/// The recording could not be created or written.
+#[derive(Debug, Error)]
+#[error("{file}: cannot write the rerun recording: {msg}")]
+pub struct RecordError {
+    /// The file.
+    pub file: String,
+    /// The cause.
+    pub msg: String,
+}
+
+/// A [`RunRecorder`] writing to an `.rrd` file.
+pub struct RerunRecorder {
+    rec: rerun::RecordingStream,
+    file: String,
+}
+
+fn xy(p: crate::geom::Pt) -> [f32; 2] {
+    [p.x as f32, p.y as f32]
+}
+
+impl RerunRecorder {
+    /// Creates the recording file.
+    pub fn create(path: &std::path::Path) -> Result<Self, RecordError> {
+        let file = path.display().to_string();
+        let rec = rerun::RecordingStreamBuilder::new("galvoplan")
+            .save(path)
+            .map_err(|e| RecordError {
+                file: file.clone(),
+                msg: e.to_string(),
+            })?;
+        Ok(Self { rec, file })
+    }
+
+    /// Flushes everything to disk.
+    pub fn finish(&self) -> Result<(), RecordError> {
+        self.rec.flush_blocking().map_err(|e| RecordError {
+            file: self.file.clone(),
+            msg: e.to_string(),
+        })
+    }
+}
+
+impl RunRecorder for RerunRecorder {
+    fn geometry(&self, geometries: &[Geometry]) {
+        let strips: Vec<rerun::LineStrip2D> = geometries
+            .iter()
+            .map(|g| {
+                let mut pts: Vec<[f32; 2]> = g.points.iter().map(|&p| xy(p)).collect();
+                if g.closed {
+                    if let Some(&f) = pts.first() {
+                        pts.push(f);
+                    }
+                }
+                rerun::LineStrip2D::from_iter(pts)
+            })
+            .collect();
+        let _ = self.rec.log_static(
+            "artwork",
+            &rerun::LineStrips2D::new(strips).with_colors([rerun::Color::from_rgb(40, 40, 40)]),
+        );
+    }
+
+    fn fields(&self, fields: &[ScanField]) {
+        let centers: Vec<[f32; 2]> = fields.iter().map(|f| xy(f.center)).collect();
+        let sizes: Vec<[f32; 2]> = fields
+            .iter()
+            .map(|f| [f.size[0] as f32, f.size[1] as f32])
+            .collect();
+        let labels: Vec<String> = fields.iter().map(|f| format!("field {}", f.id)).collect();
+        let _ = self.rec.log_static(
+            "fields",
+            &rerun::Boxes2D::from_centers_and_sizes(centers, sizes)
+                .with_labels(labels)
+                .with_colors([rerun::Color::from_rgb(59, 130, 246)]),
+        );
+    }
+
+    fn plan(&self, geometries: &[Geometry], plan: &Plan) {
+        let marks: Vec<rerun::LineStrip2D> = plan
+            .order
+            .iter()
+            .map(|s| {
+                let g = &geometries[s.geometry];
+                rerun::LineStrip2D::from_iter(
+                    g.marking_path(s.start_vertex, s.reversed)
+                        .into_iter()
+                        .map(xy),
+                )
+            })
+            .collect();
+        let idle: Vec<rerun::LineStrip2D> = plan
+            .order
+            .windows(2)
+            .map(|w| {
+                let (a, b) = (
+                    step_ends(geometries, &w[0]).1,
+                    step_ends(geometries, &w[1]).0,
+                );
+                rerun::LineStrip2D::from_iter([xy(a), xy(b)])
+            })
+            .collect();
+        let base: Vec<[f32; 2]> = plan.fields.iter().map(|f| xy(f.center)).collect();
+        let root = format!("plans/{}", plan.name);
+        let _ = self.rec.log_static(
+            format!("{root}/marks"),
+            &rerun::LineStrips2D::new(marks).with_colors([rerun::Color::from_rgb(0, 0, 0)]),
+        );
+        let _ = self.rec.log_static(
+            format!("{root}/idle"),
+            &rerun::LineStrips2D::new(idle).with_colors([rerun::Color::from_rgb(220, 38, 38)]),
+        );
+        let _ = self.rec.log_static(
+            format!("{root}/base_path"),
+            &rerun::LineStrips2D::new([rerun::LineStrip2D::from_iter(base)])
+                .with_colors([rerun::Color::from_rgb(22, 163, 74)]),
+        );
+        let _ = self.rec.flush_blocking();
+    }
+
+    fn generation(&self, generation: usize, best_idle_mm: f64, mean_idle_mm: f64) {
+        self.rec.set_time_sequence("generation", generation as i64);
+        let _ = self
+            .rec
+            .log("hga/best_idle_mm", &rerun::Scalars::single(best_idle_mm));
+        let _ = self
+            .rec
+            .log("hga/mean_idle_mm", &rerun::Scalars::single(mean_idle_mm));
+    }
+}
