@@ -26,7 +26,8 @@ pub fn compute(
         .map(|s| geometries[s.geometry].length_mm())
         .sum();
     let centers: Vec<Pt> = fields.iter().map(|f| f.center).collect();
-    let base_mm = centers.windows(2).map(|w| w[0].dist(w[1])).sum();
+    // `+ 0.0` turns the empty sum (−0.0) into 0.0
+    let base_mm = centers.windows(2).map(|w| w[0].dist(w[1])).sum::<f64>() + 0.0;
     let (covered_area_mm2, overlap_pct) = coverage(fields, profile.field_mm);
     Metrics {
         idle_mm,
@@ -57,7 +58,8 @@ pub fn idle_mm(geometries: &[Geometry], steps: &[Step]) -> f64 {
                 .1
                 .dist(step_ends(geometries, &w[1]).0)
         })
-        .sum()
+        .sum::<f64>()
+        + 0.0
 }
 
 /// Area covered by exactly one field and the overlap percentage (seed 000 §5.1).
