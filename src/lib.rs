@@ -18,6 +18,7 @@ pub mod document;
 pub mod export;
 pub mod fields;
 pub mod geom;
+pub mod hatch;
 pub mod import;
 pub mod job;
 pub mod order;

@@ -2,6 +2,7 @@
 
 use crate::document::{Document, MachineProfile, Plan, ScanField, SolverSettings};
 use crate::fields::{place_fields, split_oversize, FieldError};
+use crate::hatch::{hatch_geometries, is_hatch_output, HatchError};
 use crate::import::{import_svg_file, ImportError, ImportOptions};
 use crate::job::JobCtx;
 use crate::order::{order_plan, OrderError};
@@ -30,6 +31,14 @@ pub enum PipelineError {
         file: String,
         /// The cause.
         source: OrderError,
+    },
+    /// Hatching failed.
+    #[error("{file}: {source}")]
+    Hatch {
+        /// The document's source file.
+        file: String,
+        /// The cause.
+        source: HatchError,
     },
 }
 
@@ -61,19 +70,56 @@ pub fn load_svg(
 /// `split_oversize`, geometries larger than a field are first cut into pieces (and reported as
 /// warnings). The plan is not added to `doc.plans`.
 pub fn plan_document(doc: &mut Document, ctx: &JobCtx) -> Result<Plan, PipelineError> {
+    let hatch_s = apply_hatch(doc, ctx)?;
     let t0 = Instant::now();
     let lower_bound = place_document_fields(doc, ctx)?;
     let fields_s = t0.elapsed().as_secs_f64();
     let mut plan = order_document(doc, ctx)?;
+    plan.metrics.solve_s.hatch = hatch_s;
     plan.metrics.solve_s.fields = fields_s;
     plan.metrics.fields_lower_bound = Some(lower_bound);
-    plan.metrics.solve_s.total = plan.metrics.solve_s.fields + plan.metrics.solve_s.order;
+    plan.metrics.solve_s.total =
+        plan.metrics.solve_s.hatch + plan.metrics.solve_s.fields + plan.metrics.solve_s.order;
     Ok(plan)
 }
 
-/// The field stage alone: splits oversize geometries when the settings say so, then places the
-/// fields (keeping locked ones) and allocates the geometries. Returns the lower bound on fields.
+/// The hatch stage: with `settings.hatch` set, fills the closed geometries (one region per SVG
+/// element, see [`hatch_geometries`]) and replaces the document's geometries with the outlines
+/// (as the settings say) and the hatch, each hatch geometry small enough for one scan field.
+/// Does nothing when the document already holds hatch output (so it runs once per import).
+/// Returns the wall time in s.
+pub fn apply_hatch(doc: &mut Document, ctx: &JobCtx) -> Result<f64, PipelineError> {
+    let t0 = Instant::now();
+    let Some(settings) = doc.settings.hatch.clone() else {
+        return Ok(0.0);
+    };
+    if doc.geometries.iter().any(is_hatch_output) {
+        return Ok(0.0);
+    }
+    let hatched = hatch_geometries(&doc.geometries, &settings, doc.profile.field_mm, ctx).map_err(
+        |source| PipelineError::Hatch {
+            file: doc.source.clone().unwrap_or_else(|| "document".into()),
+            source,
+        },
+    )?;
+    doc.geometries = hatched.geometries;
+    for w in hatched.warnings {
+        // a hatch that left no output runs again on the next call: report it once
+        if !doc.warnings.contains(&w) {
+            doc.warnings.push(w);
+        }
+    }
+    // indices changed: fields and plans of the old geometry list are void
+    doc.fields.clear();
+    doc.plans.clear();
+    Ok(t0.elapsed().as_secs_f64())
+}
+
+/// The field stage alone: hatches (once, when the settings ask for it), splits oversize
+/// geometries when the settings say so, then places the fields (keeping locked ones) and
+/// allocates the geometries. Returns the lower bound on fields.
 pub fn place_document_fields(doc: &mut Document, ctx: &JobCtx) -> Result<usize, PipelineError> {
+    apply_hatch(doc, ctx)?;
     let file = doc.source.clone().unwrap_or_else(|| "document".into());
     if doc.settings.split_oversize {
         let warnings = split_oversize(&mut doc.geometries, doc.profile.field_mm);
@@ -99,8 +145,14 @@ pub fn order_document(doc: &Document, ctx: &JobCtx) -> Result<Plan, PipelineErro
         r.geometry(&doc.geometries);
         r.fields(&doc.fields);
     }
-    let mut plan = order_plan(&doc.geometries, &doc.fields, &doc.profile, &doc.settings, ctx)
-        .map_err(|source| PipelineError::Order { file, source })?;
+    let mut plan = order_plan(
+        &doc.geometries,
+        &doc.fields,
+        &doc.profile,
+        &doc.settings,
+        ctx,
+    )
+    .map_err(|source| PipelineError::Order { file, source })?;
     plan.metrics.solve_s.total = plan.metrics.solve_s.order;
     if let Some(r) = ctx.recorder() {
         r.plan(&doc.geometries, &plan);

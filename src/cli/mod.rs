@@ -104,7 +104,12 @@ struct JobOpts {
     #[arg(long, value_name = "STYLE:SPACING_MM[:ANGLE_DEG]")]
     hatch: Option<String>,
     /// Hatch edge offset from the outline, mm (default: one spacing).
-    #[arg(long, value_name = "MM", requires = "hatch")]
+    #[arg(
+        long,
+        value_name = "MM",
+        requires = "hatch",
+        allow_negative_numbers = true
+    )]
     hatch_edge: Option<f64>,
     /// Outlines of hatched shapes: marked before the hatch, after it, or not at all.
     #[arg(long, value_enum, requires = "hatch")]

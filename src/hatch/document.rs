@@ -1,0 +1,280 @@
+//! Hatching a document's geometries: closed geometries grouped into regions by SVG element,
+//! hatched, cut to fit scan fields, and put back in document order with their outlines.
+
+use super::cut::{cut, fits, Grid};
+use super::{hatch_contours, HatchError, HatchSettings, OutlineMode};
+use crate::document::{Geometry, Source};
+use crate::geom::{BBox, Pt};
+use crate::import::Warning;
+use crate::job::JobCtx;
+use rayon::prelude::*;
+use std::collections::HashMap;
+
+/// Hatch output geometries have a layer starting with this (then the region's own layer).
+pub const HATCH_LAYER_PREFIX: &str = "hatch:";
+
+/// True for a geometry made by the hatch (see [`HATCH_LAYER_PREFIX`]).
+pub fn is_hatch_output(g: &Geometry) -> bool {
+    g.source.layer.starts_with(HATCH_LAYER_PREFIX)
+}
+
+/// The geometries after hatching.
+#[derive(Debug, Clone, Default)]
+pub struct HatchedGeometries {
+    /// Open geometries as they were, each region's outlines (unless dropped) and its hatch, in
+    /// document order (a region sits where its first contour was).
+    pub geometries: Vec<Geometry>,
+    /// Regions with nothing left to hatch after the edge offset.
+    pub warnings: Vec<Warning>,
+    /// Regions hatched.
+    pub regions: usize,
+    /// Hatch geometries made (after cutting at field cells).
+    pub hatch_geometries: usize,
+}
+
+/// Hatches the closed geometries: all closed geometries of one SVG element (same
+/// `source.element`) form one region, resolved with `settings.fill_rule`. Hatch strokes whose box
+/// does not fit in a `field_mm` scan field are cut at a grid of equal cells smaller than a field
+/// (laid over the region's hatch), so every hatch geometry fits in one field; pieces do not
+/// overlap. Hatch geometries are open polylines, or closed rings when they fit.
+pub fn hatch_geometries(
+    geometries: &[Geometry],
+    settings: &HatchSettings,
+    field_mm: [f64; 2],
+    ctx: &JobCtx,
+) -> Result<HatchedGeometries, HatchError> {
+    settings.validate()?;
+    // regions in order of first appearance
+    let mut region_of: HashMap<&str, usize> = HashMap::new();
+    let mut regions: Vec<Vec<usize>> = Vec::new();
+    for (i, g) in geometries.iter().enumerate() {
+        if g.closed && g.points.len() >= 3 && !is_hatch_output(g) {
+            let r = *region_of
+                .entry(g.source.element.as_str())
+                .or_insert_with(|| {
+                    regions.push(Vec::new());
+                    regions.len() - 1
+                });
+            regions[r].push(i);
+        }
+    }
+    let hatched: Vec<Result<Vec<Geometry>, HatchError>> = regions
+        .par_iter()
+        .map(|members| {
+            ctx.check()?;
+            hatch_region(geometries, members, settings, field_mm, ctx)
+        })
+        .collect();
+    let mut out = HatchedGeometries {
+        regions: regions.len(),
+        ..HatchedGeometries::default()
+    };
+    let mut hatch_of: Vec<Option<Vec<Geometry>>> = Vec::with_capacity(regions.len());
+    for (members, h) in regions.iter().zip(hatched) {
+        let h = h?;
+        if h.is_empty() {
+            let g = &geometries[members[0]];
+            out.warnings.push(Warning {
+                element: g.source.element.clone(),
+                line: None,
+                message: format!(
+                    "nothing left to hatch inside the {} mm edge offset",
+                    settings.edge_offset()
+                ),
+            });
+        }
+        out.hatch_geometries += h.len();
+        hatch_of.push(Some(h));
+    }
+    let first_of: HashMap<usize, usize> =
+        regions.iter().enumerate().map(|(r, m)| (m[0], r)).collect();
+    let in_region: std::collections::HashSet<usize> = regions.iter().flatten().copied().collect();
+    for (i, g) in geometries.iter().enumerate() {
+        if !in_region.contains(&i) {
+            out.geometries.push(g.clone());
+            continue;
+        }
+        let Some(&r) = first_of.get(&i) else {
+            continue;
+        };
+        let outlines = regions[r].iter().map(|&k| geometries[k].clone());
+        let hatch = hatch_of[r].take().unwrap_or_default();
+        match settings.outline {
+            OutlineMode::Before => {
+                out.geometries.extend(outlines);
+                out.geometries.extend(hatch);
+            }
+            OutlineMode::After => {
+                out.geometries.extend(hatch);
+                out.geometries.extend(outlines);
+            }
+            OutlineMode::None => out.geometries.extend(hatch),
+        }
+    }
+    if out.geometries.is_empty() && !geometries.is_empty() {
+        return Err(HatchError::NothingLeft {
+            edge_offset_mm: settings.edge_offset(),
+        });
+    }
+    Ok(out)
+}
+
+/// One region's hatch as geometries, cut to fit fields.
+fn hatch_region(
+    geometries: &[Geometry],
+    members: &[usize],
+    settings: &HatchSettings,
+    field_mm: [f64; 2],
+    ctx: &JobCtx,
+) -> Result<Vec<Geometry>, HatchError> {
+    let first = &geometries[members[0]];
+    let contours: Vec<Vec<Pt>> = members
+        .iter()
+        .map(|&k| geometries[k].points.clone())
+        .collect();
+    let h = hatch_contours(&contours, settings, ctx).map_err(|e| match e {
+        HatchError::TooFine {
+            spacing_mm, lines, ..
+        } => HatchError::TooFine {
+            element: first.source.element.clone(),
+            spacing_mm,
+            lines,
+        },
+        e => e,
+    })?;
+    let all: Vec<Pt> = h
+        .strokes
+        .iter()
+        .flat_map(|s| s.points.iter().copied())
+        .collect();
+    let grid = Grid::new(&BBox::of(&all), field_mm);
+    let mut pieces: Vec<(Vec<Pt>, bool)> = Vec::with_capacity(h.strokes.len());
+    for s in h.strokes {
+        if fits(&s.points, field_mm) {
+            pieces.push((s.points, s.closed));
+        } else {
+            pieces.extend(
+                cut(&s.points, s.closed, &grid)
+                    .into_iter()
+                    .map(|p| (p, false)),
+            );
+        }
+    }
+    let layer = format!("{HATCH_LAYER_PREFIX}{}", first.source.layer);
+    Ok(pieces
+        .into_iter()
+        .enumerate()
+        .map(|(k, (points, closed))| {
+            Geometry::new(
+                points,
+                closed,
+                Source {
+                    element: first.source.element.clone(),
+                    subpath: k,
+                    layer: layer.clone(),
+                },
+            )
+        })
+        .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::HatchStyle;
+    use super::*;
+
+    fn geom(points: Vec<Pt>, closed: bool, element: &str) -> Geometry {
+        Geometry::new(
+            points,
+            closed,
+            Source {
+                element: element.into(),
+                subpath: 0,
+                layer: "#000000".into(),
+            },
+        )
+    }
+
+    fn square(x0: f64, y0: f64, w: f64) -> Vec<Pt> {
+        vec![
+            Pt::new(x0, y0),
+            Pt::new(x0 + w, y0),
+            Pt::new(x0 + w, y0 + w),
+            Pt::new(x0, y0 + w),
+        ]
+    }
+
+    #[test]
+    fn regions_by_element_with_outline_modes() {
+        let gs = vec![
+            geom(vec![Pt::new(0.0, 0.0), Pt::new(5.0, 5.0)], false, "#line"),
+            geom(square(0.0, 0.0, 10.0), true, "#a"),
+            geom(square(20.0, 0.0, 10.0), true, "#b"),
+            geom(square(3.0, 3.0, 4.0), true, "#a"),
+        ];
+        let mut s = HatchSettings::new(HatchStyle::Lines, 1.0);
+        let h = hatch_geometries(&gs, &s, [70.0, 70.0], &JobCtx::default()).unwrap();
+        assert_eq!(h.regions, 2);
+        assert_eq!(h.geometries[0].source.element, "#line");
+        // outlines of #a first (both contours), then its hatch
+        assert_eq!(h.geometries[1], gs[1]);
+        assert_eq!(h.geometries[2], gs[3]);
+        assert!(is_hatch_output(&h.geometries[3]));
+        assert_eq!(h.geometries.len(), 4 + h.hatch_geometries);
+        // #a has a hole: nothing within 1 mm of it or of the outer square
+        for g in h
+            .geometries
+            .iter()
+            .filter(|g| is_hatch_output(g) && g.source.element == "#a")
+        {
+            for p in &g.points {
+                let dx = (3.0 - p.x).max(p.x - 7.0).max(0.0);
+                let dy = (3.0 - p.y).max(p.y - 7.0).max(0.0);
+                let outer = p.x.min(p.y).min(10.0 - p.x).min(10.0 - p.y);
+                assert!(dx.hypot(dy) > 1.0 - 1e-6 && outer > 1.0 - 1e-6, "{p:?}");
+            }
+        }
+        s.outline = OutlineMode::None;
+        let h2 = hatch_geometries(&gs, &s, [70.0, 70.0], &JobCtx::default()).unwrap();
+        assert_eq!(h2.geometries.len(), 1 + h2.hatch_geometries);
+        s.outline = OutlineMode::After;
+        let h3 = hatch_geometries(&gs, &s, [70.0, 70.0], &JobCtx::default()).unwrap();
+        let last_a = h3
+            .geometries
+            .iter()
+            .rposition(|g| g.source.element == "#a")
+            .unwrap();
+        assert_eq!(h3.geometries[last_a], gs[3]);
+        // hatch output is never taken for a region again
+        let again = hatch_geometries(&h3.geometries, &s, [70.0, 70.0], &JobCtx::default()).unwrap();
+        assert_eq!(again.regions, 2);
+    }
+
+    #[test]
+    fn large_region_is_cut_to_fit_fields() {
+        let gs = vec![geom(square(0.0, 0.0, 150.0), true, "#big")];
+        let mut s = HatchSettings::new(HatchStyle::Zigzag, 2.0);
+        s.outline = OutlineMode::None;
+        let h = hatch_geometries(&gs, &s, [70.0, 70.0], &JobCtx::default()).unwrap();
+        let total: f64 = h.geometries.iter().map(Geometry::length_mm).sum();
+        // 74 lines of 146 mm + joins + border ≈ the uncut hatch
+        let uncut = hatch_contours(&[square(0.0, 0.0, 150.0)], &s, &JobCtx::default()).unwrap();
+        assert!(
+            (total - uncut.stats.total_mm).abs() < 1e-6,
+            "{total} vs {}",
+            uncut.stats.total_mm
+        );
+        for g in &h.geometries {
+            let b = g.bbox();
+            assert!(b.width() < 70.0 && b.height() < 70.0, "{}", g.describe());
+        }
+        // tiny region: warning, no hatch; without outlines nothing is left, which is an error
+        let tiny = vec![geom(square(0.0, 0.0, 1.0), true, "#tiny")];
+        let e = hatch_geometries(&tiny, &s, [70.0, 70.0], &JobCtx::default()).unwrap_err();
+        assert!(e.to_string().contains("nothing left to mark"), "{e}");
+        s.outline = OutlineMode::After;
+        let h = hatch_geometries(&tiny, &s, [70.0, 70.0], &JobCtx::default()).unwrap();
+        assert_eq!(h.warnings.len(), 1);
+        assert_eq!(h.geometries, tiny);
+    }
+}

@@ -1,0 +1,292 @@
+//! Hatch fills (seed 003): closed regions filled with laser hatch lines after an inward edge
+//! offset.
+//!
+//! A region is a set of contours resolved by a fill rule (even-odd or non-zero, like SVG's
+//! `fill-rule`; i_overlay does the resolution). Its boundary is offset inward by the edge offset
+//! `d` (cavalier_contours: exact lines and arcs), giving the *offset region* `O`. Then:
+//! - `lines`: chords of parallel lines `s` apart, one stroke each, all in the same direction;
+//! - `zigzag`: the same chords, consecutive ones joined along the boundary of `O` wherever the
+//!   boundary between them stays between the two lines, so each sweepable part is one polyline;
+//! - `cross`: zigzag at the angle and at the angle + 90°;
+//! - `contour`: the boundaries of `O`, `O ⊖ s`, `O ⊖ 2s`, … (rings), plus gap strokes where the
+//!   rings alone would leave points farther than `s/2` from every mark.
+//!
+//! Line styles also mark the boundary of `O` (the *border*, on by default), each piece once: the
+//! pieces zigzag joins already follow are not repeated. With the border every point of `O` is
+//! within `s/2` of a mark: a point farther than `s/2` from the boundary has the nearest line
+//! within `s/2` inside `O`. Parallel lines are exactly `s` apart, rings exactly `s` apart.
+//!
+//! [`hatch_contours`] fills one region; [`hatch_geometries`] fills the closed geometries of a
+//! document (one region per SVG element) and cuts strokes larger than a scan field at field-sized
+//! cells. [`bench`] reproduces seed 003's experiment.
+
+pub mod bench;
+mod boundary;
+mod contour;
+mod cut;
+mod document;
+mod region;
+mod scan;
+mod settings;
+mod zigzag;
+
+pub use document::{hatch_geometries, is_hatch_output, HatchedGeometries, HATCH_LAYER_PREFIX};
+pub use settings::{FillRule, HatchSettings, HatchStyle, OutlineMode, MIN_SPACING_MM};
+
+use crate::geom::{polyline_length, BBox, Pt};
+use crate::job::{Cancelled, JobCtx};
+use boundary::Boundary;
+use region::{Frame, Region};
+use serde::Serialize;
+use thiserror::Error;
+
+/// Arcs are flattened within this fraction of the spacing.
+const FLATTEN_TOL_SPACING: f64 = 1e-3;
+/// At most this many lines per family (or rings) per region.
+pub const MAX_LINES: usize = 1_000_000;
+
+/// Why a hatch could not be made.
+#[derive(Debug, Error)]
+pub enum HatchError {
+    /// The `--hatch` argument is malformed.
+    #[error("--hatch {spec:?}: {reason} (expected STYLE:SPACING_MM[:ANGLE_DEG] with STYLE = zigzag | lines | cross | contour)")]
+    Spec {
+        /// The argument as given.
+        spec: String,
+        /// What is wrong.
+        reason: String,
+    },
+    /// The settings are out of range.
+    #[error("hatch settings: {0}")]
+    Settings(String),
+    /// The spacing is too fine for the region's size.
+    #[error(
+        "{element}: hatch spacing {spacing_mm} mm would need {lines} lines (at most {MAX_LINES})"
+    )]
+    TooFine {
+        /// The region's element.
+        element: String,
+        /// Spacing, mm.
+        spacing_mm: f64,
+        /// Lines needed.
+        lines: usize,
+    },
+    /// Hatching left nothing to mark (every region vanished inside the edge offset and the
+    /// outlines are dropped).
+    #[error("nothing left to mark: every hatched region vanished inside the {edge_offset_mm} mm edge offset and the outlines are dropped")]
+    NothingLeft {
+        /// Edge offset, mm.
+        edge_offset_mm: f64,
+    },
+    /// The operator cancelled.
+    #[error("cancelled")]
+    Cancelled(#[from] Cancelled),
+}
+
+/// What a hatch stroke is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum StrokeKind {
+    /// One chord of a `lines` hatch.
+    Line,
+    /// A zigzag polyline: chords of consecutive lines and the boundary joins between them.
+    Zigzag,
+    /// A piece of the offset region's boundary.
+    Border,
+    /// A contour-parallel ring (closed).
+    Ring,
+    /// A gap stroke of a contour-parallel fill.
+    Gap,
+}
+
+/// One stroke of a hatch.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct HatchStroke {
+    /// What it is.
+    pub kind: StrokeKind,
+    /// Line family: 0, or 1 for the second direction of `cross`.
+    pub family: u8,
+    /// Ring level `k` (ring at `k` spacings inside the offset boundary; gaps lie between level
+    /// `k` and `k + 1`); 0 for line styles.
+    pub level: u32,
+    /// Points in mm, in marking order.
+    pub points: Vec<Pt>,
+    /// Closed (marked back to the first point).
+    pub closed: bool,
+}
+
+impl HatchStroke {
+    /// Marked length, mm.
+    pub fn length_mm(&self) -> f64 {
+        polyline_length(&self.points, self.closed)
+    }
+}
+
+/// Counts and lengths of a region's hatch.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct HatchStats {
+    /// Chords (hatch line segments) of the line styles.
+    pub lines: usize,
+    /// Zigzag polylines.
+    pub parts: usize,
+    /// Rings of `contour`.
+    pub rings: usize,
+    /// Ring levels of `contour`.
+    pub levels: usize,
+    /// Gap strokes of `contour`.
+    pub gaps: usize,
+    /// Border strokes.
+    pub borders: usize,
+    /// Length of lines / zigzag polylines (chords and joins) / rings, mm.
+    pub fill_mm: f64,
+    /// Length of the border strokes, mm.
+    pub border_mm: f64,
+    /// Length of the gap strokes, mm.
+    pub gap_mm: f64,
+    /// Everything marked, mm.
+    pub total_mm: f64,
+}
+
+/// The hatch of one region.
+#[derive(Debug, Clone, Default)]
+pub struct RegionHatch {
+    /// Strokes in a sensible marking order (line by line, ring by ring).
+    pub strokes: Vec<HatchStroke>,
+    /// The offset region's boundary loops as flattened (inside the exact offset region).
+    pub offset_loops: Vec<Vec<Pt>>,
+    /// Counts and lengths.
+    pub stats: HatchStats,
+}
+
+/// Fills one region: `contours` (closed, mm, any orientation) resolved with the settings' fill
+/// rule, offset inward by the edge offset, then hatched in the settings' style.
+pub fn hatch_contours(
+    contours: &[Vec<Pt>],
+    settings: &HatchSettings,
+    ctx: &JobCtx,
+) -> Result<RegionHatch, HatchError> {
+    settings.validate()?;
+    let s = settings.spacing_mm;
+    let loops = region::resolve(contours, settings.fill_rule);
+    let mut out = RegionHatch::default();
+    if loops.is_empty() {
+        return Ok(out);
+    }
+    let b = BBox::of(&loops.iter().flatten().copied().collect::<Vec<_>>());
+    let lines_needed = (b.width().hypot(b.height()) / s).ceil();
+    if lines_needed > MAX_LINES as f64 {
+        return Err(HatchError::TooFine {
+            element: "region".into(),
+            spacing_mm: s,
+            lines: lines_needed as usize,
+        });
+    }
+    let o = Region::new(&loops, Frame::new(&loops, s)).offset(settings.edge_offset());
+    if o.is_empty() {
+        return Ok(out);
+    }
+    ctx.check()?;
+    let tol = s * FLATTEN_TOL_SPACING;
+    let stroke = |kind, family, level, points, closed| HatchStroke {
+        kind,
+        family,
+        level,
+        points,
+        closed,
+    };
+    if settings.style == HatchStyle::Contour {
+        let levels = contour::contour_levels(&o, s, tol, MAX_LINES, ctx)?;
+        out.offset_loops = levels.first().map(|l| l.rings.clone()).unwrap_or_default();
+        out.stats.levels = levels.len();
+        for (k, level) in levels.into_iter().enumerate() {
+            for r in level.rings {
+                out.strokes
+                    .push(stroke(StrokeKind::Ring, 0, k as u32, r, true));
+            }
+            for (g, closed) in level.gaps {
+                out.strokes
+                    .push(stroke(StrokeKind::Gap, 0, k as u32, g, closed));
+            }
+        }
+    } else {
+        let flat = o.flatten(tol);
+        let a = settings.angle_deg.to_radians();
+        let angles = if settings.style == HatchStyle::Cross {
+            vec![a, a + std::f64::consts::FRAC_PI_2]
+        } else {
+            vec![a]
+        };
+        let scans = angles
+            .iter()
+            .map(|&a| scan::scan(&flat, a, s, MAX_LINES))
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(|e| HatchError::TooFine {
+                element: "region".into(),
+                spacing_mm: s,
+                lines: e.0,
+            })?;
+        ctx.check()?;
+        if settings.style == HatchStyle::Lines {
+            let sc = &scans[0];
+            for c in sc.lines.iter().flatten() {
+                let (p, q) = sc.ends(*c);
+                out.strokes
+                    .push(stroke(StrokeKind::Line, 0, 0, vec![p, q], false));
+            }
+            if settings.border {
+                for l in &flat {
+                    out.strokes
+                        .push(stroke(StrokeKind::Border, 0, 0, l.clone(), true));
+                }
+            }
+        } else {
+            let refs: Vec<&scan::Scan> = scans.iter().collect();
+            let mut boundary = Boundary::new(&flat, &refs);
+            for (f, sc) in scans.iter().enumerate() {
+                for part in zigzag::link(sc, f, &mut boundary) {
+                    out.strokes
+                        .push(stroke(StrokeKind::Zigzag, f as u8, 0, part.points, false));
+                }
+            }
+            if settings.border {
+                for (pts, closed) in boundary.unused() {
+                    out.strokes
+                        .push(stroke(StrokeKind::Border, 0, 0, pts, closed));
+                }
+            }
+        }
+        out.stats.lines = scans
+            .iter()
+            .flat_map(|sc| sc.lines.iter().flatten().map(move |c| sc.ends(*c)))
+            .filter(|(p, q)| p.dist(*q) > 0.0)
+            .count();
+        out.offset_loops = flat;
+    }
+    out.strokes
+        .retain(|st| st.points.len() >= 2 && st.length_mm() > 0.0);
+    let st = &mut out.stats;
+    for k in &out.strokes {
+        let len = k.length_mm();
+        match k.kind {
+            StrokeKind::Line => st.fill_mm += len,
+            StrokeKind::Zigzag => {
+                st.parts += 1;
+                st.fill_mm += len;
+            }
+            StrokeKind::Ring => {
+                st.rings += 1;
+                st.fill_mm += len;
+            }
+            StrokeKind::Border => {
+                st.borders += 1;
+                st.border_mm += len;
+            }
+            StrokeKind::Gap => {
+                st.gaps += 1;
+                st.gap_mm += len;
+            }
+        }
+    }
+    st.total_mm = st.fill_mm + st.border_mm + st.gap_mm;
+    Ok(out)
+}

@@ -1,0 +1,278 @@
+//! Regions: contours resolved by a fill rule (i_overlay), inward offsets (cavalier_contours) and
+//! flattening of the offset arcs back into polylines in mm.
+//!
+//! cavalier_contours works with absolute tolerances (1e-5 for equal positions), so offsets run
+//! in a scaled frame where one hatch spacing is [`UNITS_PER_SPACING`] units; results are mapped
+//! back to mm when flattened.
+
+use super::settings::FillRule;
+use crate::geom::Pt;
+use cavalier_contours::polyline::{
+    seg_arc_radius_and_center, PlineSource, PlineSourceMut, PlineVertex, Polyline,
+};
+use cavalier_contours::shape_algorithms::{Shape, ShapeOffsetOptions};
+use i_overlay::core::fill_rule::FillRule as OverlayRule;
+use i_overlay::float::simplify::SimplifyShape;
+
+/// Scale of the offset frame: one hatch spacing is this many units.
+pub(crate) const UNITS_PER_SPACING: f64 = 64.0;
+/// Positions closer than this (units) are one position when cleaning offset results.
+const SAME_POS_UNITS: f64 = 1e-5;
+/// Loops with less area than this fraction of spacing² are dropped as offset debris.
+const MIN_AREA_SPACING2: f64 = 1e-6;
+
+/// Resolves contours (mm) with a fill rule into clean loops: outer boundaries counter-clockwise
+/// (positive signed area in x-right, y-up terms), holes clockwise, no self-intersections.
+pub(crate) fn resolve(contours: &[Vec<Pt>], rule: FillRule) -> Vec<Vec<Pt>> {
+    let input: Vec<Vec<[f64; 2]>> = contours
+        .iter()
+        .filter(|c| c.len() >= 3)
+        .map(|c| c.iter().map(|p| [p.x, p.y]).collect())
+        .collect();
+    if input.is_empty() {
+        return Vec::new();
+    }
+    let rule = match rule {
+        FillRule::EvenOdd => OverlayRule::EvenOdd,
+        FillRule::NonZero => OverlayRule::NonZero,
+    };
+    let shapes = input.simplify_shape(rule);
+    shapes
+        .into_iter()
+        .flatten()
+        .filter(|c| c.len() >= 3)
+        .map(|c| c.into_iter().map(|[x, y]| Pt::new(x, y)).collect())
+        .collect()
+}
+
+#[cfg(test)]
+/// Signed area of a closed loop (positive when counter-clockwise in x-right, y-up terms).
+pub(crate) fn signed_area(pts: &[Pt]) -> f64 {
+    let n = pts.len();
+    let mut a = 0.0;
+    for i in 0..n {
+        let (p, q) = (pts[i], pts[(i + 1) % n]);
+        a += p.x * q.y - q.x * p.y;
+    }
+    a / 2.0
+}
+
+/// The scaled frame of one region: `units = (mm - origin) * k`.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Frame {
+    origin: Pt,
+    k: f64,
+}
+
+impl Frame {
+    /// A frame centred on `loops` where `spacing_mm` is [`UNITS_PER_SPACING`] units.
+    pub(crate) fn new(loops: &[Vec<Pt>], spacing_mm: f64) -> Self {
+        let b = crate::geom::BBox::of(&loops.iter().flatten().copied().collect::<Vec<_>>());
+        let origin = if b.is_empty() {
+            Pt::default()
+        } else {
+            b.center()
+        };
+        Self {
+            origin,
+            k: UNITS_PER_SPACING / spacing_mm,
+        }
+    }
+    /// mm → units for a length.
+    pub(crate) fn len_units(&self, mm: f64) -> f64 {
+        mm * self.k
+    }
+    fn units_of(self, p: Pt) -> (f64, f64) {
+        (
+            (p.x - self.origin.x) * self.k,
+            (p.y - self.origin.y) * self.k,
+        )
+    }
+    fn mm_of(self, x: f64, y: f64) -> Pt {
+        Pt::new(x / self.k + self.origin.x, y / self.k + self.origin.y)
+    }
+}
+
+/// A region in the scaled frame: cavalier_contours shape (counter-clockwise outer boundaries,
+/// clockwise holes; the region lies left of every loop).
+pub(crate) struct Region {
+    pub(crate) shape: Shape<f64>,
+    pub(crate) frame: Frame,
+}
+
+impl Region {
+    /// Builds the region from clean loops (see [`resolve`]).
+    pub(crate) fn new(loops: &[Vec<Pt>], frame: Frame) -> Self {
+        let plines = loops.iter().map(|l| {
+            let mut p = Polyline::new_closed();
+            for &q in l {
+                let (x, y) = frame.units_of(q);
+                p.add(x, y, 0.0);
+            }
+            p
+        });
+        Self {
+            shape: clean(plines),
+            frame,
+        }
+    }
+    /// True when nothing is left.
+    pub(crate) fn is_empty(&self) -> bool {
+        self.shape.ccw_plines.is_empty() && self.shape.cw_plines.is_empty()
+    }
+    /// Inward offset by `mm` (erosion by a disc); arcs are exact.
+    pub(crate) fn offset(&self, mm: f64) -> Region {
+        if mm <= 0.0 || self.is_empty() {
+            return Region {
+                shape: clean(self.plines().cloned()),
+                frame: self.frame,
+            };
+        }
+        let opts = ShapeOffsetOptions::default();
+        let out = self.shape.parallel_offset(self.frame.len_units(mm), &opts);
+        let plines = out
+            .ccw_plines
+            .into_iter()
+            .chain(out.cw_plines)
+            .map(|p| p.polyline);
+        Region {
+            shape: clean(plines),
+            frame: self.frame,
+        }
+    }
+    fn plines(&self) -> impl Iterator<Item = &Polyline<f64>> {
+        self.shape
+            .ccw_plines
+            .iter()
+            .chain(self.shape.cw_plines.iter())
+            .map(|p| &p.polyline)
+    }
+    /// The loops as polylines in mm, arcs flattened within `tol_mm` so that the polygon lies
+    /// inside the exact region: arcs bulging out of the region (convex) get inscribed chords,
+    /// arcs bulging into it (around a reflex corner) get circumscribed tangent polygons.
+    pub(crate) fn flatten(&self, tol_mm: f64) -> Vec<Vec<Pt>> {
+        let tol = self.frame.len_units(tol_mm);
+        self.plines()
+            .map(|pl| flatten_pline(pl, tol, &self.frame))
+            .filter(|l| l.len() >= 2)
+            .collect()
+    }
+}
+
+/// Removes redundant vertices and offset debris, and rebuilds the shape.
+fn clean(plines: impl Iterator<Item = Polyline<f64>>) -> Shape<f64> {
+    let min_area = MIN_AREA_SPACING2 * UNITS_PER_SPACING * UNITS_PER_SPACING;
+    let kept: Vec<Polyline<f64>> = plines
+        .map(|p| p.remove_redundant(SAME_POS_UNITS).unwrap_or(p))
+        .filter(|p| p.vertex_count() >= 2 && p.area().abs() > min_area)
+        .collect();
+    if kept.is_empty() {
+        Shape::empty()
+    } else {
+        Shape::from_plines(kept)
+    }
+}
+
+fn flatten_pline(pl: &Polyline<f64>, tol: f64, frame: &Frame) -> Vec<Pt> {
+    let n = pl.vertex_count();
+    let mut out: Vec<Pt> = Vec::with_capacity(n);
+    for i in 0..n {
+        let v1 = pl.at(i);
+        let v2 = pl.at((i + 1) % n);
+        out.push(frame.mm_of(v1.x, v1.y));
+        if v1.bulge.abs() < 1e-12 {
+            continue;
+        }
+        arc_points(v1, v2, tol, frame, &mut out);
+    }
+    // drop repeated points (including a last point equal to the first)
+    out.dedup_by(|a, b| a.dist2(*b) < 1e-24);
+    while out.len() > 1 && out[0].dist2(out[out.len() - 1]) < 1e-24 {
+        out.pop();
+    }
+    out
+}
+
+/// Interior points of the arc v1→v2 (v1 pushed by the caller, v2 by the next segment).
+fn arc_points(
+    v1: PlineVertex<f64>,
+    v2: PlineVertex<f64>,
+    tol: f64,
+    frame: &Frame,
+    out: &mut Vec<Pt>,
+) {
+    let (r, c) = seg_arc_radius_and_center(v1, v2);
+    if !(r.is_finite() && r > tol) {
+        return;
+    }
+    let sweep = 4.0 * v1.bulge.atan();
+    let a0 = (v1.y - c.y).atan2(v1.x - c.x);
+    let step_max = 2.0 * (1.0 - tol / r).clamp(-1.0, 1.0).acos();
+    let count = (sweep.abs() / step_max.max(1e-9)).ceil().clamp(1.0, 1e6) as usize;
+    let step = sweep / count as f64;
+    if v1.bulge > 0.0 {
+        // the region is on the arc's centre side: chords stay inside it
+        for k in 1..count {
+            let a = a0 + step * k as f64;
+            out.push(frame.mm_of(c.x + r * a.cos(), c.y + r * a.sin()));
+        }
+    } else {
+        // the region is outside the circle: tangents at the sub-arc ends meet outside the circle
+        let rr = r / (step / 2.0).cos();
+        for k in 0..count {
+            let a = a0 + step * (k as f64 + 0.5);
+            out.push(frame.mm_of(c.x + rr * a.cos(), c.y + rr * a.sin()));
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn square(x0: f64, y0: f64, w: f64) -> Vec<Pt> {
+        vec![
+            Pt::new(x0, y0),
+            Pt::new(x0 + w, y0),
+            Pt::new(x0 + w, y0 + w),
+            Pt::new(x0, y0 + w),
+        ]
+    }
+
+    #[test]
+    fn fill_rules_resolve_nesting() {
+        // two squares, the small one inside: even-odd makes a hole, non-zero (same direction) not
+        let c = vec![square(0.0, 0.0, 10.0), square(3.0, 3.0, 4.0)];
+        let eo = resolve(&c, FillRule::EvenOdd);
+        let area: f64 = eo.iter().map(|l| signed_area(l)).sum();
+        assert!((area - 84.0).abs() < 1e-6, "{area}");
+        let nz = resolve(&c, FillRule::NonZero);
+        let area: f64 = nz.iter().map(|l| signed_area(l)).sum();
+        assert!((area - 100.0).abs() < 1e-6, "{area}");
+    }
+
+    #[test]
+    fn offset_square_with_hole() {
+        let c = vec![square(0.0, 0.0, 10.0), square(3.0, 3.0, 4.0)];
+        let loops = resolve(&c, FillRule::EvenOdd);
+        let r = Region::new(&loops, Frame::new(&loops, 0.5));
+        let o = r.offset(1.0);
+        let flat = o.flatten(1e-4);
+        assert_eq!(flat.len(), 2);
+        // outer 8×8 minus the hole grown by 1 mm with rounded corners: 64 − (36 − 4 + π)
+        let area: f64 = flat.iter().map(|l| signed_area(l)).sum();
+        let want = 64.0 - (36.0 - 4.0 + std::f64::consts::PI);
+        assert!((area - want).abs() < 1e-2, "{area} vs {want}");
+        // every flattened point is at least 1 mm from the original boundary (inner approximation)
+        for l in &flat {
+            for p in l {
+                let d_outer = p.x.min(p.y).min(10.0 - p.x).min(10.0 - p.y);
+                let dx = (3.0 - p.x).max(p.x - 7.0).max(0.0);
+                let dy = (3.0 - p.y).max(p.y - 7.0).max(0.0);
+                let d_hole = dx.hypot(dy);
+                assert!(d_outer.min(d_hole) > 1.0 - 1e-9, "{p:?}");
+            }
+        }
+        assert!(r.offset(6.0).is_empty());
+    }
+}
