@@ -4,7 +4,7 @@
 
 use super::paint;
 use crate::document::{Geometry, MachineProfile, Plan, ScanField};
-use crate::geom::{point_segment_dist, Pt};
+use crate::geom::{point_segment_dist, BBox, Pt};
 use egui::{Color32, PointerButton, Pos2, Rect, Sense, Vec2};
 use serde::{Deserialize, Serialize};
 
@@ -171,6 +171,25 @@ impl Canvas<'_> {
         )
     }
 
+    /// What "fit to view" shows: the artwork and the fields (the laser's reach when empty),
+    /// with a small margin.
+    pub fn content_bounds(&self) -> (Pt, Pt) {
+        let b = self
+            .geometries
+            .iter()
+            .map(Geometry::bbox)
+            .chain(self.fields.iter().map(ScanField::bbox))
+            .fold(BBox::EMPTY, BBox::union);
+        if b.is_empty() || !b.width().is_finite() {
+            return Self::reach(self.profile);
+        }
+        let m = 0.03 * b.width().max(b.height()).max(1.0);
+        (
+            Pt::new(b.min_x - m, b.min_y - m),
+            Pt::new(b.max_x + m, b.max_y + m),
+        )
+    }
+
     /// Shows the canvas in `size` (the available space when `None`); returns the response and
     /// the operator's actions. Drag pans (or moves the field under the pointer when editable),
     /// the middle button always pans, the wheel zooms about the cursor.
@@ -185,7 +204,7 @@ impl Canvas<'_> {
         let label = self.label.to_string();
         response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Canvas, true, &label));
         let mut actions = Vec::new();
-        let (lo, hi) = Self::reach(self.profile);
+        let (lo, hi) = self.content_bounds();
         if let Some(old) = state.rect {
             // keep the content anchored to the centre when the canvas is resized
             state.view.offset += (rect.size() - old.size()) / 2.0;

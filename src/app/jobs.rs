@@ -23,6 +23,19 @@ impl ProgressSink for SharedProgress {
     }
 }
 
+/// Threads of a GUI solve: all cores but one, which stays with the GUI thread (HGA is
+/// deterministic for any number of threads, so this changes speed, not plans);
+/// `GALVOPLAN_SOLVER_THREADS=N` overrides it.
+pub fn solver_threads() -> usize {
+    std::env::var("GALVOPLAN_SOLVER_THREADS")
+        .ok()
+        .and_then(|v| v.trim().parse::<usize>().ok())
+        .filter(|&n| n > 0)
+        .unwrap_or_else(|| {
+            std::thread::available_parallelism().map_or(1, |n| n.get().saturating_sub(1).max(1))
+        })
+}
+
 /// How a finished job ended.
 #[derive(Debug)]
 pub enum JobOutcome {
@@ -79,7 +92,16 @@ impl Job {
                 format!("{algo:?}").to_lowercase()
             ))
             .spawn(move || {
-                let result = order_document(&snapshot, &ctx).map_err(|e| e.to_string());
+                let threads = solver_threads();
+                let solve = || order_document(&snapshot, &ctx).map_err(|e| e.to_string());
+                let result = match rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .thread_name(|k| format!("galvoplan-solve-worker-{k}"))
+                    .build()
+                {
+                    Ok(pool) => pool.install(solve),
+                    Err(_) => solve(),
+                };
                 // the receiver is gone only when the GUI dropped the job; nothing to tell then
                 let _ = tx.send(result);
                 wake.request_repaint();

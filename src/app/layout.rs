@@ -113,6 +113,13 @@ impl App {
                         self.export_dialog(kind);
                     }
                 }
+                ui.separator();
+                if ui
+                    .add(egui::Button::new("Quit").shortcut_text("Ctrl+Q"))
+                    .clicked()
+                {
+                    ui.ctx().send_viewport_cmd(egui::ViewportCommand::Close);
+                }
             });
             ui.menu_button("Edit", |ui| {
                 let u = self.history.undo_label().map(|w| format!("Undo {w}"));
@@ -256,9 +263,6 @@ impl App {
                     self.start_solve(*algo, ui.ctx());
                 }
             }
-            if let Some(job) = &self.job {
-                job.show(ui);
-            }
             ui.separator();
             ui.selectable_value(&mut self.tab, Tab::Workbench, "Workbench");
             ui.selectable_value(&mut self.tab, Tab::Compare, "Compare");
@@ -267,6 +271,10 @@ impl App {
 
     fn status_bar(&mut self, ui: &mut egui::Ui) {
         ui.horizontal(|ui| {
+            if let Some(job) = &self.job {
+                job.show(ui);
+                ui.separator();
+            }
             let t = RichText::new(&self.status.text);
             ui.label(if self.status.error { t.color(ERROR) } else { t });
             ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {

@@ -84,6 +84,8 @@ pub fn run(file: Option<PathBuf>) -> anyhow::Result<()> {
                 .and_then(|s| eframe::get_value::<Prefs>(s, PREFS_KEY))
                 .unwrap_or_default();
             let mut app = App::with_prefs(prefs);
+            app.frame_log =
+                std::env::var_os("GALVOPLAN_FRAME_LOG").and_then(|p| std::fs::File::create(p).ok());
             if let Some(f) = file {
                 app.open(&f);
             }
@@ -169,6 +171,8 @@ pub struct App {
     drag_group: u64,
     dragging: bool,
     title: String,
+    /// Per-frame timing log (`GALVOPLAN_FRAME_LOG=path`), for measuring responsiveness.
+    frame_log: Option<std::fs::File>,
 }
 
 impl Default for App {
@@ -208,6 +212,7 @@ impl App {
             drag_group: 0,
             dragging: false,
             title: String::new(),
+            frame_log: None,
         }
     }
 
@@ -589,6 +594,12 @@ impl App {
         } else if undo {
             self.undo();
         }
+        let quit = ctx
+            .input_mut(|i| i.consume_shortcut(&KeyboardShortcut::new(Modifiers::COMMAND, Key::Q)));
+        if quit {
+            // eframe stores the preferences on the way out
+            ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+        }
         let (delete, fit) = ctx.input(|i| {
             (
                 i.key_pressed(Key::Delete),
@@ -632,6 +643,17 @@ impl eframe::App for App {
     fn ui(&mut self, ui: &mut egui::Ui, frame: &mut eframe::Frame) {
         self.frames.cpu_ms = frame.info().cpu_usage.map(|s| f64::from(s) * 1e3);
         App::ui(self, ui);
+        if let Some(log) = &mut self.frame_log {
+            use std::io::Write;
+            // ui ms of this frame, whole-frame CPU ms of the previous one, solving 0/1
+            let _ = writeln!(
+                log,
+                "{:.3} {:.3} {}",
+                self.frames.last_ms(),
+                self.frames.cpu_ms.unwrap_or(f64::NAN),
+                u8::from(self.job.is_some())
+            );
+        }
     }
     fn save(&mut self, storage: &mut dyn eframe::Storage) {
         eframe::set_value(storage, PREFS_KEY, &self.prefs());

@@ -88,15 +88,19 @@ pub(crate) fn contour_levels(
         }
     });
     result?;
-    let rings = rings.into_inner().unwrap_or_default();
-    let gaps = gaps.into_inner().unwrap_or_default();
-    let n = rings.len().max(gaps.len());
-    Ok((0..n)
-        .map(|k| Level {
-            rings: rings.get(k).cloned().flatten().unwrap_or_default(),
-            gaps: gaps.get(k).cloned().flatten().unwrap_or_default(),
-        })
-        .collect())
+    let mut rings = rings.into_inner().unwrap_or_default().into_iter();
+    let mut gaps = gaps.into_inner().unwrap_or_default().into_iter();
+    let mut levels = Vec::new();
+    loop {
+        match (rings.next(), gaps.next()) {
+            (None, None) => break,
+            (r, g) => levels.push(Level {
+                rings: r.flatten().unwrap_or_default(),
+                gaps: g.flatten().unwrap_or_default(),
+            }),
+        }
+    }
+    Ok(levels)
 }
 
 /// Results of parallel tasks by level.
