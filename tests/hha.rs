@@ -19,10 +19,6 @@ fn rect(x: f64, y: f64, w: f64, h: f64) -> Geometry {
 }
 
 /// Rows of bricks (16 × 7 mm, offset every other row) across 250 mm: several fields wide.
-fn brick_wall() -> Document {
-    brick_wall_rows(6)
-}
-
 fn brick_wall_rows(rows: usize) -> Document {
     let mut geometries = Vec::new();
     for row in 0..rows {
