@@ -71,6 +71,7 @@ impl Shared<'_> {
         kicks: usize,
         ctx: &JobCtx,
     ) -> Result<(), Cancelled> {
+        ctx.check()?;
         let (prob, flipped) = self.problem(c);
         let mut order = Vec::with_capacity(c.sco.len() + 1);
         order.push(0);

@@ -469,10 +469,10 @@ impl<'a> LocalSearch<'a> {
             if dont_look[a] {
                 continue;
             }
-            steps += 1;
-            if steps % 256 == 0 {
+            if steps % 32 == 0 {
                 ctx.check()?;
             }
+            steps += 1;
             let improved = try_two_opt(prob, tour, &mut pos, &self.nbr, a, lo, hi).or_else(|| {
                 try_or_opt(prob, tour, &mut pos, &self.nbr, a, lo, hi, self.opts.or_max)
             });
