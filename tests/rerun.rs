@@ -35,10 +35,12 @@ fn decoded_messages(path: &std::path::Path) -> usize {
     );
     assert_eq!(&bytes[..4], b"RRF2", "rerun file magic");
     let reader = std::io::BufReader::new(std::fs::File::open(path).unwrap());
-    DecoderApp::decode_eager(reader)
-        .unwrap()
-        .map(|m| m.expect("every message decodes"))
-        .count()
+    let mut n = 0;
+    for msg in DecoderApp::decode_eager(reader).unwrap() {
+        msg.expect("every message decodes");
+        n += 1;
+    }
+    n
 }
 
 #[test]
