@@ -37,7 +37,7 @@ fn decoded_messages(path: &std::path::Path) -> usize {
     let reader = std::io::BufReader::new(std::fs::File::open(path).unwrap());
     let mut n = 0;
     for msg in DecoderApp::decode_eager(reader).unwrap() {
-        msg.expect("every message decodes");
+        let _decoded = msg.expect("every message decodes");
         n += 1;
     }
     n
