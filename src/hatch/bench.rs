@@ -185,7 +185,7 @@ pub fn run_case(
 /// same instance and style at the largest spacing.
 pub fn format_table(rows: &[BenchCase]) -> String {
     let mut s = String::from(
-        "| instance | style | d = s mm | lines | parts | rings (levels) | gap strokes | border strokes | fill mm | border + gap mm | total mm | mean ms | median ms | runs | ratio |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "| instance | style | d = s mm | lines | parts | rings (levels) | gap strokes | border strokes | fill mm | border + gap mm | total mm | mean ms | median ms | min ms | runs | ratio |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
         let base = rows
@@ -196,7 +196,7 @@ pub fn format_table(rows: &[BenchCase]) -> String {
         let st = &r.stats;
         let contour = r.style == HatchStyle::Contour;
         s.push_str(&format!(
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {:.3} | {:.3} | {:.3} | {:.2} | {:.2} | {} | {:.2} |\n",
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {:.3} | {:.3} | {:.3} | {:.2} | {:.2} | {:.2} | {} | {:.2} |\n",
             r.instance,
             r.style,
             r.spacing_mm,
@@ -210,6 +210,7 @@ pub fn format_table(rows: &[BenchCase]) -> String {
             st.total_mm,
             r.mean_ms,
             r.median_ms,
+            r.min_ms,
             r.runs,
             ratio
         ));
