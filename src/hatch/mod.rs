@@ -18,7 +18,7 @@
 //!
 //! [`hatch_contours`] fills one region; [`hatch_geometries`] fills the closed geometries of a
 //! document (one region per SVG element) and cuts strokes larger than a scan field at field-sized
-//! cells. [`bench`] reproduces seed 003's experiment.
+//! cells. [`mod@bench`] reproduces seed 003's experiment.
 
 pub mod bench;
 mod boundary;
