@@ -71,6 +71,8 @@ pub fn run(file: Option<PathBuf>) -> anyhow::Result<()> {
     let options = eframe::NativeOptions {
         viewport: egui::ViewportBuilder::default()
             .with_title("galvoplan")
+            // matches StartupWMClass in packaging/linux/galvoplan.desktop
+            .with_app_id("galvoplan")
             .with_inner_size([1500.0, 950.0])
             .with_min_inner_size([900.0, 600.0]),
         ..Default::default()
