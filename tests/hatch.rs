@@ -456,8 +456,16 @@ fn style_strategy() -> impl Strategy<Value = HatchStyle> {
     prop::sample::select(HatchStyle::ALL.to_vec())
 }
 
+/// Cases per property test: 128, or `HATCH_PROPTEST_CASES` for a longer stress run.
+fn proptest_cases() -> u32 {
+    std::env::var("HATCH_PROPTEST_CASES")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(128)
+}
+
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 128, failure_persistence: None, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: proptest_cases(), failure_persistence: None, ..ProptestConfig::default() })]
 
     #[test]
     fn random_polygons_with_holes_even_odd(
@@ -583,4 +591,111 @@ fn pipeline_hatches_the_contest_svg_into_fields() {
     let plan2 = plan_document(&mut doc, &JobCtx::default()).unwrap();
     assert_eq!(doc.geometries.len(), n);
     assert_eq!(plan2.metrics.solve_s.hatch, 0.0);
+}
+
+fn pts(v: &[(f64, f64)]) -> Vec<Pt> {
+    v.iter().map(|&(x, y)| Pt::new(x, y)).collect()
+}
+
+/// Zigzag at 0° with spacing `s` and edge offset `d`, checked like the property tests.
+fn zigzag_checked(contours: &[Vec<Pt>], s: f64, d: f64, fill_rule: FillRule) {
+    let st = HatchSettings {
+        style: HatchStyle::Zigzag,
+        spacing_mm: s,
+        angle_deg: 0.0,
+        edge_offset_mm: Some(d),
+        fill_rule,
+        ..HatchSettings::default()
+    };
+    let h = hatch_contours(contours, &st, &JobCtx::default()).unwrap();
+    check(contours, &st, &h);
+}
+
+/// Found by the property test: the triangle's tip pokes 1.4 µm across an edge of the ten-gon,
+/// which leaves a hole of 8·10⁻⁷ mm² in the even-odd region; its outline must keep the offset
+/// region `d` away like any other.
+#[test]
+fn tiny_hole_where_contours_almost_touch_keeps_the_edge_offset() {
+    let contours = vec![
+        pts(&[
+            (26.0, 20.0),
+            (21.854101966249686, 25.706339097770922),
+            (15.145898033750317, 23.52671151375484),
+            (15.145898033750314, 16.47328848624516),
+            (21.854101966249683, 14.293660902229078),
+        ]),
+        pts(&[
+            (18.473218585085007, 19.715145660607785),
+            (18.21326422543313, 17.69582318173844),
+            (19.712352230930534, 18.445269141350373),
+            (20.082044403894173, 19.542769695105314),
+            (20.3345597673638, 20.106863661091396),
+            (20.207282873637702, 20.711650072623218),
+            (19.748829170136744, 21.12612107642971),
+            (19.134312389330024, 21.191962836408074),
+            (18.598457054828536, 20.88402603812569),
+            (18.34594169135891, 20.319932072139608),
+        ]),
+        pts(&[
+            (18.376237222371675, 17.775700320554346),
+            (18.136688487015466, 20.06144175256869),
+            (16.60907837936767, 19.24510397994495),
+        ]),
+    ];
+    let s = 1.1410004342545863;
+    zigzag_checked(&contours, s, 0.3 * s, FillRule::EvenOdd);
+}
+
+/// Found by the property test: offsetting this region trips a debug assertion inside
+/// cavalier_contours (its release behaviour, checked here, is right).
+#[test]
+fn offset_that_trips_a_cavalier_debug_assertion() {
+    let contours = vec![
+        pts(&[
+            (26.0, 20.0),
+            (23.154862463615082, 29.7096682663203),
+            (15.145898033750317, 23.52671151375484),
+            (15.145898033750314, 16.47328848624516),
+            (22.0768662234994, 13.608063015020548),
+        ]),
+        pts(&[
+            (16.90093195722244, 22.48608803004446),
+            (17.4065208423117, 21.780821927387642),
+            (18.885265768195378, 20.27869869496166),
+            (18.848229096760434, 22.386230200346485),
+            (18.698712745031127, 23.241019798345953),
+            (17.937189405914605, 23.657075804507812),
+            (17.13710168601079, 23.32109956019633),
+        ]),
+        pts(&[
+            (17.284531629385793, 19.972706729710684),
+            (18.47970846924733, 18.26778463770463),
+            (19.818990574781193, 18.722013040379736),
+            (19.533240252317587, 20.402706301288895),
+        ]),
+    ];
+    zigzag_checked(&contours, 0.4, 0.3 * 0.4, FillRule::EvenOdd);
+}
+
+/// Found by the property test: an offset leaves a degenerate loop on which
+/// cavalier_contours' `remove_redundant` indexed past the end (a panic, also in release).
+#[test]
+fn degenerate_offset_loop_does_not_panic() {
+    let outer = [6.0, 6.0, 6.0, 6.0, 6.0];
+    let hole = [1.0, 1.0, 1.0];
+    let island = [
+        0.39165319098710055,
+        0.20137599284156465,
+        0.2,
+        0.2,
+        0.25050627362282246,
+        0.3876117060660731,
+        0.38686100316651706,
+    ];
+    let s = 0.5033860183032421;
+    let c = Pt::new(20.0, 20.0);
+    let mut hole_pts = star(c, &hole, 0.1);
+    hole_pts.reverse();
+    let contours = vec![star(c, &outer, 0.0), hole_pts, star(c, &island, 0.2)];
+    zigzag_checked(&contours, s, 0.5 * s, FillRule::NonZero);
 }

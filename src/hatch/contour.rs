@@ -9,11 +9,13 @@
 //! the boundary of `H_k`, so the pieces of that boundary farther than `s/2` from ring `k + 1` are
 //! marked as gap strokes.
 
-use super::region::Region;
+use super::region::{ArcGeom, Elem, Region};
 use crate::geom::Pt;
 use crate::job::{Cancelled, JobCtx};
 use cavalier_contours::static_aabb2d_index::{StaticAABB2DIndex, StaticAABB2DIndexBuilder};
+use rustc_hash::FxHashMap as HashMap;
 use std::cell::OnceCell;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 
 /// A boundary-of-`H_k` point counts as reached by ring `k + 1` within `s/2 · (1 + this)`.
@@ -30,8 +32,10 @@ pub(crate) struct Level {
 
 /// Rings and gaps of `region` (already offset by the edge distance), `spacing` apart.
 ///
-/// The chain of offsets `Q_k → Q_{k+1}` runs on the calling thread; as soon as `Q_{k+1}` exists a
-/// task flattens it and finds the gaps of level `k`, so the two run side by side.
+/// Two chains of offsets run side by side, `Q_0 → Q_2 → Q_4 …` and `Q_0 → Q_1 → Q_3 …` (steps of
+/// `2s`: erosions by discs compose, so `Q_{k+2} = Q_k ⊖ 2s`), which halves the longest chain of
+/// dependent offsets; as soon as `Q_k` and `Q_{k+1}` exist a task flattens ring `k + 1` and finds
+/// the gaps of level `k`.
 pub(crate) fn contour_levels(
     region: &Region,
     spacing: f64,
@@ -42,65 +46,142 @@ pub(crate) fn contour_levels(
     if region.is_empty() {
         return Ok(Vec::new());
     }
-    // slot k: rings of level k (set by task k − 1, or for k = 0 below) and gaps of level k
-    let rings: Slots<Vec<Vec<Pt>>> = Mutex::new(Vec::new());
-    let gaps: Slots<Vec<(Vec<Pt>, bool)>> = Mutex::new(Vec::new());
-    let first = Arc::new(Region {
+    let st = LevelState {
+        regions: Mutex::new(Vec::new()),
+        rings: Mutex::new(Vec::new()),
+        gaps: Mutex::new(Vec::new()),
+        first_empty: AtomicUsize::new(max_levels.saturating_add(1)),
+        cancelled: AtomicBool::new(false),
+        spacing,
+        tol_mm,
+    };
+    let q0 = Arc::new(Region {
         shape: region.shape.clone(),
         frame: region.frame,
     });
-    let mut result: Result<(), Cancelled> = Ok(());
     rayon::scope(|sc| {
-        let level0 = first.clone();
-        let rings_ref = &rings;
-        sc.spawn(move |_| store(rings_ref, 0, level0.flatten(tol_mm)));
-        let mut cur = first;
-        for k in 0..max_levels {
-            if let Err(e) = ctx.check() {
-                result = Err(e);
-                return;
+        let st = &st;
+        let level0 = q0.clone();
+        sc.spawn(move |_| store(&st.rings, 0, level0.flatten(tol_mm)));
+        st.publish(sc, 0, Some(q0.clone()));
+        let odd = q0.clone();
+        sc.spawn(move |sc| {
+            let q1 = odd.offset(spacing);
+            let q1 = (!q1.is_empty()).then(|| Arc::new(q1));
+            if let Some(q1) = st.publish(sc, 1, q1) {
+                st.chain(sc, 1, q1, ctx);
             }
-            let next = cur.offset(spacing);
-            let next = (!next.is_empty()).then(|| Arc::new(next));
-            let (q, n) = (cur.clone(), next.clone());
-            let (rings_ref, gaps_ref) = (&rings, &gaps);
-            sc.spawn(move |_| {
-                let next_rings = n.map(|n| n.flatten(tol_mm));
-                let half = q.offset(spacing / 2.0);
-                let g = if half.is_empty() {
-                    Vec::new()
-                } else {
-                    let loops = half.flatten(tol_mm);
-                    match &next_rings {
-                        Some(nr) if !nr.is_empty() => gap_strokes(&loops, nr, spacing),
-                        _ => loops.into_iter().map(|l| (l, true)).collect(),
-                    }
-                };
-                store(gaps_ref, k, g);
-                if let Some(nr) = next_rings {
-                    store(rings_ref, k + 1, nr);
-                }
-            });
-            match next {
-                Some(n) => cur = n,
-                None => break,
-            }
-        }
+        });
+        st.chain(sc, 0, q0, ctx);
     });
-    result?;
-    let mut rings = rings.into_inner().unwrap_or_default().into_iter();
-    let mut gaps = gaps.into_inner().unwrap_or_default().into_iter();
-    let mut levels = Vec::new();
-    loop {
-        match (rings.next(), gaps.next()) {
-            (None, None) => break,
-            (r, g) => levels.push(Level {
-                rings: r.flatten().unwrap_or_default(),
-                gaps: g.flatten().unwrap_or_default(),
-            }),
-        }
+    if st.cancelled.load(Ordering::Relaxed) {
+        return Err(Cancelled);
+    }
+    // levels 0 .. first empty region
+    let n = st.first_empty.load(Ordering::Relaxed);
+    let mut rings = st.rings.into_inner().unwrap_or_default().into_iter();
+    let mut gaps = st.gaps.into_inner().unwrap_or_default().into_iter();
+    let mut levels: Vec<Level> = (0..n)
+        .map(|_| Level {
+            rings: rings.next().flatten().unwrap_or_default(),
+            gaps: gaps.next().flatten().unwrap_or_default(),
+        })
+        .collect();
+    while levels
+        .last()
+        .is_some_and(|l| l.rings.is_empty() && l.gaps.is_empty())
+    {
+        levels.pop();
     }
     Ok(levels)
+}
+
+/// What the chains and tasks of [`contour_levels`] share.
+struct LevelState {
+    /// `Q_k` by level once known: `Some(None)` when empty.
+    regions: Slots<Option<Arc<Region>>>,
+    rings: Slots<Vec<Vec<Pt>>>,
+    gaps: Slots<Vec<(Vec<Pt>, bool)>>,
+    /// The lowest level known to be empty (or beyond the level limit).
+    first_empty: AtomicUsize,
+    cancelled: AtomicBool,
+    spacing: f64,
+    tol_mm: f64,
+}
+
+impl LevelState {
+    /// Offsets by `2s` from `q` (level `k`) while the regions last.
+    fn chain<'s>(&'s self, sc: &rayon::Scope<'s>, mut k: usize, mut q: Arc<Region>, ctx: &JobCtx) {
+        loop {
+            if ctx.check().is_err() {
+                self.cancelled.store(true, Ordering::Relaxed);
+                return;
+            }
+            if self.cancelled.load(Ordering::Relaxed) {
+                return;
+            }
+            k += 2;
+            let next = if k >= self.first_empty.load(Ordering::Relaxed) {
+                None
+            } else {
+                let n = q.offset(2.0 * self.spacing);
+                (!n.is_empty()).then(|| Arc::new(n))
+            };
+            match self.publish(sc, k, next) {
+                Some(n) => q = n,
+                None => return,
+            }
+        }
+    }
+
+    /// Records `Q_k` and starts the level tasks it completes; returns it back.
+    fn publish<'s>(
+        &'s self,
+        sc: &rayon::Scope<'s>,
+        k: usize,
+        q: Option<Arc<Region>>,
+    ) -> Option<Arc<Region>> {
+        if q.is_none() {
+            self.first_empty.fetch_min(k, Ordering::Relaxed);
+        }
+        let Ok(mut regions) = self.regions.lock() else {
+            return None;
+        };
+        if regions.len() <= k + 1 {
+            regions.resize_with(k + 2, || None);
+        }
+        regions[k] = Some(q.clone());
+        // level j needs Q_j (not empty) and Q_{j+1}
+        for j in [k.checked_sub(1), Some(k)].into_iter().flatten() {
+            if let (Some(Some(lo)), Some(hi)) = (&regions[j], &regions[j + 1]) {
+                let (lo, hi) = (lo.clone(), hi.clone());
+                sc.spawn(move |_| self.level(j, &lo, hi.as_deref()));
+            }
+        }
+        q
+    }
+
+    /// Ring `k + 1` and the gaps of level `k`.
+    fn level(&self, k: usize, q: &Region, next: Option<&Region>) {
+        let (s, tol_mm) = (self.spacing, self.tol_mm);
+        let next_rings = next.map(|n| n.flatten(tol_mm));
+        let g = match (next, &next_rings) {
+            (Some(n), Some(nr)) if !nr.is_empty() => {
+                let elems = ElemTable::new(n, q.frame.len_units(s / 2.0));
+                let loops = q.offset_flattened_marked(s / 2.0, tol_mm, |e| elems.covers(e));
+                gap_strokes(&loops, nr, s)
+            }
+            _ => q
+                .offset_flattened_marked(s / 2.0, tol_mm, |_| false)
+                .into_iter()
+                .map(|(l, _)| (l, true))
+                .collect(),
+        };
+        store(&self.gaps, k, g);
+        if let Some(nr) = next_rings {
+            store(&self.rings, k + 1, nr);
+        }
+    }
 }
 
 /// Results of parallel tasks by level.
@@ -160,21 +241,19 @@ impl SegIndex {
     }
 
     /// The parts of the segment `a`–`b` (parameter intervals in 0..=1) farther than `r` from
-    /// every indexed segment, into `far`. `near` holds the segments that reached the previous
+    /// every indexed segment, into `sc.far`. `near` holds the segments that reached the previous
     /// segment of the same loop: along parallel loops they and the next ones usually cover this
     /// one too, which saves the index query; they are tried first, then their neighbours, then
-    /// the index. `buf` is scratch space.
-    fn far_parts(
-        &self,
-        a: Pt,
-        b: Pt,
-        r: f64,
-        near: &mut Vec<u32>,
-        buf: &mut Vec<(f64, f64)>,
-        far: &mut Vec<(f64, f64)>,
-    ) {
-        let mut tried: Vec<u32> = Vec::with_capacity(16);
-        let mut hit: Vec<u32> = Vec::with_capacity(16);
+    /// the index.
+    fn far_parts(&self, a: Pt, b: Pt, r: f64, near: &mut Vec<u32>, sc: &mut Scratch) {
+        let Scratch {
+            tried,
+            hit,
+            buf,
+            far,
+        } = sc;
+        tried.clear();
+        hit.clear();
         buf.clear();
         let mut try_seg = |t: u32, buf: &mut Vec<(f64, f64)>| {
             if tried.contains(&t) {
@@ -220,8 +299,21 @@ impl SegIndex {
         let len = a.dist2(b).sqrt();
         far.retain(|(lo, hi)| (hi - lo) * len > 1e-9);
         near.clear();
-        near.extend_from_slice(&hit);
+        near.extend_from_slice(hit);
     }
+}
+
+/// Scratch space of [`SegIndex::far_parts`], reused from segment to segment.
+#[derive(Default)]
+struct Scratch {
+    /// Segments tried for the current segment.
+    tried: Vec<u32>,
+    /// Those within reach.
+    hit: Vec<u32>,
+    /// Their parameter intervals.
+    buf: Vec<(f64, f64)>,
+    /// The result: parameter intervals farther than `r` from every segment.
+    far: Vec<(f64, f64)>,
 }
 
 /// The complement in 0..=1 of the union of `cover` (sorted here), into `far`.
@@ -290,15 +382,190 @@ fn capsule_interval(a: Pt, b: Pt, q0: Pt, q1: Pt, r: f64) -> Option<(f64, f64)> 
     (lo <= hi).then_some((lo, hi))
 }
 
+/// The boundary elements of ring `k + 1`, to recognise the elements of the half-step loop that
+/// lie exactly `s/2` from one of them: an arc concentric with an arc of ring `k + 1` at `s/2`
+/// radius difference and within its angular span, or a line segment parallel to one of ring
+/// `k + 1` at `s/2` and within its extent. Offsets move line segments parallel and keep the
+/// centres of arcs, so most of the half-step loop is recognised and skipped by the distance
+/// check; what is left are the corners and the parts that vanish in ring `k + 1`.
+struct ElemTable {
+    arcs: HashMap<(i64, i64), Vec<ArcGeom>>,
+    /// Line segments by (direction angle, signed distance of the line from the origin).
+    lines: HashMap<(i64, i64), Vec<LineKey>>,
+    /// `s/2` in frame units.
+    half_units: f64,
+}
+
+/// A line segment of ring `k + 1` as a key: direction angle, unit direction, signed distance of
+/// its line from the origin along the left normal, and its extent along the direction.
+#[derive(Debug, Clone, Copy)]
+struct LineKey {
+    angle: f64,
+    dist: f64,
+    lo: f64,
+    hi: f64,
+}
+
+impl LineKey {
+    fn of(a: Pt, b: Pt) -> Option<Self> {
+        let d = b.minus(a);
+        let len = d.dot(d).sqrt();
+        if len <= 0.0 {
+            return None;
+        }
+        let u = d.scale(1.0 / len);
+        let n = Pt::new(-u.y, u.x);
+        let (ta, tb) = (u.dot(a), u.dot(b));
+        Some(Self {
+            angle: u.y.atan2(u.x),
+            dist: n.dot(a),
+            lo: ta.min(tb),
+            hi: ta.max(tb),
+        })
+    }
+}
+
+/// Centres and line distances closer than this (frame units; one spacing is 64 units) are the
+/// same.
+const SAME_POS_UNITS: f64 = 1e-4;
+/// Radii or line distances that differ from `s/2` by less than this (frame units) are `s/2`
+/// apart.
+const SAME_DIST_UNITS: f64 = 1e-4;
+/// Directions closer than this (radians) are the same.
+const SAME_ANGLE: f64 = 1e-9;
+/// Slack at the element ends, as a fraction of `s/2` of length.
+const END_SLACK: f64 = 1e-3;
+/// Hash cells (much larger than the tolerances above, so a lookup usually probes one cell):
+/// arc centres, frame units.
+const ARC_CELL: f64 = 1.0;
+/// Line directions, radians.
+const LINE_CELL_ANGLE: f64 = 1e-6;
+/// Line distances from the origin, frame units.
+const LINE_CELL_DIST: f64 = 1.0;
+
+impl ElemTable {
+    fn new(next: &Region, half_units: f64) -> Self {
+        let mut arcs: HashMap<(i64, i64), Vec<ArcGeom>> = HashMap::default();
+        let mut lines: HashMap<(i64, i64), Vec<LineKey>> = HashMap::default();
+        for e in next.elems() {
+            match e {
+                Elem::Arc(a) => arcs.entry(Self::arc_cell(a.center)).or_default().push(a),
+                Elem::Line(a, b) => {
+                    if let Some(k) = LineKey::of(a, b) {
+                        lines
+                            .entry(Self::line_cell(k.angle, k.dist))
+                            .or_default()
+                            .push(k);
+                    }
+                }
+            }
+        }
+        Self {
+            arcs,
+            lines,
+            half_units,
+        }
+    }
+
+    fn arc_cell(c: Pt) -> (i64, i64) {
+        (
+            (c.x / ARC_CELL).floor() as i64,
+            (c.y / ARC_CELL).floor() as i64,
+        )
+    }
+
+    fn line_cell(angle: f64, dist: f64) -> (i64, i64) {
+        (
+            (angle / LINE_CELL_ANGLE).floor() as i64,
+            (dist / LINE_CELL_DIST).floor() as i64,
+        )
+    }
+
+    /// True when `e` (an element of the half-step loop) lies exactly `s/2` from ring `k + 1`.
+    fn covers(&self, e: &Elem) -> bool {
+        match e {
+            Elem::Arc(a) => {
+                let (c, t) = (a.center, SAME_POS_UNITS);
+                cells(
+                    Self::arc_cell(Pt::new(c.x - t, c.y - t)),
+                    Self::arc_cell(Pt::new(c.x + t, c.y + t)),
+                )
+                .any(|k| {
+                    self.arcs
+                        .get(&k)
+                        .is_some_and(|l| l.iter().any(|b| self.arc_covers(b, a)))
+                })
+            }
+            Elem::Line(p, q) => {
+                let Some(h) = LineKey::of(*p, *q) else {
+                    return true;
+                };
+                // the matching line of ring k + 1 lies s/2 further to the left
+                let d = h.dist + self.half_units;
+                let (ta, td) = (SAME_ANGLE, SAME_DIST_UNITS);
+                cells(
+                    Self::line_cell(h.angle - ta, d - td),
+                    Self::line_cell(h.angle + ta, d + td),
+                )
+                .any(|k| {
+                    self.lines
+                        .get(&k)
+                        .is_some_and(|l| l.iter().any(|b| self.line_covers(b, &h)))
+                })
+            }
+        }
+    }
+
+    fn line_covers(&self, b: &LineKey, h: &LineKey) -> bool {
+        let slack = END_SLACK * self.half_units;
+        (b.angle - h.angle).abs() <= SAME_ANGLE
+            && (b.dist - h.dist - self.half_units).abs() <= SAME_DIST_UNITS
+            && h.lo >= b.lo - slack
+            && h.hi <= b.hi + slack
+    }
+
+    fn arc_covers(&self, b: &ArcGeom, a: &ArcGeom) -> bool {
+        if b.center.dist2(a.center) > SAME_POS_UNITS * SAME_POS_UNITS
+            || ((b.radius - a.radius).abs() - self.half_units).abs() > SAME_DIST_UNITS
+            || (a.sweep > 0.0) != (b.sweep > 0.0)
+        {
+            return false;
+        }
+        // both spans counter-clockwise: [start, start + len]
+        let span = |g: &ArcGeom| {
+            if g.sweep >= 0.0 {
+                (g.start, g.sweep)
+            } else {
+                (g.start + g.sweep, -g.sweep)
+            }
+        };
+        let ((a0, al), (b0, bl)) = (span(a), span(b));
+        let slack = END_SLACK * self.half_units / b.radius.max(a.radius);
+        let d = (a0 - b0 + slack).rem_euclid(std::f64::consts::TAU) - slack;
+        d + al <= bl + slack
+    }
+}
+
+/// The cells from `lo` to `hi` (inclusive; usually one).
+fn cells(lo: (i64, i64), hi: (i64, i64)) -> impl Iterator<Item = (i64, i64)> {
+    (lo.0..=hi.0).flat_map(move |x| (lo.1..=hi.1).map(move |y| (x, y)))
+}
+
 /// The pieces of the half-step loops farther than `s/2` (plus the margin) from the next rings.
-fn gap_strokes(half: &[Vec<Pt>], next: &[Vec<Pt>], spacing: f64) -> Vec<(Vec<Pt>, bool)> {
+///
+/// `half` holds the half-step loops with a flag per segment: flagged segments lie exactly `s/2`
+/// from ring `k + 1` (see [`ElemTable`]) and are not checked.
+fn gap_strokes(
+    half: &[(Vec<Pt>, Vec<bool>)],
+    next: &[Vec<Pt>],
+    spacing: f64,
+) -> Vec<(Vec<Pt>, bool)> {
     let index = SegIndex::new(next);
     let r = spacing / 2.0 * (1.0 + GAP_MARGIN);
     let mut out = Vec::new();
     let mut near: Vec<u32> = Vec::new();
-    let mut parts: Vec<(f64, f64)> = Vec::new();
-    let mut buf: Vec<(f64, f64)> = Vec::new();
-    for l in half {
+    let mut sc = Scratch::default();
+    for (l, covered) in half {
         let m = l.len();
         // polylines of far parts; `open` says whether the last one reaches its edge's end
         let mut runs: Vec<Vec<Pt>> = Vec::new();
@@ -307,14 +574,20 @@ fn gap_strokes(half: &[Vec<Pt>], next: &[Vec<Pt>], spacing: f64) -> Vec<(Vec<Pt>
         let mut all_far = true;
         for i in 0..m {
             let (a, b) = (l[i], l[(i + 1) % m]);
-            index.far_parts(a, b, r, &mut near, &mut buf, &mut parts);
+            if covered.get(i).copied().unwrap_or(false) {
+                sc.far.clear();
+                near.clear();
+            } else {
+                index.far_parts(a, b, r, &mut near, &mut sc);
+            }
+            let parts = &sc.far;
             if !(parts.len() == 1 && parts[0].0 == 0.0 && parts[0].1 == 1.0) {
                 all_far = false;
             }
             // a part from the edge's start continues the run that reached the edge's end
             let mut joins = open;
             open = false;
-            for &(lo, hi) in &parts {
+            for &(lo, hi) in parts {
                 let p = a.plus(b.minus(a).scale(lo));
                 let q = a.plus(b.minus(a).scale(hi));
                 match runs.last_mut() {

@@ -10,7 +10,8 @@ use crate::geom::Pt;
 use cavalier_contours::polyline::{
     seg_arc_radius_and_center, PlineSource, PlineSourceMut, PlineVertex, Polyline,
 };
-use cavalier_contours::shape_algorithms::{Shape, ShapeOffsetOptions};
+use cavalier_contours::shape_algorithms::{IndexedPolyline, Shape, ShapeOffsetOptions};
+use cavalier_contours::static_aabb2d_index::StaticAABB2DIndexBuilder;
 use i_overlay::core::fill_rule::FillRule as OverlayRule;
 use i_overlay::float::simplify::SimplifyShape;
 
@@ -18,8 +19,15 @@ use i_overlay::float::simplify::SimplifyShape;
 pub(crate) const UNITS_PER_SPACING: f64 = 64.0;
 /// Positions closer than this (units) are one position when cleaning offset results.
 const SAME_POS_UNITS: f64 = 1e-5;
-/// Loops with less area than this fraction of spacing² are dropped as offset debris.
+/// Offset loops with less area than this fraction of spacing² are dropped as offset debris.
 const MIN_AREA_SPACING2: f64 = 1e-6;
+/// Loops with at least this area (frame units², one spacing is 64 units) have their redundant
+/// vertices removed.
+const TIDY_MIN_AREA_UNITS2: f64 = 1e-2;
+/// Input loops with less area than this fraction of spacing² are dropped as degenerate. Much
+/// smaller than the debris limit: a tiny hole of the input (a sliver where two contours almost
+/// touch) still keeps the offset region `d` away from its outline.
+const MIN_INPUT_AREA_SPACING2: f64 = 1e-12;
 
 /// Resolves contours (mm) with a fill rule into clean loops: outer boundaries counter-clockwise
 /// (positive signed area in x-right, y-up terms), holes clockwise, no self-intersections.
@@ -112,7 +120,7 @@ impl Region {
             p
         });
         Self {
-            shape: clean(plines),
+            shape: clean(plines, MIN_INPUT_AREA_SPACING2),
             frame,
         }
     }
@@ -124,21 +132,56 @@ impl Region {
     pub(crate) fn offset(&self, mm: f64) -> Region {
         if mm <= 0.0 || self.is_empty() {
             return Region {
-                shape: clean(self.plines().cloned()),
+                shape: clean(self.plines().cloned(), MIN_INPUT_AREA_SPACING2),
                 frame: self.frame,
             };
         }
         let opts = ShapeOffsetOptions::default();
         let out = self.shape.parallel_offset(self.frame.len_units(mm), &opts);
-        let plines = out
-            .ccw_plines
-            .into_iter()
-            .chain(out.cw_plines)
-            .map(|p| p.polyline);
         Region {
-            shape: clean(plines),
+            shape: clean_indexed(
+                out.ccw_plines.into_iter().chain(out.cw_plines),
+                MIN_AREA_SPACING2,
+            ),
             frame: self.frame,
         }
+    }
+    /// The loops of the inward offset by `mm`, flattened within `tol_mm` like [`Self::flatten`]
+    /// (without building the offset's spatial indexes: for offsets that are only looked at),
+    /// each with one flag per segment (segment `i` runs from point `i` to point `i + 1`, the last
+    /// one back to the first): true where the segment comes from a boundary element (line or arc)
+    /// for which `covered` returns true.
+    pub(crate) fn offset_flattened_marked(
+        &self,
+        mm: f64,
+        tol_mm: f64,
+        covered: impl Fn(&Elem) -> bool,
+    ) -> Vec<(Vec<Pt>, Vec<bool>)> {
+        if self.is_empty() {
+            return Vec::new();
+        }
+        let opts = ShapeOffsetOptions::default();
+        let out = self.shape.parallel_offset(self.frame.len_units(mm), &opts);
+        let tol = self.frame.len_units(tol_mm);
+        out.ccw_plines
+            .iter()
+            .chain(out.cw_plines.iter())
+            .map(|p| &p.polyline)
+            .filter(|p| p.vertex_count() >= 2 && p.area().abs() > min_area())
+            .map(|pl| flatten_pline_marked(pl, tol, &self.frame, &covered))
+            .filter(|(l, _)| l.len() >= 2)
+            .collect()
+    }
+    /// The elements (line segments and arcs) of the boundary, in frame units.
+    pub(crate) fn elems(&self) -> Vec<Elem> {
+        let mut out = Vec::new();
+        for pl in self.plines() {
+            let n = pl.vertex_count();
+            for i in 0..n {
+                out.push(Elem::of(pl.at(i), pl.at((i + 1) % n)));
+            }
+        }
+        out
     }
     fn plines(&self) -> impl Iterator<Item = &Polyline<f64>> {
         self.shape
@@ -159,38 +202,160 @@ impl Region {
     }
 }
 
-/// Removes redundant vertices and offset debris, and rebuilds the shape.
-fn clean(plines: impl Iterator<Item = Polyline<f64>>) -> Shape<f64> {
-    let min_area = MIN_AREA_SPACING2 * UNITS_PER_SPACING * UNITS_PER_SPACING;
-    let kept: Vec<Polyline<f64>> = plines
-        .map(|p| p.remove_redundant(SAME_POS_UNITS).unwrap_or(p))
-        .filter(|p| p.vertex_count() >= 2 && p.area().abs() > min_area)
-        .collect();
-    if kept.is_empty() {
-        Shape::empty()
-    } else {
-        Shape::from_plines(kept)
+/// Offset loops with less area than this (units²) are debris.
+fn min_area() -> f64 {
+    MIN_AREA_SPACING2 * UNITS_PER_SPACING * UNITS_PER_SPACING
+}
+
+/// Removes redundant vertices and loops with less area than `min_area_spacing2` · spacing², and
+/// rebuilds the shape.
+fn clean(plines: impl Iterator<Item = Polyline<f64>>, min_area_spacing2: f64) -> Shape<f64> {
+    clean_indexed(plines.map(IndexedPolyline::new), min_area_spacing2)
+}
+
+/// Like [`clean`] for polylines that already carry their spatial index (offset results): the
+/// index is rebuilt only for the polylines that lost vertices.
+fn clean_indexed(
+    plines: impl Iterator<Item = IndexedPolyline<f64>>,
+    min_area_spacing2: f64,
+) -> Shape<f64> {
+    let min_area = min_area_spacing2 * UNITS_PER_SPACING * UNITS_PER_SPACING;
+    let (mut ccw, mut cw) = (Vec::new(), Vec::new());
+    for p in plines {
+        // (two vertices make a loop of two arcs, a circle)
+        if p.polyline.vertex_count() < 2 || p.polyline.area().abs() <= min_area {
+            continue;
+        }
+        // remove_redundant indexes past the end of loops that collapse to fewer than two
+        // vertices; only loops of some size are tidied (the offset removes repeated positions
+        // itself, so the others are used as they are)
+        let p = if p.polyline.area().abs() > TIDY_MIN_AREA_UNITS2 {
+            match p.polyline.remove_redundant(SAME_POS_UNITS) {
+                Some(q) => IndexedPolyline::new(q),
+                None => p,
+            }
+        } else {
+            p
+        };
+        if p.polyline.vertex_count() < 2 {
+            continue;
+        }
+        let area = p.polyline.area();
+        if area.abs() <= min_area {
+            continue;
+        }
+        if area > 0.0 {
+            ccw.push(p);
+        } else {
+            cw.push(p);
+        }
+    }
+    if ccw.is_empty() && cw.is_empty() {
+        return Shape::empty();
+    }
+    let mut b = StaticAABB2DIndexBuilder::new(ccw.len() + cw.len());
+    for p in ccw.iter().chain(cw.iter()) {
+        match p.spatial_index.bounds() {
+            Some(r) => b.add(r.min_x, r.min_y, r.max_x, r.max_y),
+            None => b.add(0.0, 0.0, 0.0, 0.0),
+        };
+    }
+    match b.build() {
+        Ok(plines_index) => Shape {
+            ccw_plines: ccw,
+            cw_plines: cw,
+            plines_index,
+        },
+        // not reached (the builder got exactly the announced count); rebuild the plain way
+        Err(_) => Shape::from_plines(ccw.into_iter().chain(cw).map(|p| p.polyline)),
+    }
+}
+
+/// An arc segment of a boundary loop in frame units: centre, radius, start angle and signed
+/// sweep (radians, positive counter-clockwise).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct ArcGeom {
+    pub(crate) center: Pt,
+    pub(crate) radius: f64,
+    pub(crate) start: f64,
+    pub(crate) sweep: f64,
+}
+
+/// One element of a boundary loop in frame units; the region lies to its left.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Elem {
+    /// A line segment from the first point to the second.
+    Line(Pt, Pt),
+    /// An arc.
+    Arc(ArcGeom),
+}
+
+impl Elem {
+    /// The element from `v1` to `v2` (a degenerate arc counts as its chord).
+    fn of(v1: PlineVertex<f64>, v2: PlineVertex<f64>) -> Self {
+        let line = Elem::Line(Pt::new(v1.x, v1.y), Pt::new(v2.x, v2.y));
+        if v1.bulge.abs() < 1e-12 {
+            return line;
+        }
+        let (r, c) = seg_arc_radius_and_center(v1, v2);
+        if !(r.is_finite() && r > 0.0) {
+            return line;
+        }
+        Elem::Arc(ArcGeom {
+            center: Pt::new(c.x, c.y),
+            radius: r,
+            start: (v1.y - c.y).atan2(v1.x - c.x),
+            sweep: 4.0 * v1.bulge.atan(),
+        })
     }
 }
 
 fn flatten_pline(pl: &Polyline<f64>, tol: f64, frame: &Frame) -> Vec<Pt> {
+    flatten_pline_marked(pl, tol, frame, &|_| false).0
+}
+
+/// Flattens a closed polyline; the flags say, per segment, whether `covered` holds for the
+/// element the segment comes from.
+fn flatten_pline_marked(
+    pl: &Polyline<f64>,
+    tol: f64,
+    frame: &Frame,
+    covered: &impl Fn(&Elem) -> bool,
+) -> (Vec<Pt>, Vec<bool>) {
     let n = pl.vertex_count();
-    let mut out: Vec<Pt> = Vec::with_capacity(n);
+    let mut pts: Vec<Pt> = Vec::with_capacity(n);
+    let mut flags: Vec<bool> = Vec::with_capacity(n);
+    let mut arc_pts: Vec<Pt> = Vec::new();
     for i in 0..n {
         let v1 = pl.at(i);
         let v2 = pl.at((i + 1) % n);
-        out.push(frame.mm_of(v1.x, v1.y));
-        if v1.bulge.abs() < 1e-12 {
-            continue;
+        let flag = covered(&Elem::of(v1, v2));
+        arc_pts.clear();
+        arc_pts.push(frame.mm_of(v1.x, v1.y));
+        if v1.bulge.abs() >= 1e-12 {
+            arc_points(v1, v2, tol, frame, &mut arc_pts);
         }
-        arc_points(v1, v2, tol, frame, &mut out);
+        // drop repeated points: the segment that follows a dropped point starts at the kept one
+        for &p in &arc_pts {
+            match pts.last() {
+                Some(q) if q.dist2(p) < 1e-24 => {
+                    if let Some(f) = flags.last_mut() {
+                        *f = flag;
+                    }
+                }
+                _ => {
+                    pts.push(p);
+                    flags.push(flag);
+                }
+            }
+        }
     }
-    // drop repeated points (including a last point equal to the first)
-    out.dedup_by(|a, b| a.dist2(*b) < 1e-24);
-    while out.len() > 1 && out[0].dist2(out[out.len() - 1]) < 1e-24 {
-        out.pop();
+    // a last point equal to the first
+    while pts.len() > 1 && pts[0].dist2(pts[pts.len() - 1]) < 1e-24 {
+        pts.pop();
+        flags.pop();
     }
-    out
+    (pts, flags)
 }
 
 /// Interior points of the arc v1→v2 (v1 pushed by the caller, v2 by the next segment).
