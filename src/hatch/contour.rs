@@ -30,14 +30,15 @@ pub(crate) struct Level {
     pub gaps: Vec<(Vec<Pt>, bool)>,
 }
 
-/// Rings and gaps of `region` (already offset by the edge distance), `spacing` apart.
+/// Rings and gaps of `region` offset inward by `edge_mm`, `spacing` apart.
 ///
-/// Two chains of offsets run side by side, `Q_0 → Q_2 → Q_4 …` and `Q_0 → Q_1 → Q_3 …` (steps of
-/// `2s`: erosions by discs compose, so `Q_{k+2} = Q_k ⊖ 2s`), which halves the longest chain of
-/// dependent offsets; as soon as `Q_k` and `Q_{k+1}` exist a task flattens ring `k + 1` and finds
-/// the gaps of level `k`.
+/// Two chains of offsets run side by side, `Q_0 → Q_2 → Q_4 …` and `Q_1 → Q_3 → …` (steps of
+/// `2s`: erosions by discs compose, so `Q_{k+2} = Q_k ⊖ 2s`; `Q_0` and `Q_1` are both offsets of
+/// `region` itself), which halves the longest chain of dependent offsets; as soon as `Q_k` and
+/// `Q_{k+1}` exist a task flattens ring `k + 1` and finds the gaps of level `k`.
 pub(crate) fn contour_levels(
     region: &Region,
+    edge_mm: f64,
     spacing: f64,
     tol_mm: f64,
     max_levels: usize,
@@ -55,24 +56,22 @@ pub(crate) fn contour_levels(
         spacing,
         tol_mm,
     };
-    let q0 = Arc::new(Region {
-        shape: region.shape.clone(),
-        frame: region.frame,
-    });
     rayon::scope(|sc| {
         let st = &st;
-        let level0 = q0.clone();
-        sc.spawn(move |_| store(&st.rings, 0, level0.flatten(tol_mm)));
-        st.publish(sc, 0, Some(q0.clone()));
-        let odd = q0.clone();
         sc.spawn(move |sc| {
-            let q1 = odd.offset(spacing);
+            let q1 = region.offset(edge_mm + spacing);
             let q1 = (!q1.is_empty()).then(|| Arc::new(q1));
             if let Some(q1) = st.publish(sc, 1, q1) {
                 st.chain(sc, 1, q1, ctx);
             }
         });
-        st.chain(sc, 0, q0, ctx);
+        let q0 = region.offset(edge_mm);
+        let q0 = (!q0.is_empty()).then(|| Arc::new(q0));
+        if let Some(q0) = st.publish(sc, 0, q0) {
+            let level0 = q0.clone();
+            sc.spawn(move |_| store(&st.rings, 0, level0.flatten(tol_mm)));
+            st.chain(sc, 0, q0, ctx);
+        }
     });
     if st.cancelled.load(Ordering::Relaxed) {
         return Err(Cancelled);
@@ -647,7 +646,7 @@ mod tests {
         ];
         let loops = resolve(&[sq], FillRule::EvenOdd);
         let r = Region::new(&loops, Frame::new(&loops, 1.0));
-        let levels = contour_levels(&r, 1.0, 1e-4, 100, &JobCtx::default()).unwrap();
+        let levels = contour_levels(&r, 0.0, 1.0, 1e-4, 100, &JobCtx::default()).unwrap();
         assert_eq!(levels.len(), 5);
         let ring_len: f64 = levels
             .iter()
@@ -667,7 +666,7 @@ mod tests {
     fn disc_rings_have_no_gaps_until_the_centre() {
         let loops = resolve(&[disc(5.3, 720)], FillRule::EvenOdd);
         let r = Region::new(&loops, Frame::new(&loops, 1.0));
-        let levels = contour_levels(&r, 1.0, 1e-4, 100, &JobCtx::default()).unwrap();
+        let levels = contour_levels(&r, 0.0, 1.0, 1e-4, 100, &JobCtx::default()).unwrap();
         // radii 5.3, 4.3, .., 0.3: six rings
         assert_eq!(levels.len(), 6);
         assert!(levels.iter().all(|l| l.gaps.is_empty()));

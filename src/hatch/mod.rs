@@ -181,11 +181,7 @@ pub fn hatch_contours(
             lines: lines_needed as usize,
         });
     }
-    let o = Region::new(&loops, Frame::new(&loops, s)).offset(settings.edge_offset());
-    if o.is_empty() {
-        return Ok(out);
-    }
-    ctx.check()?;
+    let region = Region::new(&loops, Frame::new(&loops, s));
     let tol = s * FLATTEN_TOL_SPACING;
     let stroke = |kind, family, level, points, closed| HatchStroke {
         kind,
@@ -195,7 +191,9 @@ pub fn hatch_contours(
         closed,
     };
     if settings.style == HatchStyle::Contour {
-        let levels = contour::contour_levels(&o, s, tol, MAX_LINES, ctx)?;
+        ctx.check()?;
+        let levels =
+            contour::contour_levels(&region, settings.edge_offset(), s, tol, MAX_LINES, ctx)?;
         out.offset_loops = levels.first().map(|l| l.rings.clone()).unwrap_or_default();
         out.stats.levels = levels.len();
         for (k, level) in levels.into_iter().enumerate() {
@@ -209,6 +207,11 @@ pub fn hatch_contours(
             }
         }
     } else {
+        let o = region.offset(settings.edge_offset());
+        if o.is_empty() {
+            return Ok(out);
+        }
+        ctx.check()?;
         let flat = o.flatten(tol);
         let a = settings.angle_deg.to_radians();
         let angles = if settings.style == HatchStyle::Cross {
