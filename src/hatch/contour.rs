@@ -7,19 +7,17 @@
 //! and where a part is narrower than one spacing). Those gaps are the points of the half-step
 //! region `H_k = Q_k ⊖ s/2` farther than `s/2` from `Q_{k+1}`; every such point is within `s/2` of
 //! the boundary of `H_k`, so the pieces of that boundary farther than `s/2` from ring `k + 1` are
-//! marked as gap strokes.
+//! marked as gap strokes ([`super::gaps`]). `∂H_k` is computed only near the spots where it can
+//! hold gaps ([`super::spots`]), or for the whole level when the spots cover much of it.
 
-use super::region::{ArcGeom, Elem, Region};
+use super::elems::ElemTable;
+use super::gaps::NextRing;
+use super::region::Region;
+use super::spots::{half_step_near_spots, MAX_BOX_SHARE};
 use crate::geom::Pt;
 use crate::job::{Cancelled, JobCtx};
-use cavalier_contours::static_aabb2d_index::{StaticAABB2DIndex, StaticAABB2DIndexBuilder};
-use rustc_hash::FxHashMap as HashMap;
-use std::cell::OnceCell;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use std::sync::{Arc, Mutex};
-
-/// A boundary-of-`H_k` point counts as reached by ring `k + 1` within `s/2 · (1 + this)`.
-const GAP_MARGIN: f64 = 0.004;
+use std::sync::{Arc, Mutex, OnceLock};
 
 /// The rings and gap strokes of one offset level.
 #[derive(Debug, Clone, Default)]
@@ -35,7 +33,7 @@ pub(crate) struct Level {
 /// Two chains of offsets run side by side, `Q_0 → Q_2 → Q_4 …` and `Q_1 → Q_3 → …` (steps of
 /// `2s`: erosions by discs compose, so `Q_{k+2} = Q_k ⊖ 2s`; `Q_0` and `Q_1` are both offsets of
 /// `region` itself), which halves the longest chain of dependent offsets; as soon as `Q_k` and
-/// `Q_{k+1}` exist a task flattens ring `k + 1` and finds the gaps of level `k`.
+/// `Q_{k+1}` exist a task finds the gaps of level `k` (flattening the rings it needs once).
 pub(crate) fn contour_levels(
     region: &Region,
     edge_mm: f64,
@@ -69,7 +67,9 @@ pub(crate) fn contour_levels(
         let q0 = (!q0.is_empty()).then(|| Arc::new(q0));
         if let Some(q0) = st.publish(sc, 0, q0) {
             let level0 = q0.clone();
-            sc.spawn(move |_| store(&st.rings, 0, level0.flatten(tol_mm)));
+            sc.spawn(move |_| {
+                st.ring(0, &level0);
+            });
             st.chain(sc, 0, q0, ctx);
         }
     });
@@ -82,7 +82,14 @@ pub(crate) fn contour_levels(
     let mut gaps = st.gaps.into_inner().unwrap_or_default().into_iter();
     let mut levels: Vec<Level> = (0..n)
         .map(|_| Level {
-            rings: rings.next().flatten().unwrap_or_default(),
+            rings: rings
+                .next()
+                .flatten()
+                .map(|r| match Arc::try_unwrap(r) {
+                    Ok(cell) => cell.into_inner().unwrap_or_default(),
+                    Err(shared) => shared.get().cloned().unwrap_or_default(),
+                })
+                .unwrap_or_default(),
             gaps: gaps.next().flatten().unwrap_or_default(),
         })
         .collect();
@@ -99,7 +106,8 @@ pub(crate) fn contour_levels(
 struct LevelState {
     /// `Q_k` by level once known: `Some(None)` when empty.
     regions: Slots<Option<Arc<Region>>>,
-    rings: Slots<Vec<Vec<Pt>>>,
+    /// Flattened rings by level, made once by whichever task needs them first.
+    rings: Slots<Arc<OnceLock<Vec<Vec<Pt>>>>>,
     gaps: Slots<Vec<(Vec<Pt>, bool)>>,
     /// The lowest level known to be empty (or beyond the level limit).
     first_empty: AtomicUsize,
@@ -160,15 +168,30 @@ impl LevelState {
         q
     }
 
-    /// Ring `k + 1` and the gaps of level `k`.
+    /// Ring `k` flattened (made on first use).
+    fn ring(&self, k: usize, q: &Region) -> Arc<OnceLock<Vec<Vec<Pt>>>> {
+        let cell = match self.rings.lock() {
+            Ok(mut rings) => {
+                if rings.len() <= k {
+                    rings.resize_with(k + 1, || None);
+                }
+                rings[k].get_or_insert_with(Default::default).clone()
+            }
+            Err(_) => Arc::default(),
+        };
+        cell.get_or_init(|| q.flatten(self.tol_mm));
+        cell
+    }
+
+    /// The gaps of level `k` (and ring `k + 1`, flattened on the way).
     fn level(&self, k: usize, q: &Region, next: Option<&Region>) {
         let (s, tol_mm) = (self.spacing, self.tol_mm);
-        let next_rings = next.map(|n| n.flatten(tol_mm));
-        let g = match (next, &next_rings) {
+        let next_ring = next.map(|n| self.ring(k + 1, n));
+        let g = match (next, next_ring.as_ref().and_then(|r| r.get())) {
             (Some(n), Some(nr)) if !nr.is_empty() => {
-                let elems = ElemTable::new(n, q.frame.len_units(s / 2.0));
-                let loops = q.offset_flattened_marked(s / 2.0, tol_mm, |e| elems.covers(e));
-                gap_strokes(&loops, nr, s)
+                let ring_k = self.ring(k, q);
+                let rk = ring_k.get().map(Vec::as_slice).unwrap_or_default();
+                level_gaps(q, n, rk, nr, s, tol_mm, MAX_BOX_SHARE)
             }
             _ => q
                 .offset_flattened_marked(s / 2.0, tol_mm, |_| false)
@@ -177,9 +200,48 @@ impl LevelState {
                 .collect(),
         };
         store(&self.gaps, k, g);
-        if let Some(nr) = next_rings {
-            store(&self.rings, k + 1, nr);
+    }
+}
+
+/// The gap strokes between ring `k` (of `q`, flattened `ring_k`) and ring `k + 1` (of `next`,
+/// flattened `ring_next`): from the half-step boundary near the spots, or from all of it when
+/// the spots' boxes cover more than `max_share` of the level.
+fn level_gaps(
+    q: &Region,
+    next: &Region,
+    ring_k: &[Vec<Pt>],
+    ring_next: &[Vec<Pt>],
+    s: f64,
+    tol_mm: f64,
+    max_share: f64,
+) -> Vec<(Vec<Pt>, bool)> {
+    let reach = NextRing::new(ring_next, s);
+    let at_s = ElemTable::new(next, q.frame.len_units(s));
+    let mut g = Vec::new();
+    match half_step_near_spots(q, ring_k, &at_s, s, tol_mm, max_share) {
+        Some(pieces) => {
+            for (l, closed) in &pieces {
+                reach.far_runs(l, *closed, None, &mut g);
+            }
         }
+        None => full_gaps(q, next, &reach, s, tol_mm, &mut g),
+    }
+    g
+}
+
+/// The gap strokes from the whole half-step boundary, skipping what provably lies `s/2` from
+/// ring `k + 1`.
+fn full_gaps(
+    q: &Region,
+    next: &Region,
+    reach: &NextRing,
+    s: f64,
+    tol_mm: f64,
+    out: &mut Vec<(Vec<Pt>, bool)>,
+) {
+    let at_half = ElemTable::new(next, q.frame.len_units(s / 2.0));
+    for (l, skip) in q.offset_flattened_marked(s / 2.0, tol_mm, |e| at_half.covers(e)) {
+        reach.far_runs(&l, true, Some(&skip), out);
     }
 }
 
@@ -194,428 +256,6 @@ fn store<T>(slots: &Slots<T>, k: usize, v: T) {
         }
         s[k] = Some(v);
     }
-}
-
-/// Segments of closed loops with a spatial index and their neighbours along the loops.
-struct SegIndex {
-    segs: Vec<(Pt, Pt)>,
-    /// Next and previous segment of the same loop.
-    next: Vec<u32>,
-    prev: Vec<u32>,
-    /// Built on first use (most segments are covered by their neighbours' hits).
-    index: OnceCell<Option<StaticAABB2DIndex<f64>>>,
-}
-
-impl SegIndex {
-    fn new(loops: &[Vec<Pt>]) -> Self {
-        let mut segs = Vec::new();
-        let (mut next, mut prev) = (Vec::new(), Vec::new());
-        for l in loops {
-            let (base, m) = (segs.len() as u32, l.len() as u32);
-            for i in 0..l.len() {
-                segs.push((l[i], l[(i + 1) % l.len()]));
-                let i = i as u32;
-                next.push(base + (i + 1) % m);
-                prev.push(base + (i + m - 1) % m);
-            }
-        }
-        Self {
-            index: OnceCell::new(),
-            segs,
-            next,
-            prev,
-        }
-    }
-
-    fn index(&self) -> Option<&StaticAABB2DIndex<f64>> {
-        self.index
-            .get_or_init(|| {
-                let mut b = StaticAABB2DIndexBuilder::new(self.segs.len());
-                for (a, q) in &self.segs {
-                    b.add(a.x.min(q.x), a.y.min(q.y), a.x.max(q.x), a.y.max(q.y));
-                }
-                b.build().ok()
-            })
-            .as_ref()
-    }
-
-    /// The parts of the segment `a`–`b` (parameter intervals in 0..=1) farther than `r` from
-    /// every indexed segment, into `sc.far`. `near` holds the segments that reached the previous
-    /// segment of the same loop: along parallel loops they and the next ones usually cover this
-    /// one too, which saves the index query; they are tried first, then their neighbours, then
-    /// the index.
-    fn far_parts(&self, a: Pt, b: Pt, r: f64, near: &mut Vec<u32>, sc: &mut Scratch) {
-        let Scratch {
-            tried,
-            hit,
-            buf,
-            far,
-        } = sc;
-        tried.clear();
-        hit.clear();
-        buf.clear();
-        let mut try_seg = |t: u32, buf: &mut Vec<(f64, f64)>| {
-            if tried.contains(&t) {
-                return;
-            }
-            tried.push(t);
-            let (q0, q1) = self.segs[t as usize];
-            if let Some(iv) = capsule_interval(a, b, q0, q1, r) {
-                buf.push(iv);
-                hit.push(t);
-            }
-        };
-        // 1. the previous hits and the segment after the last of them
-        for &c in near.iter() {
-            try_seg(c, buf);
-        }
-        if let Some(&c) = near.last() {
-            try_seg(self.next[c as usize], buf);
-        }
-        gaps_of(buf, far);
-        // 2. their neighbours on both sides
-        if !far.is_empty() && !near.is_empty() {
-            for &c in near.iter() {
-                try_seg(self.prev[c as usize], buf);
-                try_seg(self.next[c as usize], buf);
-            }
-            gaps_of(buf, far);
-        }
-        // 3. the index
-        if !far.is_empty() {
-            if let Some(index) = self.index() {
-                for i in index.query_iter(
-                    a.x.min(b.x) - r,
-                    a.y.min(b.y) - r,
-                    a.x.max(b.x) + r,
-                    a.y.max(b.y) + r,
-                ) {
-                    try_seg(i as u32, buf);
-                }
-            }
-            gaps_of(buf, far);
-        }
-        let len = a.dist2(b).sqrt();
-        far.retain(|(lo, hi)| (hi - lo) * len > 1e-9);
-        near.clear();
-        near.extend_from_slice(hit);
-    }
-}
-
-/// Scratch space of [`SegIndex::far_parts`], reused from segment to segment.
-#[derive(Default)]
-struct Scratch {
-    /// Segments tried for the current segment.
-    tried: Vec<u32>,
-    /// Those within reach.
-    hit: Vec<u32>,
-    /// Their parameter intervals.
-    buf: Vec<(f64, f64)>,
-    /// The result: parameter intervals farther than `r` from every segment.
-    far: Vec<(f64, f64)>,
-}
-
-/// The complement in 0..=1 of the union of `cover` (sorted here), into `far`.
-fn gaps_of(cover: &mut [(f64, f64)], far: &mut Vec<(f64, f64)>) {
-    far.clear();
-    cover.sort_by(|x, y| x.0.total_cmp(&y.0));
-    let mut t = 0.0;
-    for &(lo, hi) in cover.iter() {
-        if lo > t {
-            far.push((t, lo));
-        }
-        t = t.max(hi);
-    }
-    if t < 1.0 {
-        far.push((t, 1.0));
-    }
-}
-
-/// The parameter interval (clipped to 0..=1) of the segment `a`–`b` within `r` of the segment
-/// `q0`–`q1` (a capsule, convex, so the set is one interval).
-fn capsule_interval(a: Pt, b: Pt, q0: Pt, q1: Pt, r: f64) -> Option<(f64, f64)> {
-    let e = b.minus(a);
-    let ee = e.dot(e);
-    if ee <= 0.0 {
-        return None;
-    }
-    let mut lo = f64::INFINITY;
-    let mut hi = f64::NEG_INFINITY;
-    // the end discs
-    for c in [q0, q1] {
-        let w = a.minus(c);
-        let (bq, cq) = (e.dot(w), w.dot(w) - r * r);
-        let disc = bq * bq - ee * cq;
-        if disc >= 0.0 {
-            let sq = disc.sqrt();
-            lo = lo.min((-bq - sq) / ee);
-            hi = hi.max((-bq + sq) / ee);
-        }
-    }
-    // the rectangle: 0 ≤ (p − q0)·d ≤ L and |(p − q0)·n| ≤ r, each linear in t
-    let dq = q1.minus(q0);
-    let l = dq.dot(dq).sqrt();
-    if l > 0.0 {
-        let d = dq.scale(1.0 / l);
-        let n = Pt::new(-d.y, d.x);
-        let w = a.minus(q0);
-        let mut t0 = f64::NEG_INFINITY;
-        let mut t1 = f64::INFINITY;
-        for (f0, f1, min, max) in [(w.dot(d), e.dot(d), 0.0, l), (w.dot(n), e.dot(n), -r, r)] {
-            if f1.abs() < 1e-300 {
-                if f0 < min || f0 > max {
-                    t0 = f64::INFINITY;
-                }
-            } else {
-                let (u, v) = ((min - f0) / f1, (max - f0) / f1);
-                t0 = t0.max(u.min(v));
-                t1 = t1.min(u.max(v));
-            }
-        }
-        if t0 <= t1 {
-            lo = lo.min(t0);
-            hi = hi.max(t1);
-        }
-    }
-    let (lo, hi) = (lo.max(0.0), hi.min(1.0));
-    (lo <= hi).then_some((lo, hi))
-}
-
-/// The boundary elements of ring `k + 1`, to recognise the elements of the half-step loop that
-/// lie exactly `s/2` from one of them: an arc concentric with an arc of ring `k + 1` at `s/2`
-/// radius difference and within its angular span, or a line segment parallel to one of ring
-/// `k + 1` at `s/2` and within its extent. Offsets move line segments parallel and keep the
-/// centres of arcs, so most of the half-step loop is recognised and skipped by the distance
-/// check; what is left are the corners and the parts that vanish in ring `k + 1`.
-struct ElemTable {
-    arcs: HashMap<(i64, i64), Vec<ArcGeom>>,
-    /// Line segments by (direction angle, signed distance of the line from the origin).
-    lines: HashMap<(i64, i64), Vec<LineKey>>,
-    /// `s/2` in frame units.
-    half_units: f64,
-}
-
-/// A line segment of ring `k + 1` as a key: direction angle, unit direction, signed distance of
-/// its line from the origin along the left normal, and its extent along the direction.
-#[derive(Debug, Clone, Copy)]
-struct LineKey {
-    angle: f64,
-    dist: f64,
-    lo: f64,
-    hi: f64,
-}
-
-impl LineKey {
-    fn of(a: Pt, b: Pt) -> Option<Self> {
-        let d = b.minus(a);
-        let len = d.dot(d).sqrt();
-        if len <= 0.0 {
-            return None;
-        }
-        let u = d.scale(1.0 / len);
-        let n = Pt::new(-u.y, u.x);
-        let (ta, tb) = (u.dot(a), u.dot(b));
-        Some(Self {
-            angle: u.y.atan2(u.x),
-            dist: n.dot(a),
-            lo: ta.min(tb),
-            hi: ta.max(tb),
-        })
-    }
-}
-
-/// Centres and line distances closer than this (frame units; one spacing is 64 units) are the
-/// same.
-const SAME_POS_UNITS: f64 = 1e-4;
-/// Radii or line distances that differ from `s/2` by less than this (frame units) are `s/2`
-/// apart.
-const SAME_DIST_UNITS: f64 = 1e-4;
-/// Directions closer than this (radians) are the same.
-const SAME_ANGLE: f64 = 1e-9;
-/// Slack at the element ends, as a fraction of `s/2` of length.
-const END_SLACK: f64 = 1e-3;
-/// Hash cells (much larger than the tolerances above, so a lookup usually probes one cell):
-/// arc centres, frame units.
-const ARC_CELL: f64 = 1.0;
-/// Line directions, radians.
-const LINE_CELL_ANGLE: f64 = 1e-6;
-/// Line distances from the origin, frame units.
-const LINE_CELL_DIST: f64 = 1.0;
-
-impl ElemTable {
-    fn new(next: &Region, half_units: f64) -> Self {
-        let mut arcs: HashMap<(i64, i64), Vec<ArcGeom>> = HashMap::default();
-        let mut lines: HashMap<(i64, i64), Vec<LineKey>> = HashMap::default();
-        for e in next.elems() {
-            match e {
-                Elem::Arc(a) => arcs.entry(Self::arc_cell(a.center)).or_default().push(a),
-                Elem::Line(a, b) => {
-                    if let Some(k) = LineKey::of(a, b) {
-                        lines
-                            .entry(Self::line_cell(k.angle, k.dist))
-                            .or_default()
-                            .push(k);
-                    }
-                }
-            }
-        }
-        Self {
-            arcs,
-            lines,
-            half_units,
-        }
-    }
-
-    fn arc_cell(c: Pt) -> (i64, i64) {
-        (
-            (c.x / ARC_CELL).floor() as i64,
-            (c.y / ARC_CELL).floor() as i64,
-        )
-    }
-
-    fn line_cell(angle: f64, dist: f64) -> (i64, i64) {
-        (
-            (angle / LINE_CELL_ANGLE).floor() as i64,
-            (dist / LINE_CELL_DIST).floor() as i64,
-        )
-    }
-
-    /// True when `e` (an element of the half-step loop) lies exactly `s/2` from ring `k + 1`.
-    fn covers(&self, e: &Elem) -> bool {
-        match e {
-            Elem::Arc(a) => {
-                let (c, t) = (a.center, SAME_POS_UNITS);
-                cells(
-                    Self::arc_cell(Pt::new(c.x - t, c.y - t)),
-                    Self::arc_cell(Pt::new(c.x + t, c.y + t)),
-                )
-                .any(|k| {
-                    self.arcs
-                        .get(&k)
-                        .is_some_and(|l| l.iter().any(|b| self.arc_covers(b, a)))
-                })
-            }
-            Elem::Line(p, q) => {
-                let Some(h) = LineKey::of(*p, *q) else {
-                    return true;
-                };
-                // the matching line of ring k + 1 lies s/2 further to the left
-                let d = h.dist + self.half_units;
-                let (ta, td) = (SAME_ANGLE, SAME_DIST_UNITS);
-                cells(
-                    Self::line_cell(h.angle - ta, d - td),
-                    Self::line_cell(h.angle + ta, d + td),
-                )
-                .any(|k| {
-                    self.lines
-                        .get(&k)
-                        .is_some_and(|l| l.iter().any(|b| self.line_covers(b, &h)))
-                })
-            }
-        }
-    }
-
-    fn line_covers(&self, b: &LineKey, h: &LineKey) -> bool {
-        let slack = END_SLACK * self.half_units;
-        (b.angle - h.angle).abs() <= SAME_ANGLE
-            && (b.dist - h.dist - self.half_units).abs() <= SAME_DIST_UNITS
-            && h.lo >= b.lo - slack
-            && h.hi <= b.hi + slack
-    }
-
-    fn arc_covers(&self, b: &ArcGeom, a: &ArcGeom) -> bool {
-        if b.center.dist2(a.center) > SAME_POS_UNITS * SAME_POS_UNITS
-            || ((b.radius - a.radius).abs() - self.half_units).abs() > SAME_DIST_UNITS
-            || (a.sweep > 0.0) != (b.sweep > 0.0)
-        {
-            return false;
-        }
-        // both spans counter-clockwise: [start, start + len]
-        let span = |g: &ArcGeom| {
-            if g.sweep >= 0.0 {
-                (g.start, g.sweep)
-            } else {
-                (g.start + g.sweep, -g.sweep)
-            }
-        };
-        let ((a0, al), (b0, bl)) = (span(a), span(b));
-        let slack = END_SLACK * self.half_units / b.radius.max(a.radius);
-        let d = (a0 - b0 + slack).rem_euclid(std::f64::consts::TAU) - slack;
-        d + al <= bl + slack
-    }
-}
-
-/// The cells from `lo` to `hi` (inclusive; usually one).
-fn cells(lo: (i64, i64), hi: (i64, i64)) -> impl Iterator<Item = (i64, i64)> {
-    (lo.0..=hi.0).flat_map(move |x| (lo.1..=hi.1).map(move |y| (x, y)))
-}
-
-/// The pieces of the half-step loops farther than `s/2` (plus the margin) from the next rings.
-///
-/// `half` holds the half-step loops with a flag per segment: flagged segments lie exactly `s/2`
-/// from ring `k + 1` (see [`ElemTable`]) and are not checked.
-fn gap_strokes(
-    half: &[(Vec<Pt>, Vec<bool>)],
-    next: &[Vec<Pt>],
-    spacing: f64,
-) -> Vec<(Vec<Pt>, bool)> {
-    let index = SegIndex::new(next);
-    let r = spacing / 2.0 * (1.0 + GAP_MARGIN);
-    let mut out = Vec::new();
-    let mut near: Vec<u32> = Vec::new();
-    let mut sc = Scratch::default();
-    for (l, covered) in half {
-        let m = l.len();
-        // polylines of far parts; `open` says whether the last one reaches its edge's end
-        let mut runs: Vec<Vec<Pt>> = Vec::new();
-        let mut open = false;
-        let mut first_from_start = false;
-        let mut all_far = true;
-        for i in 0..m {
-            let (a, b) = (l[i], l[(i + 1) % m]);
-            if covered.get(i).copied().unwrap_or(false) {
-                sc.far.clear();
-                near.clear();
-            } else {
-                index.far_parts(a, b, r, &mut near, &mut sc);
-            }
-            let parts = &sc.far;
-            if !(parts.len() == 1 && parts[0].0 == 0.0 && parts[0].1 == 1.0) {
-                all_far = false;
-            }
-            // a part from the edge's start continues the run that reached the edge's end
-            let mut joins = open;
-            open = false;
-            for &(lo, hi) in parts {
-                let p = a.plus(b.minus(a).scale(lo));
-                let q = a.plus(b.minus(a).scale(hi));
-                match runs.last_mut() {
-                    Some(run) if joins && lo == 0.0 => run.push(q),
-                    _ => {
-                        if i == 0 && lo == 0.0 {
-                            first_from_start = true;
-                        }
-                        runs.push(vec![p, q]);
-                    }
-                }
-                joins = false;
-                open = hi == 1.0;
-            }
-        }
-        if all_far {
-            out.push((l.clone(), true));
-            continue;
-        }
-        // the last run reaches the loop's start and the first run starts there: one run
-        if open && first_from_start && runs.len() > 1 {
-            let first = runs.remove(0);
-            if let Some(last) = runs.last_mut() {
-                last.extend(first.into_iter().skip(1));
-            }
-        }
-        out.extend(runs.into_iter().map(|r| (r, false)));
-    }
-    out
 }
 
 #[cfg(test)]
@@ -670,5 +310,98 @@ mod tests {
         // radii 5.3, 4.3, .., 0.3: six rings
         assert_eq!(levels.len(), 6);
         assert!(levels.iter().all(|l| l.gaps.is_empty()));
+    }
+
+    /// Every point of each stroke set within `tol` of the other set, and equal total lengths.
+    fn assert_same_strokes(a: &[(Vec<Pt>, bool)], b: &[(Vec<Pt>, bool)], tol: f64, what: &str) {
+        let segs = |v: &[(Vec<Pt>, bool)]| -> Vec<(Pt, Pt)> {
+            let mut out = Vec::new();
+            for (l, closed) in v {
+                let m = l.len();
+                let n = if *closed { m } else { m.saturating_sub(1) };
+                out.extend((0..n).map(|i| (l[i], l[(i + 1) % m])));
+            }
+            out
+        };
+        let len =
+            |v: &[(Vec<Pt>, bool)]| -> f64 { v.iter().map(|(l, c)| polyline_length(l, *c)).sum() };
+        let (sa, sb) = (segs(a), segs(b));
+        for (from, to, name) in [(&sa, &sb, "local"), (&sb, &sa, "full")] {
+            for &(p, q) in from.iter() {
+                for k in 0..=4 {
+                    let x = p.plus(q.minus(p).scale(k as f64 / 4.0));
+                    let d = to
+                        .iter()
+                        .map(|&(u, v)| crate::geom::point_segment_dist(x, u, v))
+                        .fold(f64::INFINITY, f64::min);
+                    assert!(
+                        d <= tol,
+                        "{what}: {name} gap point {x:?} is {d} from the other set"
+                    );
+                }
+            }
+        }
+        let (la, lb) = (len(a), len(b));
+        assert!(
+            (la - lb).abs() <= 0.02 * la.max(lb) + 2.0 * tol,
+            "{what}: lengths {la} vs {lb}"
+        );
+    }
+
+    /// Gaps from the half-step boundary near the spots (forced even where the whole level would
+    /// be cheaper) are the gaps from the whole half-step boundary, level by level.
+    #[test]
+    fn gaps_near_spots_equal_gaps_from_the_whole_half_step() {
+        let mut shapes: Vec<(String, Vec<Vec<Pt>>, f64)> = Vec::new();
+        for (file, s) in [
+            ("tests/data/hatch/attachment1_graph1.csv", 0.7),
+            ("tests/data/hatch/attachment2_graph2.csv", 0.4),
+        ] {
+            let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(file);
+            let c = crate::hatch::bench::read_contours(&path).unwrap();
+            shapes.push((file.into(), c, s));
+        }
+        // a star with a star hole and a square hole
+        let star = |c: Pt, r: &[f64], rot: f64| -> Vec<Pt> {
+            (0..r.len())
+                .map(|i| {
+                    let a = rot + i as f64 / r.len() as f64 * std::f64::consts::TAU;
+                    Pt::new(c.x + r[i] * a.cos(), c.y + r[i] * a.sin())
+                })
+                .collect()
+        };
+        let outer = star(
+            Pt::new(0.0, 0.0),
+            &[9.0, 5.0, 8.0, 4.5, 10.0, 6.0, 7.5, 3.5],
+            0.3,
+        );
+        let hole = star(Pt::new(1.0, 0.5), &[2.0, 1.0, 2.5, 1.2, 1.8], 0.1);
+        let sq = vec![
+            Pt::new(-3.0, -3.0),
+            Pt::new(-1.5, -3.0),
+            Pt::new(-1.5, -1.5),
+            Pt::new(-3.0, -1.5),
+        ];
+        shapes.push(("stars".into(), vec![outer, hole, sq], 0.3));
+        for (name, c, s) in shapes {
+            let loops = resolve(&c, FillRule::EvenOdd);
+            let tol = s * 1e-3;
+            let mut q = Region::new(&loops, Frame::new(&loops, s)).offset(s);
+            let mut level = 0;
+            while !q.is_empty() {
+                let n = q.offset(s);
+                let (rk, rn) = (q.flatten(tol), n.flatten(tol));
+                if n.is_empty() || rn.is_empty() {
+                    break;
+                }
+                let local = level_gaps(&q, &n, &rk, &rn, s, tol, f64::INFINITY);
+                let mut full = Vec::new();
+                full_gaps(&q, &n, &NextRing::new(&rn, s), s, tol, &mut full);
+                assert_same_strokes(&local, &full, 0.02 * s, &format!("{name} level {level}"));
+                q = n;
+                level += 1;
+            }
+            assert!(level >= 3, "{name}: only {level} levels");
+        }
     }
 }

@@ -25,9 +25,12 @@ mod boundary;
 mod contour;
 mod cut;
 mod document;
+mod elems;
+mod gaps;
 mod region;
 mod scan;
 mod settings;
+mod spots;
 mod zigzag;
 
 pub use document::{hatch_geometries, is_hatch_output, HatchedGeometries, HATCH_LAYER_PREFIX};

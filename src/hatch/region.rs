@@ -96,7 +96,8 @@ impl Frame {
             (p.y - self.origin.y) * self.k,
         )
     }
-    fn mm_of(self, x: f64, y: f64) -> Pt {
+    /// Units → mm for a point.
+    pub(crate) fn mm_of(self, x: f64, y: f64) -> Pt {
         Pt::new(x / self.k + self.origin.x, y / self.k + self.origin.y)
     }
 }
@@ -170,6 +171,17 @@ impl Region {
             .filter(|p| p.vertex_count() >= 2 && p.area().abs() > min_area())
             .map(|pl| flatten_pline_marked(pl, tol, &self.frame, &covered))
             .filter(|(l, _)| l.len() >= 2)
+            .collect()
+    }
+    /// The elements of each boundary loop in order, in frame units.
+    pub(crate) fn loop_elems(&self) -> Vec<Vec<Elem>> {
+        self.plines()
+            .map(|pl| {
+                let n = pl.vertex_count();
+                (0..n)
+                    .map(|i| Elem::of(pl.at(i), pl.at((i + 1) % n)))
+                    .collect()
+            })
             .collect()
     }
     /// The elements (line segments and arcs) of the boundary, in frame units.
