@@ -30,10 +30,13 @@ pub(crate) struct Level {
 
 /// Rings and gaps of `region` offset inward by `edge_mm`, `spacing` apart.
 ///
-/// Two chains of offsets run side by side, `Q_0 → Q_2 → Q_4 …` and `Q_1 → Q_3 → …` (steps of
-/// `2s`: erosions by discs compose, so `Q_{k+2} = Q_k ⊖ 2s`; `Q_0` and `Q_1` are both offsets of
-/// `region` itself), which halves the longest chain of dependent offsets; as soon as `Q_k` and
-/// `Q_{k+1}` exist a task finds the gaps of level `k` (flattening the rings it needs once).
+/// The offsets leapfrog in pairs: `Q_0` and `Q_1` are both offsets of `region` itself, then
+/// each pair `Q_{2j}, Q_{2j+1}` comes from the deepest region known, `Q_{2j-1}`, offset by `s`
+/// and `2s` side by side (erosions by discs compose, `Q_{k+m} = Q_k ⊖ m·s`). That halves the
+/// longest chain of dependent offsets, and every offset starts from the smallest region at hand
+/// (fewer vertices, and cavalier_contours' validation queries grow with the offset distance).
+/// As soon as `Q_k` and `Q_{k+1}` exist a task finds the gaps of level `k` (flattening the rings
+/// it needs once).
 pub(crate) fn contour_levels(
     region: &Region,
     edge_mm: f64,
@@ -60,17 +63,13 @@ pub(crate) fn contour_levels(
             let q1 = region.offset(edge_mm + spacing);
             let q1 = (!q1.is_empty()).then(|| Arc::new(q1));
             if let Some(q1) = st.publish(sc, 1, q1) {
-                st.chain(sc, 1, q1, ctx);
+                st.leapfrog(sc, q1, ctx);
             }
         });
         let q0 = region.offset(edge_mm);
         let q0 = (!q0.is_empty()).then(|| Arc::new(q0));
         if let Some(q0) = st.publish(sc, 0, q0) {
-            let level0 = q0.clone();
-            sc.spawn(move |_| {
-                st.ring(0, &level0);
-            });
-            st.chain(sc, 0, q0, ctx);
+            st.ring(0, &q0);
         }
     });
     if st.cancelled.load(Ordering::Relaxed) {
@@ -117,8 +116,10 @@ struct LevelState {
 }
 
 impl LevelState {
-    /// Offsets by `2s` from `q` (level `k`) while the regions last.
-    fn chain<'s>(&'s self, sc: &rayon::Scope<'s>, mut k: usize, mut q: Arc<Region>, ctx: &JobCtx) {
+    /// From `q = Q_1`: `Q_{2j} = Q_{2j-1} ⊖ s` and `Q_{2j+1} = Q_{2j-1} ⊖ 2s` side by side (the
+    /// latter is the base of the next pair) while the regions last.
+    fn leapfrog<'s>(&'s self, sc: &rayon::Scope<'s>, mut q: Arc<Region>, ctx: &JobCtx) {
+        let mut k = 1;
         loop {
             if ctx.check().is_err() {
                 self.cancelled.store(true, Ordering::Relaxed);
@@ -127,14 +128,18 @@ impl LevelState {
             if self.cancelled.load(Ordering::Relaxed) {
                 return;
             }
-            k += 2;
-            let next = if k >= self.first_empty.load(Ordering::Relaxed) {
-                None
-            } else {
-                let n = q.offset(2.0 * self.spacing);
-                (!n.is_empty()).then(|| Arc::new(n))
+            let first_empty = self.first_empty.load(Ordering::Relaxed);
+            let offset = |m: f64, level: usize| {
+                (level < first_empty)
+                    .then(|| q.offset(m * self.spacing))
+                    .filter(|n| !n.is_empty())
+                    .map(Arc::new)
             };
-            match self.publish(sc, k, next) {
+            // both offsets of the pair before the level tasks they unlock
+            let (even, odd) = rayon::join(|| offset(1.0, k + 1), || offset(2.0, k + 2));
+            self.publish(sc, k + 1, even);
+            k += 2;
+            match self.publish(sc, k, odd) {
                 Some(n) => q = n,
                 None => return,
             }
