@@ -22,6 +22,7 @@
 
 pub mod bench;
 mod boundary;
+mod clip;
 mod contour;
 mod cut;
 mod document;

@@ -96,6 +96,17 @@ impl Frame {
             (p.y - self.origin.y) * self.k,
         )
     }
+    /// mm → units for a box.
+    pub(crate) fn box_units(self, b: &crate::geom::BBox) -> crate::geom::BBox {
+        let (min_x, min_y) = self.units_of(Pt::new(b.min_x, b.min_y));
+        let (max_x, max_y) = self.units_of(Pt::new(b.max_x, b.max_y));
+        crate::geom::BBox {
+            min_x,
+            min_y,
+            max_x,
+            max_y,
+        }
+    }
     /// Units → mm for a point.
     pub(crate) fn mm_of(self, x: f64, y: f64) -> Pt {
         Pt::new(x / self.k + self.origin.x, y / self.k + self.origin.y)
@@ -122,6 +133,13 @@ impl Region {
         });
         Self {
             shape: clean(plines, MIN_INPUT_AREA_SPACING2),
+            frame,
+        }
+    }
+    /// The region bounded by closed polylines in frame units (region on their left).
+    pub(crate) fn from_plines(plines: Vec<Polyline<f64>>, frame: Frame) -> Self {
+        Self {
+            shape: clean(plines.into_iter(), MIN_INPUT_AREA_SPACING2),
             frame,
         }
     }
@@ -302,9 +320,26 @@ pub(crate) enum Elem {
     Arc(ArcGeom),
 }
 
+impl ArcGeom {
+    /// The point of the arc's circle at angle `ang`.
+    pub(crate) fn point(&self, ang: f64) -> Pt {
+        Pt::new(
+            self.center.x + self.radius * ang.cos(),
+            self.center.y + self.radius * ang.sin(),
+        )
+    }
+}
+
 impl Elem {
+    /// The point at parameter `t` (0 at the start, 1 at the end; arcs: linear in angle).
+    pub(crate) fn at(&self, t: f64) -> Pt {
+        match self {
+            Elem::Line(a, b) => a.plus(b.minus(*a).scale(t)),
+            Elem::Arc(g) => g.point(g.start + t * g.sweep),
+        }
+    }
     /// The element from `v1` to `v2` (a degenerate arc counts as its chord).
-    fn of(v1: PlineVertex<f64>, v2: PlineVertex<f64>) -> Self {
+    pub(crate) fn of(v1: PlineVertex<f64>, v2: PlineVertex<f64>) -> Self {
         let line = Elem::Line(Pt::new(v1.x, v1.y), Pt::new(v2.x, v2.y));
         if v1.bulge.abs() < 1e-12 {
             return line;

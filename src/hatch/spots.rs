@@ -12,8 +12,9 @@
 //! because the box edges are farther than `s/2` from `B'`. That small offset replaces the offset
 //! of the whole level.
 
+use super::clip::clip_region;
 use super::elems::ElemTable;
-use super::region::{resolve, ArcGeom, Elem, Region};
+use super::region::{resolve, Elem, Region};
 use super::settings::FillRule;
 use crate::geom::{BBox, Pt};
 
@@ -71,22 +72,30 @@ pub(crate) fn half_step_near_spots(
     let mut out = Vec::new();
     for inner in boxes {
         let clip = grown(inner, clip_grow);
-        let pieces: Vec<Vec<Pt>> = ring_k
-            .iter()
-            .filter(|l| overlaps(&BBox::of(l), &clip))
-            .map(|l| clip_loop(l, &clip))
-            .filter(|l| l.len() >= 3)
-            .collect();
-        let loops = resolve(&pieces, FillRule::NonZero);
-        if loops.is_empty() {
+        let local = match clip_region(q, &q.frame.box_units(&clip)) {
+            Some(loops) => Region::from_plines(loops, q.frame),
+            None => polygon_clip(q, ring_k, &clip),
+        };
+        if local.is_empty() {
             continue;
         }
-        let local = Region::new(&loops, q.frame);
         for l in local.offset(spacing / 2.0).flatten(tol_mm) {
             clip_polyline(&l, &inner, &mut out);
         }
     }
     Some(out)
+}
+
+/// `Q_k ∩ clip` from the flattened ring `k` (Sutherland–Hodgman and a fill-rule resolution): the
+/// fallback when the exact clip fails.
+fn polygon_clip(q: &Region, ring_k: &[Vec<Pt>], clip: &BBox) -> Region {
+    let pieces: Vec<Vec<Pt>> = ring_k
+        .iter()
+        .filter(|l| overlaps(&BBox::of(l), clip))
+        .map(|l| clip_loop(l, clip))
+        .filter(|l| l.len() >= 3)
+        .collect();
+    Region::new(&resolve(&pieces, FillRule::NonZero), q.frame)
 }
 
 /// Bounding boxes (frame units) of the spots of `q`: the parts of its boundary that ring
@@ -176,31 +185,16 @@ fn turn(a: &Elem, b: &Elem) -> f64 {
     (t1.x * t2.y - t1.y * t2.x).atan2(t1.dot(t2))
 }
 
-/// The point of `e` at parameter `t`.
-fn point_at(e: &Elem, t: f64) -> Pt {
-    match e {
-        Elem::Line(a, b) => a.plus(b.minus(*a).scale(t)),
-        Elem::Arc(g) => arc_point(g, g.start + t * g.sweep),
-    }
-}
-
-fn arc_point(g: &ArcGeom, ang: f64) -> Pt {
-    Pt::new(
-        g.center.x + g.radius * ang.cos(),
-        g.center.y + g.radius * ang.sin(),
-    )
-}
-
 /// Bounding box of the piece `t0..t1` of `e` (arcs: the ends and the axis extremes between).
 fn piece_box(e: &Elem, t0: f64, t1: f64) -> BBox {
-    let mut b = BBox::of(&[point_at(e, t0), point_at(e, t1)]);
+    let mut b = BBox::of(&[e.at(t0), e.at(t1)]);
     if let Elem::Arc(g) = e {
         let (a0, a1) = (g.start + t0 * g.sweep, g.start + t1 * g.sweep);
         let (lo, hi) = (a0.min(a1), a0.max(a1));
         let quarter = std::f64::consts::FRAC_PI_2;
         let mut k = (lo / quarter).ceil();
         while k * quarter <= hi {
-            b.extend(arc_point(g, k * quarter));
+            b.extend(g.point(k * quarter));
             k += 1.0;
         }
     }
