@@ -232,6 +232,36 @@ impl Region {
     }
 }
 
+/// The inward offset by `mm` of the region bounded by one counter-clockwise loop `pl` (frame
+/// units), flattened like [`Region::flatten`]: [`Region::offset`] without the shape and the
+/// spatial indexes of its result.
+pub(crate) fn offset_loop_flattened(
+    pl: Polyline<f64>,
+    mm: f64,
+    tol_mm: f64,
+    frame: Frame,
+) -> Vec<Vec<Pt>> {
+    let input_min = MIN_INPUT_AREA_SPACING2 * UNITS_PER_SPACING * UNITS_PER_SPACING;
+    if pl.vertex_count() < 2 || pl.area() <= input_min {
+        return Vec::new();
+    }
+    let pl = if pl.area() > TIDY_MIN_AREA_UNITS2 {
+        pl.remove_redundant(SAME_POS_UNITS).unwrap_or(pl)
+    } else {
+        pl
+    };
+    if pl.vertex_count() < 2 || pl.area() <= input_min {
+        return Vec::new();
+    }
+    let tol = frame.len_units(tol_mm);
+    pl.parallel_offset(frame.len_units(mm))
+        .iter()
+        .filter(|p| p.vertex_count() >= 2 && p.area() > min_area())
+        .map(|p| flatten_pline(p, tol, &frame))
+        .filter(|l| l.len() >= 2)
+        .collect()
+}
+
 /// Offset loops with less area than this (units²) are debris.
 fn min_area() -> f64 {
     MIN_AREA_SPACING2 * UNITS_PER_SPACING * UNITS_PER_SPACING

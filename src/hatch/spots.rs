@@ -14,7 +14,7 @@
 
 use super::clip::clip_region;
 use super::elems::ElemTable;
-use super::region::{resolve, Elem, Region};
+use super::region::{offset_loop_flattened, resolve, Elem, Region};
 use super::settings::FillRule;
 use crate::geom::{BBox, Pt};
 
@@ -72,14 +72,20 @@ pub(crate) fn half_step_near_spots(
     let mut out = Vec::new();
     for inner in boxes {
         let clip = grown(inner, clip_grow);
-        let local = match clip_region(q, &q.frame.box_units(&clip)) {
-            Some(loops) => Region::from_plines(loops, q.frame),
-            None => polygon_clip(q, ring_k, &clip),
+        let half_step = match clip_region(q, &q.frame.box_units(&clip)) {
+            // one loop (the usual case): offset as a polyline, without a shape's indexes
+            Some(mut loops) if loops.len() == 1 => loops
+                .pop()
+                .map(|l| offset_loop_flattened(l, spacing / 2.0, tol_mm, q.frame))
+                .unwrap_or_default(),
+            Some(loops) => Region::from_plines(loops, q.frame)
+                .offset(spacing / 2.0)
+                .flatten(tol_mm),
+            None => polygon_clip(q, ring_k, &clip)
+                .offset(spacing / 2.0)
+                .flatten(tol_mm),
         };
-        if local.is_empty() {
-            continue;
-        }
-        for l in local.offset(spacing / 2.0).flatten(tol_mm) {
+        for l in half_step {
             clip_polyline(&l, &inner, &mut out);
         }
     }
