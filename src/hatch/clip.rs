@@ -62,7 +62,7 @@ fn clip_once(q: &Region, b: &BBox) -> Clip {
     let mut pieces: Vec<Piece> = Vec::new();
     let mut any_crossing = false;
     let all = q.shape.ccw_plines.iter().chain(q.shape.cw_plines.iter());
-    for ip in all {
+    for (ip, elems) in all.zip(q.loop_elems()) {
         let pl = &ip.polyline;
         let n = pl.vertex_count();
         let Some(lb) = ip.spatial_index.bounds() else {
@@ -90,7 +90,7 @@ fn clip_once(q: &Region, b: &BBox) -> Clip {
             loops.push(pl.clone());
             continue;
         }
-        match loop_pieces(pl, &idx, b) {
+        match loop_pieces(pl, elems, &idx, b) {
             Some(mut p) if !p.is_empty() => {
                 any_crossing = true;
                 pieces.append(&mut p);
@@ -256,7 +256,7 @@ fn perimeter_point(b: &BBox, u: f64) -> (f64, f64) {
 
 /// The inside pieces of loop `pl`, walking the elements `idx` (sorted; the others lie outside
 /// the box). `None` when the loop's pieces are inconsistent.
-fn loop_pieces(pl: &Polyline<f64>, idx: &[usize], b: &BBox) -> Option<Vec<Piece>> {
+fn loop_pieces(pl: &Polyline<f64>, elems: &[Elem], idx: &[usize], b: &BBox) -> Option<Vec<Piece>> {
     let n = pl.vertex_count();
     let mut cuts = Vec::new();
     // open piece: vertices so far, entry position (None: started at the walk's start while
@@ -274,8 +274,7 @@ fn loop_pieces(pl: &Polyline<f64>, idx: &[usize], b: &BBox) -> Option<Vec<Piece>
             }
         }
         prev = Some(i);
-        let (v1, v2) = (pl.at(i), pl.at((i + 1) % n));
-        let seg = Elem::of(v1, v2);
+        let seg = elems[i];
         box_cuts(&seg, b, &mut cuts);
         let mut t0 = 0.0;
         let ts: Vec<f64> = cuts.iter().copied().chain(std::iter::once(1.0)).collect();

@@ -220,16 +220,17 @@ fn level_gaps(
     tol_mm: f64,
     max_share: f64,
 ) -> Vec<(Vec<Pt>, bool)> {
-    let reach = NextRing::new(ring_next, s);
     let at_s = ElemTable::new(next, q.frame.len_units(s));
     let mut g = Vec::new();
     match half_step_near_spots(q, ring_k, &at_s, s, tol_mm, max_share) {
-        Some(pieces) => {
-            for (l, closed) in &pieces {
+        Some(h) => {
+            // only ring k + 1 near the boxes is ever within reach of their pieces
+            let reach = NextRing::near(ring_next, s, &h.boxes);
+            for (l, closed) in &h.pieces {
                 reach.far_runs(l, *closed, None, &mut g);
             }
         }
-        None => full_gaps(q, next, &reach, s, tol_mm, &mut g),
+        None => full_gaps(q, next, &NextRing::new(ring_next, s), s, tol_mm, &mut g),
     }
     g
 }

@@ -69,7 +69,7 @@ impl ElemTable {
     pub(crate) fn new(next: &Region, dist_units: f64) -> Self {
         let mut arcs: HashMap<(i64, i64), Vec<ArcGeom>> = HashMap::default();
         let mut lines: HashMap<(i64, i64), Vec<LineKey>> = HashMap::default();
-        for e in next.elems() {
+        for &e in next.loop_elems().iter().flatten() {
             match e {
                 Elem::Arc(a) => arcs.entry(Self::arc_cell(a.center)).or_default().push(a),
                 Elem::Line(a, b) => {

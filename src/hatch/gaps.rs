@@ -1,7 +1,7 @@
 //! Gap strokes of the contour-parallel fill: the pieces of a half-step boundary farther than
 //! `s/2` (plus a margin) from the next ring.
 
-use crate::geom::Pt;
+use crate::geom::{BBox, Pt};
 use cavalier_contours::static_aabb2d_index::{StaticAABB2DIndex, StaticAABB2DIndexBuilder};
 use std::cell::OnceCell;
 
@@ -22,6 +22,35 @@ impl NextRing {
         Self {
             index: SegIndex::new(rings),
             reach_mm: spacing / 2.0 * (1.0 + GAP_MARGIN),
+        }
+    }
+
+    /// Like [`Self::new`], keeping only the segments within reach of `boxes` (mm): for points
+    /// inside the boxes the answer is the same.
+    pub(crate) fn near(rings: &[Vec<Pt>], spacing: f64, boxes: &[BBox]) -> Self {
+        let reach_mm = spacing / 2.0 * (1.0 + GAP_MARGIN);
+        // (a little more than the reach: the test is on segment boxes)
+        let grow = 1.01 * reach_mm;
+        let grown: Vec<BBox> = boxes
+            .iter()
+            .map(|b| BBox {
+                min_x: b.min_x - grow,
+                min_y: b.min_y - grow,
+                max_x: b.max_x + grow,
+                max_y: b.max_y + grow,
+            })
+            .collect();
+        let near = |a: Pt, b: Pt| {
+            grown.iter().any(|g| {
+                a.x.max(b.x) >= g.min_x
+                    && a.x.min(b.x) <= g.max_x
+                    && a.y.max(b.y) >= g.min_y
+                    && a.y.min(b.y) <= g.max_y
+            })
+        };
+        Self {
+            index: SegIndex::filtered(rings, near),
+            reach_mm,
         }
     }
 
@@ -106,15 +135,32 @@ struct SegIndex {
 
 impl SegIndex {
     fn new(loops: &[Vec<Pt>]) -> Self {
+        Self::filtered(loops, |_, _| true)
+    }
+
+    /// The segments for which `keep` holds; neighbours along a loop are linked where both are
+    /// kept (else a segment is its own neighbour).
+    fn filtered(loops: &[Vec<Pt>], keep: impl Fn(Pt, Pt) -> bool) -> Self {
         let mut segs = Vec::new();
         let (mut next, mut prev) = (Vec::new(), Vec::new());
         for l in loops {
-            let (base, m) = (segs.len() as u32, l.len() as u32);
-            for i in 0..l.len() {
-                segs.push((l[i], l[(i + 1) % l.len()]));
-                let i = i as u32;
-                next.push(base + (i + 1) % m);
-                prev.push(base + (i + m - 1) % m);
+            let m = l.len();
+            // indexes of the kept segments of this loop, by loop position
+            let mut id: Vec<Option<u32>> = Vec::with_capacity(m);
+            for i in 0..m {
+                let (a, b) = (l[i], l[(i + 1) % m]);
+                if keep(a, b) {
+                    id.push(Some(segs.len() as u32));
+                    segs.push((a, b));
+                } else {
+                    id.push(None);
+                }
+            }
+            for i in 0..m {
+                if let Some(me) = id[i] {
+                    next.push(id[(i + 1) % m].unwrap_or(me));
+                    prev.push(id[(i + m - 1) % m].unwrap_or(me));
+                }
             }
         }
         Self {

@@ -14,6 +14,7 @@ use cavalier_contours::shape_algorithms::{IndexedPolyline, Shape, ShapeOffsetOpt
 use cavalier_contours::static_aabb2d_index::StaticAABB2DIndexBuilder;
 use i_overlay::core::fill_rule::FillRule as OverlayRule;
 use i_overlay::float::simplify::SimplifyShape;
+use std::sync::OnceLock;
 
 /// Scale of the offset frame: one hatch spacing is this many units.
 pub(crate) const UNITS_PER_SPACING: f64 = 64.0;
@@ -118,6 +119,9 @@ impl Frame {
 pub(crate) struct Region {
     pub(crate) shape: Shape<f64>,
     pub(crate) frame: Frame,
+    /// The boundary elements by loop, made on first use (a level's region is looked at as ring
+    /// `k` and as ring `k + 1`).
+    elems: OnceLock<Vec<Vec<Elem>>>,
 }
 
 impl Region {
@@ -131,17 +135,18 @@ impl Region {
             }
             p
         });
+        Self::of_shape(clean(plines, MIN_INPUT_AREA_SPACING2), frame)
+    }
+    fn of_shape(shape: Shape<f64>, frame: Frame) -> Self {
         Self {
-            shape: clean(plines, MIN_INPUT_AREA_SPACING2),
+            shape,
             frame,
+            elems: OnceLock::new(),
         }
     }
     /// The region bounded by closed polylines in frame units (region on their left).
     pub(crate) fn from_plines(plines: Vec<Polyline<f64>>, frame: Frame) -> Self {
-        Self {
-            shape: clean(plines.into_iter(), MIN_INPUT_AREA_SPACING2),
-            frame,
-        }
+        Self::of_shape(clean(plines.into_iter(), MIN_INPUT_AREA_SPACING2), frame)
     }
     /// True when nothing is left.
     pub(crate) fn is_empty(&self) -> bool {
@@ -150,20 +155,20 @@ impl Region {
     /// Inward offset by `mm` (erosion by a disc); arcs are exact.
     pub(crate) fn offset(&self, mm: f64) -> Region {
         if mm <= 0.0 || self.is_empty() {
-            return Region {
-                shape: clean(self.plines().cloned(), MIN_INPUT_AREA_SPACING2),
-                frame: self.frame,
-            };
+            return Region::of_shape(
+                clean(self.plines().cloned(), MIN_INPUT_AREA_SPACING2),
+                self.frame,
+            );
         }
         let opts = ShapeOffsetOptions::default();
         let out = self.shape.parallel_offset(self.frame.len_units(mm), &opts);
-        Region {
-            shape: clean_indexed(
+        Region::of_shape(
+            clean_indexed(
                 out.ccw_plines.into_iter().chain(out.cw_plines),
                 MIN_AREA_SPACING2,
             ),
-            frame: self.frame,
-        }
+            self.frame,
+        )
     }
     /// The loops of the inward offset by `mm`, flattened within `tol_mm` like [`Self::flatten`]
     /// (without building the offset's spatial indexes: for offsets that are only looked at),
@@ -191,27 +196,19 @@ impl Region {
             .filter(|(l, _)| l.len() >= 2)
             .collect()
     }
-    /// The elements of each boundary loop in order, in frame units.
-    pub(crate) fn loop_elems(&self) -> Vec<Vec<Elem>> {
-        self.plines()
-            .map(|pl| {
-                let n = pl.vertex_count();
-                (0..n)
-                    .map(|i| Elem::of(pl.at(i), pl.at((i + 1) % n)))
-                    .collect()
-            })
-            .collect()
-    }
-    /// The elements (line segments and arcs) of the boundary, in frame units.
-    pub(crate) fn elems(&self) -> Vec<Elem> {
-        let mut out = Vec::new();
-        for pl in self.plines() {
-            let n = pl.vertex_count();
-            for i in 0..n {
-                out.push(Elem::of(pl.at(i), pl.at((i + 1) % n)));
-            }
-        }
-        out
+    /// The elements of each boundary loop in order (counter-clockwise loops first, as in the
+    /// shape), in frame units.
+    pub(crate) fn loop_elems(&self) -> &[Vec<Elem>] {
+        self.elems.get_or_init(|| {
+            self.plines()
+                .map(|pl| {
+                    let n = pl.vertex_count();
+                    (0..n)
+                        .map(|i| Elem::of(pl.at(i), pl.at((i + 1) % n)))
+                        .collect()
+                })
+                .collect()
+        })
     }
     fn plines(&self) -> impl Iterator<Item = &Polyline<f64>> {
         self.shape

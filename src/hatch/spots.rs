@@ -30,7 +30,7 @@ pub(crate) const MAX_BOX_SHARE: f64 = 0.3;
 /// At most this many boxes per level; beyond, the whole level is offset.
 const MAX_BOXES: usize = 64;
 
-/// The pieces of `∂H_k` that can hold gaps, as (points in mm, closed), or `None` when the
+/// The pieces of `∂H_k` that can hold gaps, with their boxes, or `None` when the
 /// clip boxes cover more than `max_share` of the level's bounding box (offsetting all of `Q_k`
 /// is then cheaper; see [`MAX_BOX_SHARE`]).
 ///
@@ -43,11 +43,11 @@ pub(crate) fn half_step_near_spots(
     spacing: f64,
     tol_mm: f64,
     max_share: f64,
-) -> Option<Vec<(Vec<Pt>, bool)>> {
+) -> Option<HalfStepPieces> {
     let s_units = q.frame.len_units(spacing);
     let spots = spot_boxes(q, table, s_units);
     if spots.is_empty() {
-        return Some(Vec::new());
+        return Some(HalfStepPieces::default());
     }
     // boxes in mm
     let grow = spacing * (0.5 + SPOT_GROW_SPACING);
@@ -70,7 +70,7 @@ pub(crate) fn half_step_near_spots(
         return None;
     }
     let mut out = Vec::new();
-    for inner in boxes {
+    for &inner in &boxes {
         let clip = grown(inner, clip_grow);
         let half_step = match clip_region(q, &q.frame.box_units(&clip)) {
             // one loop (the usual case): offset as a polyline, without a shape's indexes
@@ -89,7 +89,15 @@ pub(crate) fn half_step_near_spots(
             clip_polyline(&l, &inner, &mut out);
         }
     }
-    Some(out)
+    Some(HalfStepPieces { pieces: out, boxes })
+}
+
+/// The pieces of `∂H_k` near the spots and the boxes (mm) they lie in.
+#[derive(Debug, Default)]
+pub(crate) struct HalfStepPieces {
+    /// (points in mm, closed).
+    pub(crate) pieces: Vec<(Vec<Pt>, bool)>,
+    pub(crate) boxes: Vec<BBox>,
 }
 
 /// `Q_k ∩ clip` from the flattened ring `k` (Sutherland–Hodgman and a fill-rule resolution): the
