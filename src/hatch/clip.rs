@@ -545,7 +545,12 @@ mod tests {
 
     proptest::proptest! {
         #![proptest_config(proptest::prelude::ProptestConfig {
-            cases: 256, failure_persistence: None, ..Default::default()
+            cases: std::env::var("HATCH_PROPTEST_CASES")
+                .ok()
+                .and_then(|v| v.parse().ok())
+                .unwrap_or(256),
+            failure_persistence: None,
+            ..Default::default()
         })]
         /// Random stars with star holes, offset (arcs at the reflex corners), clipped by random
         /// boxes: the exact clip never fails and has the polygon clip's area.
