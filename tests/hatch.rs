@@ -699,3 +699,26 @@ fn degenerate_offset_loop_does_not_panic() {
     let contours = vec![star(c, &outer, 0.0), hole_pts, star(c, &island, 0.2)];
     zigzag_checked(&contours, s, 0.5 * s, FillRule::NonZero);
 }
+
+/// A circle imported as a coarse polygon (bench instance rnd-82: r = 1.44 mm, 0.01 mm chord
+/// tolerance) under a 0.3 mm contour fill: its corners leave slivers a fraction of a percent
+/// beyond s/2, which once became hundreds of gap strokes of about 3 µm. Gap strokes are at
+/// least 0.02 s long, and the coverage still holds.
+#[test]
+fn coarse_polygon_circle_gets_no_micro_gap_strokes() {
+    for n in [24usize, 27, 30, 36, 48] {
+        let c: Vec<Pt> = (0..n)
+            .map(|i| {
+                let a = i as f64 / n as f64 * std::f64::consts::TAU;
+                Pt::new(206.218 + 1.44 * a.cos(), 75.898 + 1.44 * a.sin())
+            })
+            .collect();
+        let st = HatchSettings::new(HatchStyle::Contour, 0.3);
+        let h = hatch_contours(std::slice::from_ref(&c), &st, &JobCtx::default()).unwrap();
+        for g in h.strokes.iter().filter(|g| g.kind == StrokeKind::Gap) {
+            let l = galvoplan::geom::polyline_length(&g.points, g.closed);
+            assert!(l >= 0.02 * 0.3, "{n} corners: gap stroke of {l} mm");
+        }
+        check(&[c], &st, &h);
+    }
+}

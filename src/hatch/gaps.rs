@@ -1,12 +1,18 @@
 //! Gap strokes of the contour-parallel fill: the pieces of a half-step boundary farther than
 //! `s/2` (plus a margin) from the next ring.
 
-use crate::geom::{BBox, Pt};
+use crate::geom::{polyline_length, BBox, Pt};
 use cavalier_contours::static_aabb2d_index::{StaticAABB2DIndex, StaticAABB2DIndexBuilder};
 use std::cell::OnceCell;
 
 /// A boundary-of-`H_k` point counts as reached by ring `k + 1` within `s/2 · (1 + this)`.
 pub(crate) const GAP_MARGIN: f64 = 0.004;
+/// Gap strokes shorter than this many spacings are dropped. They mark slivers that reach less
+/// than about 0.6 % beyond `s/2` from the rings: a sharp corner of turn θ leaves a far piece of
+/// `s · (tan(θ/2) − 0.0895)` on the half-step boundary whose corner lies `s/2 · (1/cos(θ/2) − 1)`
+/// beyond `s/2`, and a closed piece of this perimeter has an inradius under `0.0032 s`. Such
+/// micro-strokes (a few µm) cost a jump and a laser switch each and say nothing at any spot size.
+pub(crate) const MIN_GAP_LEN_SPACING: f64 = 0.02;
 
 /// Ring `k + 1` of a level, flattened, as segments with a spatial index: what the half-step
 /// boundary is measured against.
@@ -14,6 +20,8 @@ pub(crate) struct NextRing {
     index: SegIndex,
     /// The reach `s/2 · (1 + GAP_MARGIN)`, mm.
     reach_mm: f64,
+    /// Shorter gap strokes are dropped, mm.
+    min_len_mm: f64,
 }
 
 impl NextRing {
@@ -22,6 +30,7 @@ impl NextRing {
         Self {
             index: SegIndex::new(rings),
             reach_mm: spacing / 2.0 * (1.0 + GAP_MARGIN),
+            min_len_mm: spacing * MIN_GAP_LEN_SPACING,
         }
     }
 
@@ -51,6 +60,7 @@ impl NextRing {
         Self {
             index: SegIndex::filtered(rings, near),
             reach_mm,
+            min_len_mm: spacing * MIN_GAP_LEN_SPACING,
         }
     }
 
@@ -109,7 +119,9 @@ impl NextRing {
             }
         }
         if all_far {
-            out.push((pts.to_vec(), closed));
+            if polyline_length(pts, closed) >= self.min_len_mm {
+                out.push((pts.to_vec(), closed));
+            }
             return;
         }
         // on a loop, the last run reaches the start and the first run starts there: one run
@@ -119,7 +131,11 @@ impl NextRing {
                 last.extend(first.into_iter().skip(1));
             }
         }
-        out.extend(runs.into_iter().map(|r| (r, false)));
+        out.extend(
+            runs.into_iter()
+                .filter(|r| polyline_length(r, false) >= self.min_len_mm)
+                .map(|r| (r, false)),
+        );
     }
 }
 
