@@ -176,6 +176,11 @@ fn check(contours: &[Vec<Pt>], settings: &HatchSettings, h: &RegionHatch) {
     let reference = Reference::new(contours, settings.fill_rule, s.max(0.05));
     let strokes: Vec<&HatchStroke> = h.strokes.iter().collect();
     assert!(!strokes.is_empty(), "no strokes");
+    // 0. no micro-strokes (a jump and a laser switch for nothing)
+    for st in &strokes {
+        let l = galvoplan::geom::polyline_length(&st.points, st.closed);
+        assert!(l >= 0.002 * s, "{:?} stroke of {l} mm", st.kind);
+    }
     // 1. nothing outside the offset region (1 µm)
     for st in &strokes {
         for p in samples(&st.points, st.closed, s / 4.0) {

@@ -46,6 +46,10 @@ use thiserror::Error;
 
 /// Arcs are flattened within this fraction of the spacing.
 const FLATTEN_TOL_SPACING: f64 = 1e-3;
+/// Strokes shorter than this many spacings are dropped: nothing is left unmarked by more than
+/// half of that, far inside the coverage tolerance, and the machine is spared a jump and a
+/// laser switch for a mark below any spot size (and below the G-code's resolution).
+const MIN_STROKE_SPACING: f64 = 2e-3;
 /// At most this many lines per family (or rings) per region.
 pub const MAX_LINES: usize = 1_000_000;
 
@@ -265,12 +269,14 @@ pub fn hatch_contours(
         out.stats.lines = scans
             .iter()
             .flat_map(|sc| sc.lines.iter().flatten().map(move |c| sc.ends(*c)))
-            .filter(|(p, q)| p.dist(*q) > 0.0)
+            .filter(|(p, q)| p.dist(*q) >= s * MIN_STROKE_SPACING && p.dist(*q) > 0.0)
             .count();
         out.offset_loops = flat;
     }
-    out.strokes
-        .retain(|st| st.points.len() >= 2 && st.length_mm() > 0.0);
+    // (a few µm or less: where a line ends next to a corner, a border piece of 0.01 µm is left)
+    out.strokes.retain(|st| {
+        st.points.len() >= 2 && st.length_mm() >= s * MIN_STROKE_SPACING && st.length_mm() > 0.0
+    });
     let st = &mut out.stats;
     for k in &out.strokes {
         let len = k.length_mm();
