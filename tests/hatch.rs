@@ -13,7 +13,7 @@
 mod common;
 
 use galvoplan::document::{MachineProfile, SolverSettings};
-use galvoplan::geom::{point_segment_dist, Pt};
+use galvoplan::geom::{point_segment_dist, star_polygon as star, Pt};
 use galvoplan::hatch::bench::read_contours;
 use galvoplan::hatch::{
     hatch_contours, FillRule, HatchSettings, HatchStroke, HatchStyle, OutlineMode, RegionHatch,
@@ -425,17 +425,6 @@ fn without_border_lines_leave_the_boundary_alone() {
     assert!(h.strokes.iter().all(|s| s.kind == StrokeKind::Zigzag));
     assert_eq!(h.stats.lines, 18);
     assert_eq!(h.stats.parts, 1);
-}
-
-/// A star-shaped polygon around `c` with radii in `[r0, r1]`.
-fn star(c: Pt, radii: &[f64], rot: f64) -> Vec<Pt> {
-    let n = radii.len();
-    (0..n)
-        .map(|i| {
-            let a = rot + i as f64 / n as f64 * std::f64::consts::TAU;
-            Pt::new(c.x + radii[i] * a.cos(), c.y + radii[i] * a.sin())
-        })
-        .collect()
 }
 
 prop_compose! {

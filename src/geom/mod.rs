@@ -156,6 +156,18 @@ impl BBox {
     }
 }
 
+/// A star-shaped closed polygon around `c`: vertex `i` of `radii.len()` at distance `radii[i]`,
+/// at angle `rot + i · 2π / n` (radians, counter-clockwise). Equal radii make a regular polygon.
+pub fn star_polygon(c: Pt, radii: &[f64], rot: f64) -> Vec<Pt> {
+    let n = radii.len();
+    (0..n)
+        .map(|i| {
+            let a = rot + i as f64 / n as f64 * std::f64::consts::TAU;
+            Pt::new(c.x + radii[i] * a.cos(), c.y + radii[i] * a.sin())
+        })
+        .collect()
+}
+
 /// Length of a polyline in mm; `closed` adds the segment back to the first point.
 pub fn polyline_length(points: &[Pt], closed: bool) -> f64 {
     let open: f64 = points.windows(2).map(|w| w[0].dist(w[1])).sum();

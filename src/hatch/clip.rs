@@ -90,7 +90,7 @@ fn clip_once(q: &Region, b: &BBox) -> Clip {
             loops.push(pl.clone());
             continue;
         }
-        match loop_pieces(pl, elems, &idx, b) {
+        match loop_pieces(elems, &idx, b) {
             Some(mut p) if !p.is_empty() => {
                 any_crossing = true;
                 pieces.append(&mut p);
@@ -254,10 +254,10 @@ fn perimeter_point(b: &BBox, u: f64) -> (f64, f64) {
     }
 }
 
-/// The inside pieces of loop `pl`, walking the elements `idx` (sorted; the others lie outside
+/// The inside pieces of a loop of elements `elems`, walking those in `idx` (sorted; the others lie outside
 /// the box). `None` when the loop's pieces are inconsistent.
-fn loop_pieces(pl: &Polyline<f64>, elems: &[Elem], idx: &[usize], b: &BBox) -> Option<Vec<Piece>> {
-    let n = pl.vertex_count();
+fn loop_pieces(elems: &[Elem], idx: &[usize], b: &BBox) -> Option<Vec<Piece>> {
+    let n = elems.len();
     let mut cuts = Vec::new();
     // open piece: vertices so far, entry position (None: started at the walk's start while
     // inside, to be joined with the walk's last piece)
@@ -277,8 +277,7 @@ fn loop_pieces(pl: &Polyline<f64>, elems: &[Elem], idx: &[usize], b: &BBox) -> O
         let seg = elems[i];
         box_cuts(&seg, b, &mut cuts);
         let mut t0 = 0.0;
-        let ts: Vec<f64> = cuts.iter().copied().chain(std::iter::once(1.0)).collect();
-        for t1 in ts {
+        for &t1 in cuts.iter().chain(std::iter::once(&1.0)) {
             let mid = seg.at(0.5 * (t0 + t1));
             let is_in = inside(b, mid);
             match (&mut cur, is_in) {
@@ -533,16 +532,6 @@ mod tests {
         }
     }
 
-    fn star(c: Pt, radii: &[f64], rot: f64) -> Vec<Pt> {
-        let n = radii.len();
-        (0..n)
-            .map(|i| {
-                let a = rot + i as f64 / n as f64 * std::f64::consts::TAU;
-                Pt::new(c.x + radii[i] * a.cos(), c.y + radii[i] * a.sin())
-            })
-            .collect()
-    }
-
     proptest::proptest! {
         #![proptest_config(proptest::prelude::ProptestConfig {
             cases: std::env::var("HATCH_PROPTEST_CASES")
@@ -564,9 +553,9 @@ mod tests {
             d in 0.0f64..2.0,
             (bx, by, bw, bh) in (-14.0f64..14.0, -14.0f64..14.0, 0.5f64..12.0, 0.5f64..12.0),
         ) {
-            let mut c = vec![star(Pt::new(0.0, 0.0), &outer, 0.0)];
+            let mut c = vec![crate::geom::star_polygon(Pt::new(0.0, 0.0), &outer, 0.0)];
             for ((x, y), r) in holes {
-                c.push(star(Pt::new(x, y), &r, 0.3));
+                c.push(crate::geom::star_polygon(Pt::new(x, y), &r, 0.3));
             }
             let loops = resolve(&c, FillRule::EvenOdd);
             let frame = Frame::new(&loops, 1.0);

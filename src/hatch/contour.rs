@@ -368,14 +368,7 @@ mod tests {
             shapes.push((file.into(), c, s));
         }
         // a star with a star hole and a square hole
-        let star = |c: Pt, r: &[f64], rot: f64| -> Vec<Pt> {
-            (0..r.len())
-                .map(|i| {
-                    let a = rot + i as f64 / r.len() as f64 * std::f64::consts::TAU;
-                    Pt::new(c.x + r[i] * a.cos(), c.y + r[i] * a.sin())
-                })
-                .collect()
-        };
+        let star = crate::geom::star_polygon;
         let outer = star(
             Pt::new(0.0, 0.0),
             &[9.0, 5.0, 8.0, 4.5, 10.0, 6.0, 7.5, 3.5],

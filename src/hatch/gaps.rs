@@ -27,8 +27,12 @@ pub(crate) struct NextRing {
 impl NextRing {
     /// Ring `k + 1` (closed loops, mm) for spacing `spacing` mm.
     pub(crate) fn new(rings: &[Vec<Pt>], spacing: f64) -> Self {
+        Self::of_index(SegIndex::new(rings), spacing)
+    }
+
+    fn of_index(index: SegIndex, spacing: f64) -> Self {
         Self {
-            index: SegIndex::new(rings),
+            index,
             reach_mm: spacing / 2.0 * (1.0 + GAP_MARGIN),
             min_len_mm: spacing * MIN_GAP_LEN_SPACING,
         }
@@ -37,9 +41,8 @@ impl NextRing {
     /// Like [`Self::new`], keeping only the segments within reach of `boxes` (mm): for points
     /// inside the boxes the answer is the same.
     pub(crate) fn near(rings: &[Vec<Pt>], spacing: f64, boxes: &[BBox]) -> Self {
-        let reach_mm = spacing / 2.0 * (1.0 + GAP_MARGIN);
         // (a little more than the reach: the test is on segment boxes)
-        let grow = 1.01 * reach_mm;
+        let grow = 1.01 * spacing / 2.0 * (1.0 + GAP_MARGIN);
         let grown: Vec<BBox> = boxes
             .iter()
             .map(|b| BBox {
@@ -57,11 +60,7 @@ impl NextRing {
                     && a.y.min(b.y) <= g.max_y
             })
         };
-        Self {
-            index: SegIndex::filtered(rings, near),
-            reach_mm,
-            min_len_mm: spacing * MIN_GAP_LEN_SPACING,
-        }
+        Self::of_index(SegIndex::filtered(rings, near), spacing)
     }
 
     /// The pieces of `pts` (a closed loop or an open polyline) farther than the reach from the

@@ -269,13 +269,15 @@ pub fn hatch_contours(
         out.stats.lines = scans
             .iter()
             .flat_map(|sc| sc.lines.iter().flatten().map(move |c| sc.ends(*c)))
-            .filter(|(p, q)| p.dist(*q) >= s * MIN_STROKE_SPACING && p.dist(*q) > 0.0)
+            .map(|(p, q)| p.dist(q))
+            .filter(|&len_mm| len_mm > 0.0 && len_mm >= s * MIN_STROKE_SPACING)
             .count();
         out.offset_loops = flat;
     }
     // (a few µm or less: where a line ends next to a corner, a border piece of 0.01 µm is left)
     out.strokes.retain(|st| {
-        st.points.len() >= 2 && st.length_mm() >= s * MIN_STROKE_SPACING && st.length_mm() > 0.0
+        let len_mm = st.length_mm();
+        st.points.len() >= 2 && len_mm > 0.0 && len_mm >= s * MIN_STROKE_SPACING
     });
     let st = &mut out.stats;
     for k in &out.strokes {

@@ -239,17 +239,11 @@ pub(crate) fn offset_loop_flattened(
     frame: Frame,
 ) -> Vec<Vec<Pt>> {
     let input_min = MIN_INPUT_AREA_SPACING2 * UNITS_PER_SPACING * UNITS_PER_SPACING;
-    if pl.vertex_count() < 2 || pl.area() <= input_min {
-        return Vec::new();
-    }
-    let pl = if pl.area() > TIDY_MIN_AREA_UNITS2 {
-        pl.remove_redundant(SAME_POS_UNITS).unwrap_or(pl)
-    } else {
-        pl
+    let pl = match tidied(&pl, input_min) {
+        Some((Some(q), area)) if area > 0.0 => q,
+        Some((None, area)) if area > 0.0 => pl,
+        _ => return Vec::new(),
     };
-    if pl.vertex_count() < 2 || pl.area() <= input_min {
-        return Vec::new();
-    }
     let tol = frame.len_units(tol_mm);
     pl.parallel_offset(frame.len_units(mm))
         .iter()
@@ -257,6 +251,26 @@ pub(crate) fn offset_loop_flattened(
         .map(|p| flatten_pline(p, tol, &frame))
         .filter(|l| l.len() >= 2)
         .collect()
+}
+
+/// A loop with its redundant vertices removed, as `(the new loop if any vertex went, signed
+/// area)`, or `None` when it has fewer than two vertices or no more than `min_area` (units²).
+fn tidied(pl: &Polyline<f64>, min_area: f64) -> Option<(Option<Polyline<f64>>, f64)> {
+    // (two vertices make a loop of two arcs, a circle)
+    if pl.vertex_count() < 2 || pl.area().abs() <= min_area {
+        return None;
+    }
+    // remove_redundant indexes past the end of loops that collapse to fewer than two vertices;
+    // only loops of some size are tidied (the offset removes repeated positions itself, so the
+    // others are used as they are)
+    let q = if pl.area().abs() > TIDY_MIN_AREA_UNITS2 {
+        pl.remove_redundant(SAME_POS_UNITS)
+    } else {
+        None
+    };
+    let kept = q.as_ref().unwrap_or(pl);
+    let area = kept.area();
+    (kept.vertex_count() >= 2 && area.abs() > min_area).then_some((q, area))
 }
 
 /// Offset loops with less area than this (units²) are debris.
@@ -279,28 +293,11 @@ fn clean_indexed(
     let min_area = min_area_spacing2 * UNITS_PER_SPACING * UNITS_PER_SPACING;
     let (mut ccw, mut cw) = (Vec::new(), Vec::new());
     for p in plines {
-        // (two vertices make a loop of two arcs, a circle)
-        if p.polyline.vertex_count() < 2 || p.polyline.area().abs() <= min_area {
-            continue;
-        }
-        // remove_redundant indexes past the end of loops that collapse to fewer than two
-        // vertices; only loops of some size are tidied (the offset removes repeated positions
-        // itself, so the others are used as they are)
-        let p = if p.polyline.area().abs() > TIDY_MIN_AREA_UNITS2 {
-            match p.polyline.remove_redundant(SAME_POS_UNITS) {
-                Some(q) => IndexedPolyline::new(q),
-                None => p,
-            }
-        } else {
-            p
+        let (p, area) = match tidied(&p.polyline, min_area) {
+            None => continue,
+            Some((None, area)) => (p, area),
+            Some((Some(q), area)) => (IndexedPolyline::new(q), area),
         };
-        if p.polyline.vertex_count() < 2 {
-            continue;
-        }
-        let area = p.polyline.area();
-        if area.abs() <= min_area {
-            continue;
-        }
         if area > 0.0 {
             ccw.push(p);
         } else {

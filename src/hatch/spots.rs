@@ -63,7 +63,10 @@ pub(crate) fn half_step_near_spots(
             })
             .collect(),
     );
-    let all = BBox::of(&ring_k.iter().flatten().copied().collect::<Vec<_>>());
+    let all = ring_k
+        .iter()
+        .map(|l| BBox::of(l))
+        .fold(BBox::EMPTY, BBox::union);
     let clip_grow = spacing * (0.5 + CLIP_GROW_SPACING);
     let area: f64 = boxes.iter().map(|b| grown(*b, clip_grow).area()).sum();
     if boxes.len() > MAX_BOXES || area > max_share * all.area() {
