@@ -133,13 +133,8 @@ pub fn run_instance(
             let (mut doc, import_s) = load_svg(path, profile.clone(), s.clone(), opts)?;
             let plan = plan_document(&mut doc, ctx)?;
             let t0 = Instant::now();
-            let g = write_gcode(
-                &doc.geometries,
-                &plan,
-                &doc.profile,
-                doc.page_mm[1],
-                "bench",
-            );
+            let toolpath = crate::pipeline::lower_plan(&doc, &plan)?;
+            let g = write_gcode(&toolpath, &plan, &doc.profile, doc.page_mm[1], "bench");
             let rep = report_json("bench", &plan, &doc.settings, &doc.warnings);
             std::hint::black_box((g.len(), rep.len()));
             let export_s = t0.elapsed().as_secs_f64();

@@ -21,6 +21,7 @@ pub mod geom;
 pub mod hatch;
 pub mod import;
 pub mod job;
+pub mod motion;
 pub mod order;
 pub mod pipeline;
 #[cfg(feature = "rerun")]

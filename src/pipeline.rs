@@ -5,6 +5,7 @@ use crate::fields::{place_fields, split_oversize, FieldError};
 use crate::hatch::{hatch_geometries, is_hatch_output, HatchError};
 use crate::import::{import_svg_file, ImportError, ImportOptions};
 use crate::job::JobCtx;
+use crate::motion::{lower, LowerError, Toolpath};
 use crate::order::{order_plan, OrderError};
 use std::path::Path;
 use std::time::Instant;
@@ -31,6 +32,14 @@ pub enum PipelineError {
         file: String,
         /// The cause.
         source: OrderError,
+    },
+    /// The plan could not be lowered to machine motion.
+    #[error("{file}: {source}")]
+    Lower {
+        /// The document's source file.
+        file: String,
+        /// The cause.
+        source: LowerError,
     },
     /// Hatching failed.
     #[error("{file}: {source}")]
@@ -158,4 +167,12 @@ pub fn order_document(doc: &Document, ctx: &JobCtx) -> Result<Plan, PipelineErro
         r.plan(&doc.geometries, &plan);
     }
     Ok(plan)
+}
+
+/// The machine motion of one of the document's plans ([`crate::motion::lower`]).
+pub fn lower_plan(doc: &Document, plan: &Plan) -> Result<Toolpath, PipelineError> {
+    lower(&doc.geometries, plan, &doc.profile).map_err(|source| PipelineError::Lower {
+        file: doc.source.clone().unwrap_or_else(|| "document".into()),
+        source,
+    })
 }

@@ -4,7 +4,7 @@
 
 mod common;
 
-use galvoplan::document::{Algo, Document, MachineProfile, SolverSettings};
+use galvoplan::document::{Algo, CostModel, Document, MachineProfile, SolverSettings};
 use galvoplan::job::{CancelToken, JobCtx, NoProgress};
 use galvoplan::pipeline::{load_svg, order_document, place_document_fields};
 use std::sync::Arc;
@@ -32,8 +32,24 @@ fn hga(seed: u64) -> SolverSettings {
 }
 
 #[test]
-fn hga_is_valid_deterministic_and_no_worse_than_hha() {
+fn hga_on_time_is_no_slower_than_hha() {
     let doc = demo(hga(3));
+    let a = order_document(&doc, &JobCtx::default()).unwrap();
+    common::check_plan(&doc, &a);
+    let mut hha_doc = doc.clone();
+    hha_doc.settings.algo = Algo::Hha;
+    let h = order_document(&hha_doc, &JobCtx::default()).unwrap();
+    let (ta, th) = (a.metrics.job_time_s.unwrap(), h.metrics.job_time_s.unwrap());
+    assert!(ta <= th + 1e-12, "HGA {ta} s vs HHA {th} s");
+}
+
+#[test]
+fn hga_is_valid_deterministic_and_no_worse_than_hha() {
+    // seed 000's objective: idle travel
+    let doc = demo(SolverSettings {
+        cost_model: CostModel::Distance,
+        ..hga(3)
+    });
     let a = order_document(&doc, &JobCtx::default()).unwrap();
     common::check_plan(&doc, &a);
     let b = order_document(&doc, &JobCtx::default()).unwrap();

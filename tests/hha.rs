@@ -29,11 +29,14 @@ fn brick_wall_rows(rows: usize) -> Document {
             x += 18.0;
         }
     }
-    Document {
+    let mut doc = Document {
         geometries,
         page_mm: [300.0, 300.0],
         ..Document::default()
-    }
+    };
+    // seed 000's objectives (idle travel, direction changes) are what these tests check
+    doc.settings.cost_model = galvoplan::document::CostModel::Distance;
+    doc
 }
 
 fn plan_wall(rows: usize, improve: bool) -> (Document, galvoplan::document::Plan) {

@@ -7,7 +7,7 @@ use galvoplan::document::{MachineProfile, SolverSettings};
 use galvoplan::export::{preview_svg, report_json, write_gcode};
 use galvoplan::import::ImportOptions;
 use galvoplan::job::JobCtx;
-use galvoplan::pipeline::{load_svg, plan_document};
+use galvoplan::pipeline::{load_svg, lower_plan, plan_document};
 
 fn run(
     name: &str,
@@ -37,7 +37,8 @@ fn demo_plans_and_checks() {
     assert!(m.idle_mm > 0.0 && m.base_mm > 0.0);
     assert!(m.overlap_pct >= 0.0 && m.overlap_pct < 100.0);
     // idle_mm equals the sum of the G-code's laser-off travel between strokes
-    let g = write_gcode(&doc.geometries, &plan, &doc.profile, doc.page_mm[1], "demo");
+    let toolpath = lower_plan(&doc, &plan).unwrap();
+    let g = write_gcode(&toolpath, &plan, &doc.profile, doc.page_mm[1], "demo");
     assert!(g.starts_with("; galvoplan"));
     assert!(g.contains("G21\nG90\n"));
     let report: serde_json::Value = serde_json::from_str(&report_json(
@@ -53,7 +54,7 @@ fn demo_plans_and_checks() {
     );
     assert!(report["metrics"]["idle_mm"].as_f64().unwrap() > 0.0);
     assert!(report["metrics"]["solve_s"]["total"].is_number());
-    let svg = preview_svg(&doc.geometries, &plan, doc.page_mm);
+    let svg = preview_svg(&toolpath, &plan, doc.page_mm);
     assert!(galvoplan::import::import_svg(
         svg.as_bytes(),
         "preview.svg",

@@ -102,21 +102,20 @@ impl ExportKind {
     }
 }
 
-/// The text of an export.
-pub fn export_text(doc: &Document, plan: &Plan, kind: ExportKind) -> String {
+/// The text of an export, from the plan's lowered toolpath.
+pub fn export_text(doc: &Document, plan: &Plan, kind: ExportKind) -> Result<String, String> {
     let source = doc.source.clone().unwrap_or_else(|| "document".into());
-    match kind {
-        ExportKind::Gcode => {
-            write_gcode(&doc.geometries, plan, &doc.profile, doc.page_mm[1], &source)
-        }
+    let toolpath = crate::pipeline::lower_plan(doc, plan).map_err(|e| e.to_string())?;
+    Ok(match kind {
+        ExportKind::Gcode => write_gcode(&toolpath, plan, &doc.profile, doc.page_mm[1], &source),
         ExportKind::Report => report_json(&source, plan, &doc.settings, &doc.warnings),
-        ExportKind::Preview => preview_svg(&doc.geometries, plan, doc.page_mm),
-    }
+        ExportKind::Preview => preview_svg(&toolpath, plan, doc.page_mm),
+    })
 }
 
 /// Writes an export atomically.
 pub fn export(doc: &Document, plan: &Plan, kind: ExportKind, path: &Path) -> Result<(), String> {
-    write_atomic(path, export_text(doc, plan, kind).as_bytes())
+    write_atomic(path, export_text(doc, plan, kind)?.as_bytes())
         .map_err(|e| format!("{}: cannot write: {e}", path.display()))
 }
 

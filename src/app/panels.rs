@@ -412,9 +412,14 @@ impl Editors {
                     .set_file_name("profile.toml")
                     .save_file()
                 {
-                    if let Err(e) =
-                        crate::document::write_atomic(&path, profile.to_toml().as_bytes())
-                    {
+                    let written = profile
+                        .to_toml()
+                        .map_err(|e| e.to_string())
+                        .and_then(|text| {
+                            crate::document::write_atomic(&path, text.as_bytes())
+                                .map_err(|e| e.to_string())
+                        });
+                    if let Err(e) = written {
                         self.file_error = Some(format!("{}: cannot write: {e}", path.display()));
                     }
                 }

@@ -7,7 +7,9 @@ mod progress;
 
 use anyhow::Result;
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use galvoplan::document::{Algo, FieldsMode, MachineProfile, SolverSettings, VertexMode};
+use galvoplan::document::{
+    Algo, CostModel, FieldsMode, MachineProfile, SolverSettings, VertexMode,
+};
 use galvoplan::hatch::{HatchSettings, OutlineMode};
 use galvoplan::import::ImportOptions;
 use std::path::PathBuf;
@@ -52,6 +54,17 @@ enum AlgoArg {
     Hga,
     /// Fields in creation order, nearest neighbour inside each.
     Baseline,
+    /// Fields and geometries in document order, no optimisation (seed 002's reference).
+    AsIs,
+}
+
+/// What the ordering minimises, as on the command line.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+enum CostArg {
+    /// Machine time of the lowered toolpath (stage trapezoids and settling, scanner jumps).
+    Time,
+    /// Idle travel in mm (seed 000's objective).
+    Distance,
 }
 
 /// Start-vertex choice, as on the command line.
@@ -75,6 +88,9 @@ struct JobOpts {
     /// Ordering algorithm.
     #[arg(long, value_enum, default_value = "hha")]
     algo: AlgoArg,
+    /// What the ordering minimises: job time or idle distance.
+    #[arg(long, value_enum, default_value = "time")]
+    cost: CostArg,
     /// Start vertices: exact (layered-graph DP after VEA) or vea (seed 000 only).
     #[arg(long, value_enum, default_value = "exact")]
     vertex: VertexArg,
@@ -153,6 +169,11 @@ impl JobOpts {
                 AlgoArg::Hha => Algo::Hha,
                 AlgoArg::Hga => Algo::Hga,
                 AlgoArg::Baseline => Algo::Baseline,
+                AlgoArg::AsIs => Algo::AsIs,
+            },
+            cost_model: match self.cost {
+                CostArg::Time => CostModel::Time,
+                CostArg::Distance => CostModel::Distance,
             },
             seed: self.seed,
             time_limit_s: self.time_limit,
@@ -168,7 +189,6 @@ impl JobOpts {
                 ..Default::default()
             },
             hatch: self.hatch()?,
-            ..SolverSettings::default()
         })
     }
     fn hatch(&self) -> Result<Option<HatchSettings>> {
@@ -219,6 +239,18 @@ struct PlanArgs {
     /// Write exactly the geometry to be marked as an SVG in mm.
     #[arg(long)]
     export_geometry: Option<PathBuf>,
+    /// Write the sampled stage + scanner trajectory as CSV
+    /// (`t_s,stage_x_mm,stage_y_mm,scan_x_mm,scan_y_mm,laser`).
+    #[arg(long, value_name = "OUT.csv")]
+    trajectory: Option<PathBuf>,
+    /// Sampling period of the trajectory (the controller's clock), ms.
+    #[arg(
+        long,
+        value_name = "MS",
+        default_value_t = 1.0,
+        requires = "trajectory"
+    )]
+    trajectory_period_ms: f64,
     #[command(flatten)]
     job: JobOpts,
 }

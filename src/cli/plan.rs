@@ -4,9 +4,11 @@ use super::progress::BarProgress;
 use super::PlanArgs;
 use anyhow::{Context, Result};
 use galvoplan::document::write_atomic;
-use galvoplan::export::{geometry_svg, preview_svg, report_json, write_gcode};
+use galvoplan::export::{
+    geometry_svg, preview_svg, report_json, trajectory_csv, trajectory_period_s, write_gcode,
+};
 use galvoplan::job::{CancelToken, JobCtx};
-use galvoplan::pipeline::{load_svg, plan_document};
+use galvoplan::pipeline::{load_svg, lower_plan, plan_document};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -14,6 +16,11 @@ pub fn run(a: &PlanArgs) -> Result<()> {
     let profile = a.job.profile()?;
     let settings = a.job.settings()?;
     let opts = a.job.import()?;
+    let period_s = a
+        .trajectory
+        .as_ref()
+        .map(|_| trajectory_period_s(a.trajectory_period_ms))
+        .transpose()?;
     let (mut doc, import_s) = load_svg(&a.input, profile, settings, &opts)?;
     for w in &doc.warnings {
         eprintln!("galvoplan: warning: {}: {w}", a.input.display());
@@ -33,17 +40,19 @@ pub fn run(a: &PlanArgs) -> Result<()> {
     let mut plan = result?;
     let t0 = Instant::now();
     let source = a.input.display().to_string();
-    let gcode = write_gcode(
-        &doc.geometries,
-        &plan,
-        &doc.profile,
-        doc.page_mm[1],
-        &source,
-    );
+    let toolpath = lower_plan(&doc, &plan)?;
+    // the trajectory is the toolpath on the controller's clock; the report then gives its time
+    let trajectory = period_s.map(|p| {
+        let clocked = toolpath.on_clock(p);
+        plan.metrics.job_time_s = Some(clocked.duration_s());
+        plan.metrics.job_time_breakdown_s = Some(clocked.breakdown());
+        trajectory_csv(&clocked, p)
+    });
+    let gcode = write_gcode(&toolpath, &plan, &doc.profile, doc.page_mm[1], &source);
     let preview = a
         .preview
         .as_ref()
-        .map(|_| preview_svg(&doc.geometries, &plan, doc.page_mm));
+        .map(|_| preview_svg(&toolpath, &plan, doc.page_mm));
     let geometry = a
         .export_geometry
         .as_ref()
@@ -71,12 +80,16 @@ pub fn run(a: &PlanArgs) -> Result<()> {
     if let (Some(p), Some(s)) = (&a.export_geometry, &geometry) {
         write(p, s)?;
     }
+    if let (Some(p), Some(s)) = (&a.trajectory, &trajectory) {
+        write(p, s)?;
+    }
     let m = &plan.metrics;
     eprintln!(
-        "galvoplan: {}: {} geometries, {} fields, idle {:.1} mm, base {:.1} mm, marked {:.1} mm, {} direction changes, {:.1} ms",
+        "galvoplan: {}: {} geometries, {} fields, job time {:.3} s, idle {:.1} mm, base {:.1} mm, marked {:.1} mm, {} direction changes, planned in {:.1} ms",
         source,
         doc.geometries.len(),
         m.fields,
+        m.job_time_s.unwrap_or(0.0),
         m.idle_mm,
         m.base_mm,
         m.marked_mm,

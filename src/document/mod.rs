@@ -7,9 +7,10 @@ mod project;
 mod settings;
 
 pub use geometry::{Geometry, Source};
-pub use plan::{GenerationRecord, Metrics, Plan, ScanField, StageTimes, Step};
+pub use plan::{GenerationRecord, Metrics, Plan, ScanField, StageTimes, Step, TimeBreakdown};
 pub use profile::{
-    AxisLimits, GcodeDialect, LaserTiming, MachineProfile, ProfileError, ScannerSpeeds, BUILTIN,
+    AxisLimits, GcodeDialect, GcodeMode, LaserTiming, MachineProfile, ProfileError, ScannerSpeeds,
+    BUILTIN, PROFILE_VERSION,
 };
 pub use project::{load_project, save_project, write_atomic, ProjectError, PROJECT_VERSION};
 pub use settings::{Algo, CostModel, FieldsMode, GaParams, SolverSettings, VertexMode};

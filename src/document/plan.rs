@@ -95,6 +95,38 @@ pub struct StageTimes {
     pub order_detail: Vec<(String, f64)>,
 }
 
+/// Job time by what the machine does, s; the parts add up to the job time.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct TimeBreakdown {
+    /// Stage moves between fields.
+    pub stage: f64,
+    /// Stage settling after moves.
+    pub settle: f64,
+    /// Scanner jumps and jump delays (those not hidden in a stage move).
+    pub jump: f64,
+    /// Marking.
+    pub mark: f64,
+    /// Laser on and off delays.
+    pub laser_delays: f64,
+}
+
+impl TimeBreakdown {
+    /// The parts with their names, in display order.
+    pub fn parts(&self) -> [(&'static str, f64); 5] {
+        [
+            ("stage", self.stage),
+            ("settle", self.settle),
+            ("jump", self.jump),
+            ("mark", self.mark),
+            ("laser_delays", self.laser_delays),
+        ]
+    }
+    /// The sum of the parts, s.
+    pub fn total(&self) -> f64 {
+        self.parts().iter().map(|p| p.1).sum()
+    }
+}
+
 /// Metrics of a plan (definitions in DESIGN.md and [`crate::order::metrics`]).
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct Metrics {
@@ -114,8 +146,11 @@ pub struct Metrics {
     pub overlap_pct: f64,
     /// Sign reversals of the travel direction along the base path.
     pub direction_changes: usize,
-    /// Estimated step-and-scan machine time, s.
+    /// Machine time of the job: the lowered toolpath's duration ([`crate::motion`]), s.
     pub job_time_s: Option<f64>,
+    /// The job time by what the machine does, s.
+    #[serde(default)]
+    pub job_time_breakdown_s: Option<TimeBreakdown>,
     /// Wall time per stage, s.
     pub solve_s: StageTimes,
 }

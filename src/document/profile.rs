@@ -4,16 +4,26 @@ use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 /// Current profile format version.
-pub const PROFILE_VERSION: u32 = 1;
+///
+/// * 1: stroke, field, axis velocity and acceleration, scanner, laser, G-code words.
+/// * 2: an axis may give `ramp_s` (seed 002 Table 2's t_a, rest to full speed) instead of
+///   `max_accel_mm_s2`, and a `settle_s` after each move; `[gcode] mode` (`tcp` or
+///   `stage-scanner`) and `scanner_axes`. Every version-1 file is a valid version-2 file.
+pub const PROFILE_VERSION: u32 = 2;
 
 /// Limits of one base-stage axis (seed 002, Table 2 style).
+///
+/// In a profile file the acceleration is given either as `max_accel_mm_s2` or as `ramp_s`, the
+/// time from rest to full speed (seed 002 Table 2's t_a): `max_accel = max_velocity / ramp_s`.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
-#[serde(default, deny_unknown_fields)]
+#[serde(try_from = "AxisLimitsFile")]
 pub struct AxisLimits {
     /// Maximum velocity in mm/s.
     pub max_velocity_mm_s: f64,
     /// Maximum acceleration in mm/s².
     pub max_accel_mm_s2: f64,
+    /// Settling time after each move of this axis, s.
+    pub settle_s: f64,
 }
 
 impl Default for AxisLimits {
@@ -21,7 +31,48 @@ impl Default for AxisLimits {
         Self {
             max_velocity_mm_s: 500.0,
             max_accel_mm_s2: 5_000.0,
+            settle_s: 0.0,
         }
+    }
+}
+
+/// An axis table as written in a profile file: acceleration or ramp time.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct AxisLimitsFile {
+    #[serde(default = "default_velocity_mm_s")]
+    max_velocity_mm_s: f64,
+    max_accel_mm_s2: Option<f64>,
+    ramp_s: Option<f64>,
+    #[serde(default)]
+    settle_s: f64,
+}
+
+fn default_velocity_mm_s() -> f64 {
+    AxisLimits::default().max_velocity_mm_s
+}
+
+impl TryFrom<AxisLimitsFile> for AxisLimits {
+    type Error = String;
+    fn try_from(f: AxisLimitsFile) -> Result<Self, String> {
+        let max_accel_mm_s2 = match (f.max_accel_mm_s2, f.ramp_s) {
+            (Some(_), Some(_)) => {
+                return Err("give max_accel_mm_s2 or ramp_s, not both".into());
+            }
+            (Some(a), None) => a,
+            (None, Some(ramp_s)) => {
+                if !(ramp_s.is_finite() && ramp_s > 0.0) {
+                    return Err(format!("ramp_s = {ramp_s} must be a positive number"));
+                }
+                f.max_velocity_mm_s / ramp_s
+            }
+            (None, None) => AxisLimits::default().max_accel_mm_s2,
+        };
+        Ok(AxisLimits {
+            max_velocity_mm_s: f.max_velocity_mm_s,
+            max_accel_mm_s2,
+            settle_s: f.settle_s,
+        })
     }
 }
 
@@ -66,6 +117,18 @@ impl Default for LaserTiming {
     }
 }
 
+/// What the G-code drives.
+#[derive(Debug, Clone, Copy, Serialize, Deserialize, PartialEq, Eq, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum GcodeMode {
+    /// The tool-centre-point path on X/Y (the controller splits stage and scanner itself).
+    #[default]
+    Tcp,
+    /// The stage on X/Y once per field; scanner jumps and marks in field-local coordinates on
+    /// the two [`GcodeDialect::scanner_axes`] words.
+    StageScanner,
+}
+
 /// G-code dialect options. The defaults produce the contract in DESIGN.md.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 #[serde(default, deny_unknown_fields)]
@@ -82,6 +145,10 @@ pub struct GcodeDialect {
     pub decimals: usize,
     /// Mirror Y about the page height (for y-up machines).
     pub flip_y: bool,
+    /// Tool-centre path or stage + scanner axes.
+    pub mode: GcodeMode,
+    /// Axis words of the scanner in `stage-scanner` mode (x, y).
+    pub scanner_axes: [String; 2],
 }
 
 impl Default for GcodeDialect {
@@ -93,6 +160,8 @@ impl Default for GcodeDialect {
             feed_mm_min: 60_000.0,
             decimals: 4,
             flip_y: false,
+            mode: GcodeMode::Tcp,
+            scanner_axes: ["U".into(), "V".into()],
         }
     }
 }
@@ -181,13 +250,30 @@ pub const BUILTIN: &[(&str, &str)] = &[
     ),
 ];
 
+/// Brings a profile table of an earlier format version to [`PROFILE_VERSION`], one step per
+/// version; a table without `version` is taken as current. Later versions are left for
+/// [`MachineProfile::validate`] to reject.
+fn upgrade(table: &mut toml::Table) {
+    let Some(version) = table.get("version").and_then(toml::Value::as_integer) else {
+        return;
+    };
+    if version == 1 {
+        // 1 → 2 only added fields, each with a default that keeps version-1 behaviour
+        // (acceleration as given, no settling, tool-centre G-code)
+        table.insert("version".into(), toml::Value::Integer(2));
+    }
+}
+
 impl MachineProfile {
     /// Parses and validates a profile from TOML text; `file` names it in errors.
     pub fn from_toml(text: &str, file: &str) -> Result<Self, ProfileError> {
-        let p: MachineProfile = toml::from_str(text).map_err(|e| ProfileError::Parse {
+        let parse_error = |e: toml::de::Error| ProfileError::Parse {
             file: file.into(),
             msg: e.to_string().replace('\n', " "),
-        })?;
+        };
+        let mut table: toml::Table = toml::from_str(text).map_err(parse_error)?;
+        upgrade(&mut table);
+        let p: MachineProfile = table.try_into().map_err(parse_error)?;
         p.validate().map_err(|msg| ProfileError::Invalid {
             file: file.into(),
             msg,
@@ -214,8 +300,8 @@ impl MachineProfile {
             .and_then(|(n, t)| Self::from_toml(t, n))
     }
     /// Serialises to TOML.
-    pub fn to_toml(&self) -> String {
-        toml::to_string_pretty(self).unwrap_or_default()
+    pub fn to_toml(&self) -> Result<String, toml::ser::Error> {
+        toml::to_string_pretty(self)
     }
     /// Checks ranges; returns a message naming the first bad value.
     pub fn validate(&self) -> Result<(), String> {
@@ -242,6 +328,8 @@ impl MachineProfile {
                 false,
             ),
             ("axis_y.max_accel_mm_s2", self.axis_y.max_accel_mm_s2, false),
+            ("axis_x.settle_s", self.axis_x.settle_s, true),
+            ("axis_y.settle_s", self.axis_y.settle_s, true),
             (
                 "scanner.jump_speed_mm_s",
                 self.scanner.jump_speed_mm_s,
@@ -275,10 +363,20 @@ impl MachineProfile {
         for (name, w) in [
             ("gcode.laser_on", &self.gcode.laser_on),
             ("gcode.laser_off", &self.gcode.laser_off),
+            ("gcode.scanner_axes[0]", &self.gcode.scanner_axes[0]),
+            ("gcode.scanner_axes[1]", &self.gcode.scanner_axes[1]),
         ] {
             if w.trim().is_empty() {
                 return Err(format!("{name} must not be empty"));
             }
+        }
+        let [u, v] = &self.gcode.scanner_axes;
+        if self.gcode.mode == GcodeMode::StageScanner
+            && (u == v || [u, v].iter().any(|w| ["X", "Y"].contains(&w.trim())))
+        {
+            return Err(format!(
+                "gcode.scanner_axes = [{u}, {v}] must be two words other than X and Y"
+            ));
         }
         Ok(())
     }
@@ -302,7 +400,7 @@ mod tests {
     #[test]
     fn toml_round_trip() {
         let p = MachineProfile::default();
-        let q = MachineProfile::from_toml(&p.to_toml(), "x").unwrap();
+        let q = MachineProfile::from_toml(&p.to_toml().unwrap(), "x").unwrap();
         assert_eq!(p, q);
     }
 

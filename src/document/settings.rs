@@ -19,6 +19,9 @@ pub enum FieldsMode {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "lowercase")]
 pub enum Algo {
+    /// Fields and geometries in document order, no optimisation (seed 002's reference).
+    #[serde(rename = "as-is")]
+    AsIs,
     /// Fields in creation order, nearest neighbour inside each field.
     Baseline,
     /// Hierarchical heuristic algorithm (seed 000 §3.2).
@@ -26,6 +29,18 @@ pub enum Algo {
     Hha,
     /// Hybrid genetic algorithm (seed 000 §3.3).
     Hga,
+}
+
+impl Algo {
+    /// The name used on the command line, in reports and in plan names.
+    pub fn label(self) -> &'static str {
+        match self {
+            Algo::AsIs => "as-is",
+            Algo::Baseline => "baseline",
+            Algo::Hha => "hha",
+            Algo::Hga => "hga",
+        }
+    }
 }
 
 /// How start vertices are chosen once the order is fixed.
@@ -43,10 +58,10 @@ pub enum VertexMode {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "lowercase")]
 pub enum CostModel {
-    /// Euclidean distance in mm.
-    #[default]
+    /// Idle distance in mm (seed 000's objective).
     Distance,
-    /// Machine time from the profile's dynamics (seed 002).
+    /// Machine time from the profile's dynamics (seed 002): the toolpath's job time.
+    #[default]
     Time,
 }
 

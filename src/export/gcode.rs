@@ -1,31 +1,26 @@
-//! G-code for the tool-centre-point path, per the contract in DESIGN.md.
+//! G-code from the lowered toolpath, in two dialects (DESIGN.md, docs/GCODE.md):
+//!
+//! * `tcp`: the tool-centre-point path on X/Y — `G0` to each stroke's start, the laser-on word,
+//!   `G1` marks (feed on the first), the laser-off word; a comment at every field change;
+//! * `stage-scanner`: at every field change a `G0 X.. Y..` positions the stage at the field's
+//!   centre; scanner jumps (`G0`) and marks (`G1`) are field-local offsets on the two scanner
+//!   axis words (default `U`, `V`), with the same laser words.
 
-use crate::document::{Geometry, MachineProfile, Plan};
+use crate::document::{GcodeMode, MachineProfile, Plan};
 use crate::geom::Pt;
+use crate::motion::Toolpath;
 use std::fmt::Write;
 
-/// Writes the plan as G-code: `G21`, `G90`; per stroke a `G0` to its start, the laser-on word
-/// (with `S` power when the profile sets one), `G1` moves (feed on the first), the laser-off word.
-/// A comment marks every field change. Y is mirrored about `page_height_mm` when the profile's
-/// dialect says `flip_y`.
-pub fn write_gcode(
-    geometries: &[Geometry],
-    plan: &Plan,
-    profile: &MachineProfile,
+/// Number formatting and the Y mirror of a dialect.
+struct Words<'a> {
+    profile: &'a MachineProfile,
     page_height_mm: f64,
-    title: &str,
-) -> String {
-    let d = &profile.gcode;
-    let prec = d.decimals;
-    let map = |p: Pt| -> (f64, f64) {
-        if d.flip_y {
-            (p.x, page_height_mm - p.y)
-        } else {
-            (p.x, p.y)
-        }
-    };
-    let num = |v: f64| -> String {
-        let s = format!("{:.*}", prec, v);
+}
+
+impl Words<'_> {
+    /// A number with the dialect's decimals, trailing zeros trimmed, no negative zero.
+    fn num(&self, v: f64) -> String {
+        let s = format!("{:.*}", self.profile.gcode.decimals, v);
         let s = if s.contains('.') {
             s.trim_end_matches('0').trim_end_matches('.').to_string()
         } else {
@@ -36,12 +31,96 @@ pub fn write_gcode(
         } else {
             s
         }
+    }
+    /// A machine position (mirrored about the page height when the dialect flips Y).
+    fn position(&self, p: Pt) -> Pt {
+        if self.profile.gcode.flip_y {
+            Pt::new(p.x, self.page_height_mm - p.y)
+        } else {
+            p
+        }
+    }
+    /// A scanner offset (mirrored with the positions).
+    fn offset(&self, o: Pt) -> Pt {
+        if self.profile.gcode.flip_y {
+            Pt::new(o.x, -o.y)
+        } else {
+            o
+        }
+    }
+    /// `X.. Y..`, or the scanner words for an offset in stage-scanner mode.
+    fn xy(&self, axes: [&str; 2], p: Pt) -> String {
+        format!("{}{} {}{}", axes[0], self.num(p.x), axes[1], self.num(p.y))
+    }
+}
+
+/// Writes the toolpath of `plan` as G-code in the profile's dialect; Y is mirrored about
+/// `page_height_mm` when the dialect says `flip_y`.
+pub fn write_gcode(
+    toolpath: &Toolpath,
+    plan: &Plan,
+    profile: &MachineProfile,
+    page_height_mm: f64,
+    title: &str,
+) -> String {
+    let d = &profile.gcode;
+    let w = Words {
+        profile,
+        page_height_mm,
     };
     let on = match d.power {
-        Some(s) => format!("{} S{}", d.laser_on, num(s)),
+        Some(s) => format!("{} S{}", d.laser_on, w.num(s)),
         None => d.laser_on.clone(),
     };
-    let mut out = String::with_capacity(plan.order.len() * 64);
+    let stage_scanner = d.mode == GcodeMode::StageScanner;
+    let scan_axes = [d.scanner_axes[0].as_str(), d.scanner_axes[1].as_str()];
+    let mut out = String::with_capacity(toolpath.strokes.len() * 64);
+    header(&mut out, toolpath, plan, title);
+    let _ = writeln!(out, "{}", d.laser_off);
+    let mut current_field = None;
+    for (k, stroke) in toolpath.strokes.iter().enumerate() {
+        if current_field != Some(stroke.field) {
+            current_field = Some(stroke.field);
+            let c = w.position(stroke.stage);
+            let _ = writeln!(
+                out,
+                "; field {} centre {} {}",
+                stroke.field,
+                w.num(c.x),
+                w.num(c.y)
+            );
+            if stage_scanner {
+                let _ = writeln!(out, "G0 {}", w.xy(["X", "Y"], c));
+            }
+        }
+        let points = toolpath.stroke_points(k);
+        let place = |p: Pt| -> String {
+            if stage_scanner {
+                w.xy(scan_axes, w.offset(p.minus(stroke.stage)))
+            } else {
+                w.xy(["X", "Y"], w.position(p))
+            }
+        };
+        let Some((&first, rest)) = points.split_first() else {
+            continue;
+        };
+        let _ = writeln!(out, "G0 {}", place(first));
+        let _ = writeln!(out, "{on}");
+        for (j, &p) in rest.iter().enumerate() {
+            if j == 0 {
+                let _ = writeln!(out, "G1 {} F{}", place(p), w.num(d.feed_mm_min));
+            } else {
+                let _ = writeln!(out, "G1 {}", place(p));
+            }
+        }
+        let _ = writeln!(out, "{}", d.laser_off);
+    }
+    out.push_str("; end\n");
+    out
+}
+
+fn header(out: &mut String, toolpath: &Toolpath, plan: &Plan, title: &str) {
+    let m = &plan.metrics;
     let _ = writeln!(
         out,
         "; galvoplan {} — {}",
@@ -50,44 +129,13 @@ pub fn write_gcode(
     );
     let _ = writeln!(
         out,
-        "; {} strokes in {} fields, marked {:.3} mm, idle {:.3} mm, base {:.3} mm",
-        plan.order.len(),
+        "; {} strokes in {} fields, marked {:.3} mm, idle {:.3} mm, base {:.3} mm, job time {:.3} s",
+        toolpath.strokes.len(),
         plan.fields.len(),
-        plan.metrics.marked_mm,
-        plan.metrics.idle_mm,
-        plan.metrics.base_mm
+        m.marked_mm,
+        m.idle_mm,
+        m.base_mm,
+        toolpath.duration_s()
     );
     out.push_str("G21\nG90\n");
-    let _ = writeln!(out, "{}", d.laser_off);
-    let mut current_field = None;
-    for step in &plan.order {
-        if current_field != Some(step.field) {
-            current_field = Some(step.field);
-            if let Some(f) = plan.fields.iter().find(|f| f.id == step.field) {
-                let (x, y) = map(f.center);
-                let _ = writeln!(out, "; field {} centre {} {}", f.id, num(x), num(y));
-            }
-        }
-        let Some(g) = geometries.get(step.geometry) else {
-            continue;
-        };
-        let path = g.marking_path(step.start_vertex, step.reversed);
-        let Some((&first, rest)) = path.split_first() else {
-            continue;
-        };
-        let (x, y) = map(first);
-        let _ = writeln!(out, "G0 X{} Y{}", num(x), num(y));
-        let _ = writeln!(out, "{on}");
-        for (k, &p) in rest.iter().enumerate() {
-            let (x, y) = map(p);
-            if k == 0 {
-                let _ = writeln!(out, "G1 X{} Y{} F{}", num(x), num(y), num(d.feed_mm_min));
-            } else {
-                let _ = writeln!(out, "G1 X{} Y{}", num(x), num(y));
-            }
-        }
-        let _ = writeln!(out, "{}", d.laser_off);
-    }
-    out.push_str("; end\n");
-    out
 }

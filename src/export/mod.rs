@@ -1,9 +1,14 @@
-//! Export of a plan: G-code (TCP path), JSON report, SVG preview, and the geometry as SVG.
+//! Export of a plan, all from its lowered toolpath: G-code (tool-centre or stage + scanner),
+//! JSON report, SVG preview, sampled trajectory; and the geometry as SVG.
 
 mod gcode;
 mod report;
 mod svg_preview;
+mod trajectory;
 
 pub use gcode::write_gcode;
 pub use report::{report_json, Report};
 pub use svg_preview::{geometry_svg, preview_svg};
+pub use trajectory::{
+    trajectory_csv, trajectory_period_s, PeriodError, MAX_PERIOD_S, MIN_PERIOD_S, TRAJECTORY_HEADER,
+};

@@ -1,6 +1,7 @@
 //! SVG renderings: the planned path over the fields, and the bare geometry to be marked.
 
 use crate::document::{Geometry, Plan};
+use crate::motion::Toolpath;
 use std::fmt::Write;
 
 fn pts_attr(points: &[crate::geom::Pt]) -> String {
@@ -18,9 +19,10 @@ fn header(out: &mut String, w: f64, h: f64, min_x: f64, min_y: f64) {
     );
 }
 
-/// The plan as an SVG in mm: scan fields as translucent numbered squares (visiting order), marks
-/// in black, idle moves as dashed red lines, start (green) and end (red) markers.
-pub fn preview_svg(geometries: &[Geometry], plan: &Plan, page_mm: [f64; 2]) -> String {
+/// The plan as an SVG in mm: scan fields as translucent numbered squares (visiting order), the
+/// toolpath's marks in black, its idle moves as dashed red lines, start (green) and end (red)
+/// markers.
+pub fn preview_svg(toolpath: &Toolpath, plan: &Plan, page_mm: [f64; 2]) -> String {
     let mut b = crate::geom::BBox {
         min_x: 0.0,
         min_y: 0.0,
@@ -42,14 +44,12 @@ pub fn preview_svg(geometries: &[Geometry], plan: &Plan, page_mm: [f64; 2]) -> S
         );
     }
     out.push_str("</g>\n<g id=\"marks\" fill=\"none\" stroke=\"black\" stroke-width=\"0.25\">\n");
-    let mut ends = Vec::with_capacity(plan.order.len());
-    for s in &plan.order {
-        if let Some(g) = geometries.get(s.geometry) {
-            let path = g.marking_path(s.start_vertex, s.reversed);
-            let _ = writeln!(out, "<polyline points=\"{}\"/>", pts_attr(&path));
-            if let (Some(&a), Some(&z)) = (path.first(), path.last()) {
-                ends.push((a, z));
-            }
+    let mut ends = Vec::with_capacity(toolpath.strokes.len());
+    for k in 0..toolpath.strokes.len() {
+        let path = toolpath.stroke_points(k);
+        let _ = writeln!(out, "<polyline points=\"{}\"/>", pts_attr(path));
+        if let (Some(&a), Some(&z)) = (path.first(), path.last()) {
+            ends.push((a, z));
         }
     }
     out.push_str("</g>\n<g id=\"idle\" fill=\"none\" stroke=\"#dc2626\" stroke-width=\"0.2\" stroke-dasharray=\"1 0.7\">\n");

@@ -8,17 +8,20 @@
 //! * `covered_area_mm2`: area covered by exactly one field (seed 000 §5.1);
 //!   `overlap_pct = 100 · (1 − covered / (fields · field area))`.
 //! * `direction_changes`: see [`direction_changes`].
-//! * `job_time_s`: step-and-scan estimate, see [`job_time_s`].
+//! * `job_time_s`: the lowered toolpath's duration, with `job_time_breakdown_s` by what the
+//!   machine does ([`crate::motion`]).
 
 use crate::document::{Geometry, MachineProfile, Metrics, ScanField, Step};
 use crate::geom::Pt;
+use crate::motion::Toolpath;
 
-/// Computes all metrics of an ordering; `fields` in visiting order.
+/// Computes all metrics of an ordering; `fields` in visiting order, `toolpath` its lowering.
 pub fn compute(
     geometries: &[Geometry],
     fields: &[ScanField],
     steps: &[Step],
     profile: &MachineProfile,
+    toolpath: &Toolpath,
 ) -> Metrics {
     let idle_mm = idle_mm(geometries, steps);
     let marked_mm = steps
@@ -38,7 +41,8 @@ pub fn compute(
         covered_area_mm2,
         overlap_pct,
         direction_changes: direction_changes(geometries, fields, steps, profile.field_mm),
-        job_time_s: Some(job_time_s(geometries, fields, steps, profile)),
+        job_time_s: Some(toolpath.duration_s()),
+        job_time_breakdown_s: Some(toolpath.breakdown()),
         solve_s: Default::default(),
     }
 }
@@ -194,58 +198,6 @@ pub fn direction_changes(
     changes
 }
 
-/// Time of a point-to-point move of one axis with a trapezoidal velocity profile, s.
-fn axis_time_s(d_mm: f64, v_mm_s: f64, a_mm_s2: f64) -> f64 {
-    let d = d_mm.abs();
-    if d == 0.0 {
-        return 0.0;
-    }
-    if d < v_mm_s * v_mm_s / a_mm_s2 {
-        2.0 * (d / a_mm_s2).sqrt()
-    } else {
-        d / v_mm_s + v_mm_s / a_mm_s2
-    }
-}
-
-/// Step-and-scan job time estimate, s: base moves between field centres (both axes move at once,
-/// each with a trapezoidal profile, the slower one counts), scanner jumps at jump speed plus the
-/// jump delay, marks at mark speed plus laser on and off delays.
-pub fn job_time_s(
-    geometries: &[Geometry],
-    fields: &[ScanField],
-    steps: &[Step],
-    profile: &MachineProfile,
-) -> f64 {
-    let base: f64 = fields
-        .windows(2)
-        .map(|w| {
-            let d = w[1].center.minus(w[0].center);
-            axis_time_s(
-                d.x,
-                profile.axis_x.max_velocity_mm_s,
-                profile.axis_x.max_accel_mm_s2,
-            )
-            .max(axis_time_s(
-                d.y,
-                profile.axis_y.max_velocity_mm_s,
-                profile.axis_y.max_accel_mm_s2,
-            ))
-        })
-        .sum();
-    let lt = &profile.laser;
-    let marks: f64 = steps
-        .iter()
-        .map(|s| {
-            geometries[s.geometry].length_mm() / profile.scanner.mark_speed_mm_s
-                + lt.on_delay_s
-                + lt.off_delay_s
-        })
-        .sum();
-    let jumps = idle_mm(geometries, steps) / profile.scanner.jump_speed_mm_s
-        + steps.len().saturating_sub(1) as f64 * lt.jump_delay_s;
-    base + marks + jumps
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -303,13 +255,5 @@ mod tests {
             direction_changes(&gs2, &f, &steps(&[0, 1, 2, 3]), [70.0, 70.0]),
             0
         );
-    }
-
-    #[test]
-    fn trapezoid_times() {
-        // short move: triangle profile
-        assert!((axis_time_s(1.0, 100.0, 100.0) - 0.2).abs() < 1e-12);
-        // long move: cruise
-        assert!((axis_time_s(300.0, 100.0, 1000.0) - 3.1).abs() < 1e-12);
     }
 }

@@ -1,16 +1,23 @@
 //! Ordering: which field after which, which geometry after which, where each one starts.
 
+mod as_is;
 mod baseline;
+pub mod cost;
 pub mod hga;
 pub mod hha;
 pub mod metrics;
+pub mod time;
 pub mod tsp;
 pub mod vertex;
 
+pub use as_is::as_is_order;
 pub use baseline::baseline_order;
 
-use crate::document::{Algo, Geometry, MachineProfile, Plan, ScanField, SolverSettings, Step};
+use crate::document::{
+    Algo, CostModel, Geometry, MachineProfile, Plan, ScanField, SolverSettings, Step,
+};
 use crate::job::{Cancelled, JobCtx};
+use crate::motion::{lower, LowerError, Toolpath};
 use thiserror::Error;
 
 /// Why ordering failed.
@@ -22,6 +29,9 @@ pub enum OrderError {
     /// A geometry is not allocated to any field.
     #[error("{0} geometries are not allocated to a scan field (first: geometry {1})")]
     Unallocated(usize, usize),
+    /// The plan cannot be turned into machine motion.
+    #[error(transparent)]
+    Lower(#[from] LowerError),
 }
 
 /// The ordered strokes of a run, before metrics.
@@ -46,55 +56,153 @@ pub fn order_plan(
     let t0 = std::time::Instant::now();
     let mut detail = Vec::new();
     let mut history = Vec::new();
-    let ordering = match settings.algo {
-        Algo::Baseline => baseline_order(geometries, fields, ctx)?,
-        Algo::Hha => hha::hha_order(geometries, fields, profile, settings, ctx, &mut detail)?,
+    // what a time search starts from: the algorithm's plan, and HGA's HHA seed plan too
+    let mut starts = Vec::new();
+    match settings.algo {
+        Algo::AsIs => starts.push(as_is_order(geometries, fields, ctx)?),
+        Algo::Baseline => starts.push(baseline_order(geometries, fields, ctx)?),
+        Algo::Hha => starts.push(hha::hha_order(
+            geometries,
+            fields,
+            profile,
+            settings,
+            ctx,
+            &mut detail,
+        )?),
         Algo::Hga => {
-            let t = std::time::Instant::now();
-            let seed_plan = if settings.ga.seed_with_hha {
-                Some(hha::hha_order(
-                    geometries,
-                    fields,
-                    profile,
-                    settings,
-                    ctx,
-                    &mut detail,
-                )?)
-            } else {
-                None
-            };
-            detail.push(("hha_seed".into(), t.elapsed().as_secs_f64()));
-            let t = std::time::Instant::now();
-            let r = hga::hga_order(
-                geometries,
-                fields,
-                profile,
-                settings,
-                seed_plan.as_ref(),
-                ctx,
-            )?;
-            detail.push(("ga".into(), t.elapsed().as_secs_f64()));
+            let (r, seed_plan) = run_hga(geometries, fields, profile, settings, ctx, &mut detail)?;
             history = r.history;
-            r.ordering
+            starts.push(r.ordering);
+            starts.extend(seed_plan);
         }
     };
+    let by_time = settings.cost_model == CostModel::Time && settings.algo != Algo::AsIs;
+    let t = std::time::Instant::now();
+    let mut best: Option<(Ordering, Toolpath)> = None;
+    for start in starts {
+        let candidate = if by_time {
+            time_ordering(geometries, fields, profile, settings, start, ctx)?
+        } else {
+            let toolpath = lower_ordering(geometries, fields, profile, &start)?;
+            (start, toolpath)
+        };
+        if best
+            .as_ref()
+            .is_none_or(|b| candidate.1.duration_s() < b.1.duration_s())
+        {
+            best = Some(candidate);
+        }
+        // the distance objective is the algorithm's own: its plan alone counts
+        if !by_time {
+            break;
+        }
+    }
+    if by_time {
+        detail.push(("time".into(), t.elapsed().as_secs_f64()));
+    }
+    let Some((ordering, toolpath)) = best else {
+        return Err(OrderError::Cancelled(Cancelled));
+    };
     let order_s = t0.elapsed().as_secs_f64();
-    let by_id = |id: usize| fields.iter().find(|f| f.id == id).cloned();
-    let plan_fields: Vec<ScanField> = ordering
-        .field_order
-        .iter()
-        .filter_map(|&id| by_id(id))
-        .collect();
-    let mut m = metrics::compute(geometries, &plan_fields, &ordering.steps, profile);
+    let plan_fields = fields_in_order(fields, &ordering.field_order);
+    let mut m = metrics::compute(
+        geometries,
+        &plan_fields,
+        &ordering.steps,
+        profile,
+        &toolpath,
+    );
     m.solve_s.order = order_s;
     m.solve_s.order_detail = detail;
     Ok(Plan {
-        name: format!("{:?}", settings.algo).to_lowercase(),
+        name: settings.algo.label().into(),
         algo: settings.algo,
         fields: plan_fields,
         order: ordering.steps,
         metrics: m,
         history,
+    })
+}
+
+/// HGA, seeded with the HHA plan when the settings say so; returns the seed plan too.
+fn run_hga(
+    geometries: &[Geometry],
+    fields: &[ScanField],
+    profile: &MachineProfile,
+    settings: &SolverSettings,
+    ctx: &JobCtx,
+    detail: &mut Vec<(String, f64)>,
+) -> Result<(hga::HgaResult, Option<Ordering>), OrderError> {
+    let t = std::time::Instant::now();
+    let seed_plan = if settings.ga.seed_with_hha {
+        Some(hha::hha_order(
+            geometries, fields, profile, settings, ctx, detail,
+        )?)
+    } else {
+        None
+    };
+    detail.push(("hha_seed".into(), t.elapsed().as_secs_f64()));
+    let t = std::time::Instant::now();
+    let r = hga::hga_order(
+        geometries,
+        fields,
+        profile,
+        settings,
+        seed_plan.as_ref(),
+        ctx,
+    )?;
+    detail.push(("ga".into(), t.elapsed().as_secs_f64()));
+    Ok((r, seed_plan))
+}
+
+/// The fields of `order` (ids) in that order.
+fn fields_in_order(fields: &[ScanField], order: &[usize]) -> Vec<ScanField> {
+    order
+        .iter()
+        .filter_map(|&id| fields.iter().find(|f| f.id == id).cloned())
+        .collect()
+}
+
+/// The toolpath of an ordering.
+fn lower_ordering(
+    geometries: &[Geometry],
+    fields: &[ScanField],
+    profile: &MachineProfile,
+    ordering: &Ordering,
+) -> Result<Toolpath, LowerError> {
+    let plan = Plan {
+        name: String::new(),
+        algo: Algo::default(),
+        fields: fields_in_order(fields, &ordering.field_order),
+        order: ordering.steps.clone(),
+        metrics: Default::default(),
+        history: Vec::new(),
+    };
+    lower(geometries, &plan, profile)
+}
+
+/// The distance ordering refined for job time ([`time::refine_for_time`]); the refinement is
+/// kept only when its toolpath is not slower, so `--cost time` never loses to `--cost distance`.
+/// After a cancel the ordering is returned as it is (the best so far).
+fn time_ordering(
+    geometries: &[Geometry],
+    fields: &[ScanField],
+    profile: &MachineProfile,
+    settings: &SolverSettings,
+    ordering: Ordering,
+    ctx: &JobCtx,
+) -> Result<(Ordering, Toolpath), OrderError> {
+    let by_distance = lower_ordering(geometries, fields, profile, &ordering)?;
+    let refined =
+        match time::refine_for_time(geometries, fields, &ordering, profile, settings.seed, ctx) {
+            Ok(refined) => refined,
+            Err(Cancelled) => return Ok((ordering, by_distance)),
+        };
+    let by_time = lower_ordering(geometries, fields, profile, &refined)?;
+    Ok(if by_time.duration_s() <= by_distance.duration_s() {
+        (refined, by_time)
+    } else {
+        (ordering, by_distance)
     })
 }
 

@@ -1,5 +1,5 @@
 ; galvoplan 0.1.0 — small.svg
-; 6 strokes in 5 fields, marked 261.876 mm, idle 253.611 mm, base 301.774 mm
+; 6 strokes in 5 fields, marked 261.876 mm, idle 253.611 mm, base 301.774 mm, job time 1.666 s
 G21
 G90
 M5

@@ -1,5 +1,5 @@
 ; galvoplan 0.1.0 — small.svg
-; 6 strokes in 3 fields, marked 261.876 mm, idle 276.664 mm, base 217.491 mm
+; 6 strokes in 3 fields, marked 261.876 mm, idle 276.664 mm, base 217.491 mm, job time 0.895 s
 G21
 G90
 M5

@@ -4,6 +4,7 @@ use super::Chromosome;
 use crate::document::{Geometry, Step};
 use crate::geom::Pt;
 use crate::job::{Cancelled, JobCtx};
+use crate::order::cost::TravelCost;
 use crate::order::tsp::{LocalSearch, LsOptions, Node, PathProblem, Tour, NO_CLUSTER};
 use crate::order::vertex::{optimal_vertices, vea};
 
@@ -57,6 +58,7 @@ impl Shared<'_> {
             flippable,
             cluster,
             cluster_penalty: self.penalty,
+            metric: TravelCost::Distance,
         };
         (prob, flipped)
     }

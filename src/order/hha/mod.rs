@@ -27,6 +27,7 @@ use super::{OrderError, Ordering};
 use crate::document::{Geometry, MachineProfile, ScanField, SolverSettings, Step, VertexMode};
 use crate::geom::Pt;
 use crate::job::{Cancelled, JobCtx};
+use crate::order::cost::TravelCost;
 use rayon::prelude::*;
 use std::time::Instant;
 
@@ -278,7 +279,7 @@ fn order_field(
 
 /// Local search of one field's strokes on their real ends, between fixed anchor points.
 #[allow(clippy::too_many_arguments)]
-fn refine_field(
+pub(crate) fn refine_field(
     geometries: &[Geometry],
     run: &[Step],
     before: Option<Pt>,
@@ -332,6 +333,7 @@ fn refine_field(
         flippable,
         cluster: Vec::new(),
         cluster_penalty: 0.0,
+        metric: TravelCost::Distance,
     };
     let mut flipped = vec![false; n];
     for (k, s) in run.iter().enumerate() {

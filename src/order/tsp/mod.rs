@@ -12,6 +12,7 @@
 //! Or-opt moves are evaluated in O(1). The first node may be fixed (a fixed start); the last node
 //! may be fixed (a fixed end) or free (an open path with a virtual end node of zero cost).
 
+use super::cost::TravelCost;
 use crate::geom::Pt;
 use crate::job::{Cancelled, JobCtx};
 
@@ -52,6 +53,8 @@ pub struct PathProblem {
     pub cluster: Vec<u32>,
     /// Added to every edge between two different clusters (seed 000 Algorithm 1).
     pub cluster_penalty: f64,
+    /// What travelling between two points costs (Euclidean distance unless set).
+    pub metric: TravelCost,
 }
 
 /// Cluster of a node that belongs to none (e.g. a start point): its edges carry no penalty.
@@ -81,6 +84,7 @@ impl PathProblem {
             flippable: vec![false; points.len()],
             cluster: Vec::new(),
             cluster_penalty: 0.0,
+            metric: TravelCost::Distance,
         }
     }
     fn start(&self, t: &Tour, i: usize) -> Pt {
@@ -99,7 +103,7 @@ impl PathProblem {
     }
     /// Cost of the edge `i → j` with the tour's orientations.
     pub fn cost(&self, t: &Tour, i: usize, j: usize) -> f64 {
-        self.end(t, i).dist(self.start(t, j))
+        self.metric.between(self.end(t, i), self.start(t, j))
             + self.lambda * (self.nodes[i].p - self.nodes[j].p).max(0.0)
             + self.cross(i, j)
     }
@@ -116,17 +120,19 @@ impl PathProblem {
     fn cost_o(&self, i: usize, fi: bool, j: usize, fj: bool) -> f64 {
         let a = if fi { self.nodes[i].s } else { self.nodes[i].e };
         let b = if fj { self.nodes[j].e } else { self.nodes[j].s };
-        a.dist(b) + self.lambda * (self.nodes[i].p - self.nodes[j].p).max(0.0) + self.cross(i, j)
+        self.metric.between(a, b)
+            + self.lambda * (self.nodes[i].p - self.nodes[j].p).max(0.0)
+            + self.cross(i, j)
     }
     /// Total cost of a tour.
     pub fn tour_cost(&self, t: &Tour) -> f64 {
         t.order.windows(2).map(|w| self.cost(t, w[0], w[1])).sum()
     }
-    /// Idle distance of a tour (λ ignored).
+    /// Travel cost of a tour under the metric (λ and cluster penalties ignored).
     pub fn tour_distance(&self, t: &Tour) -> f64 {
         t.order
             .windows(2)
-            .map(|w| self.end(t, w[0]).dist(self.start(t, w[1])))
+            .map(|w| self.metric.between(self.end(t, w[0]), self.start(t, w[1])))
             .sum()
     }
 }

@@ -159,7 +159,7 @@ proptest! {
             .map(|i| if open_mask >> (i % 64) & 1 == 1 { Node { s: a[i], e: b[i], p: a[i].x } } else { Node::point(a[i], a[i].x) })
             .collect();
         let flippable: Vec<bool> = nodes.iter().map(|q| q.s != q.e).collect();
-        let prob = PathProblem { nodes, lambda, fixed_first, fixed_last, flippable, cluster: Vec::new(), cluster_penalty: 0.0 };
+        let prob = PathProblem { nodes, lambda, fixed_first, fixed_last, flippable, cluster: Vec::new(), cluster_penalty: 0.0, metric: Default::default() };
         let mut t = Tour { order: (0..n).collect(), flipped: vec![false; n] };
         let before = prob.tour_cost(&t);
         let c = local_search(&prob, &mut t, LsOptions::default(), &JobCtx::default()).unwrap();

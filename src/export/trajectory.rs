@@ -1,0 +1,61 @@
+//! The sampled stage + scanner trajectory (DESIGN.md, *Trajectory*): what a controller streams.
+
+use crate::motion::Toolpath;
+use std::fmt::Write;
+use thiserror::Error;
+
+/// CSV header of a trajectory file.
+pub const TRAJECTORY_HEADER: &str = "t_s,stage_x_mm,stage_y_mm,scan_x_mm,scan_y_mm,laser";
+
+/// Shortest sampling period accepted, s: below a microsecond the file of a minute's job holds
+/// 60 million rows.
+pub const MIN_PERIOD_S: f64 = 1e-6;
+
+/// Longest sampling period accepted, s: a controller clock slower than 100 ms cannot follow a
+/// scanner.
+pub const MAX_PERIOD_S: f64 = 0.1;
+
+/// An impossible sampling period.
+#[derive(Debug, Error, PartialEq)]
+#[error("trajectory period {period_ms} ms must lie between {} and {} ms", MIN_PERIOD_S * 1e3, MAX_PERIOD_S * 1e3)]
+pub struct PeriodError {
+    /// The period asked for, ms.
+    pub period_ms: f64,
+}
+
+/// Checks a sampling period given in ms; returns it in s.
+pub fn trajectory_period_s(period_ms: f64) -> Result<f64, PeriodError> {
+    let period_s = period_ms * 1e-3;
+    if period_s.is_finite() && (MIN_PERIOD_S..=MAX_PERIOD_S).contains(&period_s) {
+        Ok(period_s)
+    } else {
+        Err(PeriodError { period_ms })
+    }
+}
+
+/// Samples `toolpath` every `period_s` from t = 0 to its end (the last sample at or after the
+/// end): one CSV row per sample, tool-centre point = stage + scan, laser 0/1. Run the toolpath
+/// [`Toolpath::on_clock`] of the same period first so that every mark starts and ends on a
+/// sample.
+pub fn trajectory_csv(toolpath: &Toolpath, period_s: f64) -> String {
+    let end_s = toolpath.duration_s();
+    let samples = (end_s / period_s - 1e-9).ceil().max(0.0) as usize + 1;
+    let mut out = String::with_capacity(samples * 64);
+    out.push_str(TRAJECTORY_HEADER);
+    out.push('\n');
+    for k in 0..samples {
+        let t_s = k as f64 * period_s;
+        let m = toolpath.state_at(t_s);
+        let _ = writeln!(
+            out,
+            "{:.7},{:.6},{:.6},{:.6},{:.6},{}",
+            t_s,
+            m.stage.x,
+            m.stage.y,
+            m.scan.x,
+            m.scan.y,
+            u8::from(m.laser)
+        );
+    }
+    out
+}

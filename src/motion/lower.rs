@@ -1,0 +1,231 @@
+//! [`lower`]: the one place where a plan becomes machine motion.
+
+use super::axis::StageDynamics;
+use super::toolpath::{ScanMotion, Segment, SegmentKind, StageMotion, Toolpath};
+use crate::document::{Geometry, MachineProfile, Plan};
+use crate::geom::Pt;
+use thiserror::Error;
+
+/// How far a marked point may lie outside its field's reach before lowering refuses the plan,
+/// mm: the import's 10 nm grid and float sums of field centres stay far below it.
+pub const REACH_TOLERANCE_MM: f64 = 1e-6;
+
+/// Why a plan cannot be lowered.
+#[derive(Debug, Error, PartialEq)]
+pub enum LowerError {
+    /// A step names a geometry the document does not have.
+    #[error("plan step {step} names geometry {geometry}, which the document does not have")]
+    NoGeometry {
+        /// Step index in marking order.
+        step: usize,
+        /// The geometry index.
+        geometry: usize,
+    },
+    /// A step names a field the plan does not have.
+    #[error("plan step {step} names scan field {field}, which the plan does not have")]
+    NoField {
+        /// Step index in marking order.
+        step: usize,
+        /// The field id.
+        field: usize,
+    },
+    /// A geometry reaches outside its field.
+    #[error("geometry {geometry} reaches {excess_mm:.4} mm outside scan field {field}")]
+    OutOfReach {
+        /// The geometry index.
+        geometry: usize,
+        /// The field id.
+        field: usize,
+        /// How far beyond the field edge, mm.
+        excess_mm: f64,
+    },
+}
+
+/// Lowers a step-and-scan plan to the machine's motion.
+///
+/// The stage starts at rest at the first field's centre with the scanner at the first stroke's
+/// start (no homing move). Per stroke: a scanner jump (laser off, jump speed) and the jump delay,
+/// the laser-on delay, the mark (mark speed), the laser-off delay. On a field change the stage
+/// moves (both axes at once, trapezoids, the slower sets the time) and settles; the scanner jumps
+/// to the next start offset during the move when the jump and its delay fit in the move, after
+/// the settling otherwise. The job ends with the last laser-off delay.
+pub fn lower(
+    geometries: &[Geometry],
+    plan: &Plan,
+    profile: &MachineProfile,
+) -> Result<Toolpath, LowerError> {
+    let mut b = Builder::new(profile);
+    for (k, step) in plan.order.iter().enumerate() {
+        let g = geometries
+            .get(step.geometry)
+            .ok_or(LowerError::NoGeometry {
+                step: k,
+                geometry: step.geometry,
+            })?;
+        let field = plan
+            .fields
+            .iter()
+            .find(|f| f.id == step.field)
+            .ok_or(LowerError::NoField {
+                step: k,
+                field: step.field,
+            })?;
+        let path = g.marking_path(step.start_vertex, step.reversed);
+        check_reach(&path, field.center, field.size).map_err(|excess_mm| {
+            LowerError::OutOfReach {
+                geometry: step.geometry,
+                field: step.field,
+                excess_mm,
+            }
+        })?;
+        let Some(&start) = path.first() else {
+            continue;
+        };
+        b.go_to(field.center, start.minus(field.center), k == 0);
+        let stroke = b
+            .path
+            .push_stroke(k, step.geometry, step.field, field.center, &path);
+        b.mark(stroke);
+    }
+    Ok(b.path)
+}
+
+/// `Err(excess)` when a point lies outside the field of `size` centred at `center`.
+fn check_reach(path: &[Pt], center: Pt, size: [f64; 2]) -> Result<(), f64> {
+    let excess = path
+        .iter()
+        .map(|p| {
+            let o = p.minus(center);
+            (o.x.abs() - size[0] / 2.0).max(o.y.abs() - size[1] / 2.0)
+        })
+        .fold(f64::NEG_INFINITY, f64::max);
+    if excess > REACH_TOLERANCE_MM {
+        Err(excess)
+    } else {
+        Ok(())
+    }
+}
+
+/// Appends segments while tracking where the stage and scanner are.
+struct Builder<'a> {
+    profile: &'a MachineProfile,
+    stage: StageDynamics,
+    path: Toolpath,
+    t_s: f64,
+    stage_at: Pt,
+    scan_at: Pt,
+}
+
+impl<'a> Builder<'a> {
+    fn new(profile: &'a MachineProfile) -> Self {
+        Self {
+            profile,
+            stage: StageDynamics::of(profile),
+            path: Toolpath::default(),
+            t_s: 0.0,
+            stage_at: Pt::default(),
+            scan_at: Pt::default(),
+        }
+    }
+
+    fn push(&mut self, kind: SegmentKind, duration_s: f64, stage: StageMotion, scan: ScanMotion) {
+        self.path.segments.push(Segment {
+            kind,
+            start_s: self.t_s,
+            duration_s,
+            stage,
+            scan,
+        });
+        self.t_s += duration_s;
+    }
+
+    /// A pause with stage and scanner at rest (skipped when zero).
+    fn hold(&mut self, kind: SegmentKind, duration_s: f64) {
+        if duration_s > 0.0 {
+            let (stage, scan) = (self.stage_at, self.scan_at);
+            self.push(
+                kind,
+                duration_s,
+                StageMotion::Hold(stage),
+                ScanMotion::Hold(scan),
+            );
+        }
+    }
+
+    /// A scanner jump to `offset` and its delay, the stage at rest.
+    fn jump(&mut self, offset: Pt) {
+        let move_s = offset.dist(self.scan_at) / self.profile.scanner.jump_speed_mm_s;
+        if move_s > 0.0 {
+            let from = self.scan_at;
+            let stage = StageMotion::Hold(self.stage_at);
+            let scan = ScanMotion::Line {
+                from,
+                to: offset,
+                move_s,
+            };
+            self.push(SegmentKind::Jump, move_s, stage, scan);
+            self.scan_at = offset;
+        }
+        self.hold(SegmentKind::JumpDelay, self.profile.laser.jump_delay_s);
+    }
+
+    /// Brings the stage to `center` and the scanner to `offset` (the first stroke: places them).
+    fn go_to(&mut self, center: Pt, offset: Pt, first: bool) {
+        if first {
+            self.stage_at = center;
+            self.scan_at = offset;
+            return;
+        }
+        if center == self.stage_at {
+            self.jump(offset);
+            return;
+        }
+        let mv = self.stage.plan_move(self.stage_at, center);
+        let jump_s = offset.dist(self.scan_at) / self.profile.scanner.jump_speed_mm_s;
+        let hidden =
+            jump_s <= mv.move_s && jump_s + self.profile.laser.jump_delay_s <= mv.total_s();
+        let scan = if hidden {
+            ScanMotion::Line {
+                from: self.scan_at,
+                to: offset,
+                move_s: jump_s,
+            }
+        } else {
+            ScanMotion::Hold(self.scan_at)
+        };
+        self.push(
+            SegmentKind::StageMove,
+            mv.move_s,
+            StageMotion::Move(mv),
+            scan,
+        );
+        self.stage_at = center;
+        if hidden {
+            self.scan_at = offset;
+        }
+        self.hold(SegmentKind::Settle, mv.settle_s);
+        if !hidden {
+            self.jump(offset);
+        }
+    }
+
+    /// Marks stroke `stroke` from where the scanner stands: on delay, mark, off delay.
+    fn mark(&mut self, stroke: usize) {
+        let laser = &self.profile.laser;
+        let (on_s, off_s) = (laser.on_delay_s, laser.off_delay_s);
+        self.hold(SegmentKind::LaserOnDelay, on_s);
+        let length_mm = self.path.strokes[stroke].length_mm;
+        let duration_s = length_mm / self.profile.scanner.mark_speed_mm_s;
+        let stage = StageMotion::Hold(self.stage_at);
+        self.push(
+            SegmentKind::Mark,
+            duration_s,
+            stage,
+            ScanMotion::Mark { stroke },
+        );
+        if let Some(&end) = self.path.stroke_points(stroke).last() {
+            self.scan_at = end.minus(self.stage_at);
+        }
+        self.hold(SegmentKind::LaserOffDelay, off_s);
+    }
+}

@@ -1,0 +1,29 @@
+//! Motion: what the machine does and how long it takes.
+//!
+//! [`lower`] turns a plan into a [`Toolpath`], a sequence of timed [`Segment`]s (stage move,
+//! settle, scanner jump, jump delay, laser-on delay, mark, laser-off delay) from which the stage
+//! position, the scanner offset, the tool-centre point and the laser state are known at any
+//! instant ([`Toolpath::state_at`]). Every output reads the toolpath: the job time and its
+//! breakdown in the metrics, the G-code (both dialects), the SVG preview, the sampled trajectory
+//! and the GUI's canvas and playback. The ordering's time cost ([`StageDynamics::move_time_s`])
+//! is the same stage timing the lowering uses.
+//!
+//! Timing model (profile units):
+//! * stage: per axis a rest-to-rest trapezoid (or triangle) at the axis' velocity and
+//!   acceleration limits; both axes start together and the slower sets the move time (seed 002
+//!   §6.3); each axis that moved then settles for its `settle_s`;
+//! * scanner: jumps in a straight line at jump speed followed by the jump delay; marks at mark
+//!   speed between the laser-on and laser-off delays.
+
+mod axis;
+mod lower;
+mod toolpath;
+
+pub use axis::{AxisMove, StageDynamics, StageMove};
+pub use lower::{lower, LowerError, REACH_TOLERANCE_MM};
+pub use toolpath::{
+    MachineState, ScanMotion, Segment, SegmentKind, StageMotion, Stroke, Toolpath, TIME_EPS_S,
+};
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,341 @@
+//! The lowered toolpath: timed segments with the stage position, the scanner offset and the
+//! laser state known at any instant.
+
+use super::axis::StageMove;
+use crate::document::TimeBreakdown;
+use crate::geom::Pt;
+use std::ops::Range;
+
+/// Instants closer than this are the same instant (s): segment ends meet at sums of floats.
+pub const TIME_EPS_S: f64 = 1e-9;
+
+/// What a segment does (the job-time breakdown adds their durations by kind).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SegmentKind {
+    /// The stage moves to the next field (the scanner may jump to its next start meanwhile).
+    StageMove,
+    /// The stage settles after a move.
+    Settle,
+    /// The scanner jumps (laser off) at jump speed.
+    Jump,
+    /// The scanner settles after a jump.
+    JumpDelay,
+    /// Waiting at a mark's start before it (laser-on delay).
+    LaserOnDelay,
+    /// Marking at mark speed (laser on).
+    Mark,
+    /// Waiting at a mark's end after it (laser-off delay).
+    LaserOffDelay,
+}
+
+/// What the stage does during a segment.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum StageMotion {
+    /// At rest at a position (mm).
+    Hold(Pt),
+    /// A rest-to-rest move starting with the segment.
+    Move(StageMove),
+}
+
+/// What the scanner does during a segment; offsets are tool-centre point − stage, mm.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ScanMotion {
+    /// Holds an offset.
+    Hold(Pt),
+    /// Straight from one offset to another at constant speed over the first `move_s` of the
+    /// segment, then holds.
+    Line {
+        /// Offset at the segment's start.
+        from: Pt,
+        /// Offset reached after `move_s`.
+        to: Pt,
+        /// Duration of the straight move, s.
+        move_s: f64,
+    },
+    /// Marks stroke `stroke` of the toolpath at constant speed over the whole segment (the
+    /// stage holds, so the offset follows the stroke).
+    Mark {
+        /// Index into [`Toolpath::strokes`].
+        stroke: usize,
+    },
+}
+
+/// One timed piece of the job.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Segment {
+    /// What it does.
+    pub kind: SegmentKind,
+    /// Start time from the job's start, s.
+    pub start_s: f64,
+    /// Duration, s.
+    pub duration_s: f64,
+    /// Stage motion.
+    pub stage: StageMotion,
+    /// Scanner motion.
+    pub scan: ScanMotion,
+}
+
+impl Segment {
+    /// End time, s.
+    pub fn end_s(&self) -> f64 {
+        self.start_s + self.duration_s
+    }
+}
+
+/// One marked stroke: the tool-centre points in marking order.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Stroke {
+    /// Index of the plan step it marks.
+    pub step: usize,
+    /// Geometry index.
+    pub geometry: usize,
+    /// Field id.
+    pub field: usize,
+    /// Where the stage stands while it is marked, mm.
+    pub stage: Pt,
+    /// Its points in [`Toolpath`]'s point list.
+    pub points: Range<usize>,
+    /// Marked length, mm.
+    pub length_mm: f64,
+}
+
+/// The machine's state at an instant.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MachineState {
+    /// Stage position, mm.
+    pub stage: Pt,
+    /// Scanner offset (tool-centre point − stage), mm.
+    pub scan: Pt,
+    /// Laser on.
+    pub laser: bool,
+}
+
+impl MachineState {
+    /// The tool-centre point, mm.
+    pub fn tcp(&self) -> Pt {
+        self.stage.plus(self.scan)
+    }
+}
+
+/// A job as the machine runs it: contiguous segments from t = 0, and the marked strokes.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Toolpath {
+    /// Segments in time order; each starts where the previous one ends.
+    pub segments: Vec<Segment>,
+    /// Marked strokes in marking order.
+    pub strokes: Vec<Stroke>,
+    /// Tool-centre points of all strokes, concatenated.
+    points: Vec<Pt>,
+    /// Arc length from each stroke's first point to each point, mm (parallel to `points`).
+    arc_mm: Vec<f64>,
+}
+
+/// Ticks closer to a whole number than this are that whole number: segment durations are float
+/// sums, and a mark that fills exactly two ticks must not become three.
+const TICK_EPS: f64 = 1e-6;
+
+/// `t_s` rounded up to whole ticks of `period_s`.
+fn ceil_to_tick(t_s: f64, period_s: f64) -> f64 {
+    ((t_s / period_s - TICK_EPS).ceil()).max(0.0) * period_s
+}
+
+impl Toolpath {
+    /// Adds a stroke's points; returns its index.
+    pub(super) fn push_stroke(
+        &mut self,
+        step: usize,
+        geometry: usize,
+        field: usize,
+        stage: Pt,
+        path: &[Pt],
+    ) -> usize {
+        let first = self.points.len();
+        let mut arc = 0.0;
+        for (k, &p) in path.iter().enumerate() {
+            if k > 0 {
+                arc += p.dist(path[k - 1]);
+            }
+            self.points.push(p);
+            self.arc_mm.push(arc);
+        }
+        self.strokes.push(Stroke {
+            step,
+            geometry,
+            field,
+            stage,
+            points: first..self.points.len(),
+            length_mm: arc,
+        });
+        self.strokes.len() - 1
+    }
+
+    /// The same job run on a controller clock of `period_s`, where the laser can switch only on
+    /// a tick: each mark starts on a tick (the wait before it, at its start with the laser off,
+    /// grows to the next tick) and lasts whole ticks (marked slightly slower when its length at
+    /// mark speed is not whole ticks); between two marks at least one tick has the laser off.
+    /// Everything else keeps its timing. A sampled trajectory at that period then holds every
+    /// mark's start and end point, and never shows a jump as a mark.
+    pub fn on_clock(&self, period_s: f64) -> Toolpath {
+        let mut out = Toolpath {
+            segments: Vec::with_capacity(self.segments.len() + self.strokes.len()),
+            strokes: self.strokes.clone(),
+            points: self.points.clone(),
+            arc_mm: self.arc_mm.clone(),
+        };
+        let mut t_s = 0.0;
+        let mut last_mark_end_s = f64::NEG_INFINITY;
+        for seg in &self.segments {
+            if seg.kind != SegmentKind::Mark {
+                out.segments.push(Segment {
+                    start_s: t_s,
+                    ..*seg
+                });
+                t_s += seg.duration_s;
+                continue;
+            }
+            // one laser-off tick between two marks: the sample after a mark's end is off
+            let start_s = ceil_to_tick(t_s, period_s).max(last_mark_end_s + 2.0 * period_s);
+            if start_s > t_s {
+                let at_start = self.state_in(seg, seg.start_s);
+                out.segments.push(Segment {
+                    kind: SegmentKind::LaserOnDelay,
+                    start_s: t_s,
+                    duration_s: start_s - t_s,
+                    stage: StageMotion::Hold(at_start.stage),
+                    scan: ScanMotion::Hold(at_start.scan),
+                });
+            }
+            let duration_s = ceil_to_tick(seg.duration_s, period_s);
+            out.segments.push(Segment {
+                start_s,
+                duration_s,
+                ..*seg
+            });
+            t_s = start_s + duration_s;
+            last_mark_end_s = t_s;
+        }
+        out
+    }
+
+    /// The tool-centre points of stroke `k` in marking order.
+    pub fn stroke_points(&self, k: usize) -> &[Pt] {
+        self.strokes
+            .get(k)
+            .map_or(&[][..], |s| &self.points[s.points.clone()])
+    }
+
+    /// Total duration, s.
+    pub fn duration_s(&self) -> f64 {
+        self.segments.last().map_or(0.0, Segment::end_s)
+    }
+
+    /// Durations added up by kind.
+    pub fn breakdown(&self) -> TimeBreakdown {
+        let mut b = TimeBreakdown::default();
+        for s in &self.segments {
+            let slot = match s.kind {
+                SegmentKind::StageMove => &mut b.stage,
+                SegmentKind::Settle => &mut b.settle,
+                SegmentKind::Jump | SegmentKind::JumpDelay => &mut b.jump,
+                SegmentKind::Mark => &mut b.mark,
+                SegmentKind::LaserOnDelay | SegmentKind::LaserOffDelay => &mut b.laser_delays,
+            };
+            *slot += s.duration_s;
+        }
+        b
+    }
+
+    /// The index of the segment running at `t_s` (the last one starting at or before it;
+    /// clamped to the job).
+    pub fn segment_at(&self, t_s: f64) -> usize {
+        self.segments
+            .partition_point(|s| s.start_s <= t_s)
+            .saturating_sub(1)
+    }
+
+    /// The machine's state at `t_s` (clamped to the job). An instant where a mark begins or
+    /// ends belongs to the mark, laser on.
+    pub fn state_at(&self, t_s: f64) -> MachineState {
+        let Some(last) = self.segments.len().checked_sub(1) else {
+            return MachineState {
+                stage: Pt::default(),
+                scan: Pt::default(),
+                laser: false,
+            };
+        };
+        let k = self.segment_at(t_s);
+        let on_mark = |i: usize| {
+            self.segments.get(i).is_some_and(|s| {
+                s.kind == SegmentKind::Mark
+                    && t_s >= s.start_s - TIME_EPS_S
+                    && t_s <= s.end_s() + TIME_EPS_S
+            })
+        };
+        let k = if on_mark(k) {
+            k
+        } else if k > 0 && on_mark(k - 1) {
+            k - 1
+        } else if k < last && on_mark(k + 1) {
+            k + 1
+        } else {
+            k
+        };
+        self.state_in(&self.segments[k], t_s)
+    }
+
+    fn state_in(&self, seg: &Segment, t_s: f64) -> MachineState {
+        let local_s = (t_s - seg.start_s).clamp(0.0, seg.duration_s);
+        let stage = match &seg.stage {
+            StageMotion::Hold(p) => *p,
+            StageMotion::Move(m) => m.position(local_s),
+        };
+        let (scan, laser) = match seg.scan {
+            ScanMotion::Hold(o) => (o, false),
+            ScanMotion::Line { from, to, move_s } => {
+                let u = if move_s > 0.0 {
+                    (local_s / move_s).min(1.0)
+                } else {
+                    1.0
+                };
+                (from.plus(to.minus(from).scale(u)), false)
+            }
+            ScanMotion::Mark { stroke } => {
+                let u = if seg.duration_s > 0.0 {
+                    local_s / seg.duration_s
+                } else {
+                    1.0
+                };
+                (self.point_along(stroke, u).minus(stage), true)
+            }
+        };
+        MachineState { stage, scan, laser }
+    }
+
+    /// The point at fraction `u` (0..=1) of stroke `k`'s length.
+    fn point_along(&self, k: usize, u: f64) -> Pt {
+        let Some(s) = self.strokes.get(k) else {
+            return Pt::default();
+        };
+        let pts = &self.points[s.points.clone()];
+        let arc = &self.arc_mm[s.points.clone()];
+        let Some(&first) = pts.first() else {
+            return Pt::default();
+        };
+        let target = u.clamp(0.0, 1.0) * s.length_mm;
+        // first point whose arc length reaches the target
+        let j = arc.partition_point(|&a| a < target);
+        if j == 0 {
+            return first;
+        }
+        if j >= pts.len() {
+            return pts[pts.len() - 1];
+        }
+        let span = arc[j] - arc[j - 1];
+        let w = if span > 0.0 {
+            (target - arc[j - 1]) / span
+        } else {
+            1.0
+        };
+        pts[j - 1].plus(pts[j].minus(pts[j - 1]).scale(w))
+    }
+}

@@ -1,0 +1,259 @@
+//! The motion layer end to end: one lowered toolpath behind the G-code dialects, the sampled
+//! trajectory and the job time; time-based ordering against distance and the document order;
+//! profile versions.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+mod common;
+
+use galvoplan::document::{
+    Algo, CostModel, Document, GcodeMode, MachineProfile, Plan, SolverSettings,
+};
+use galvoplan::export::{trajectory_csv, write_gcode, TRAJECTORY_HEADER};
+use galvoplan::geom::{point_segment_dist, Pt};
+use galvoplan::import::ImportOptions;
+use galvoplan::job::JobCtx;
+use galvoplan::motion::Toolpath;
+use galvoplan::pipeline::{load_svg, lower_plan, plan_document};
+
+fn plan_example(name: &str, profile: MachineProfile, settings: SolverSettings) -> (Document, Plan) {
+    let path = common::root().join("assets/examples").join(name);
+    let (mut doc, _) = load_svg(&path, profile, settings, &ImportOptions::default()).unwrap();
+    let plan = plan_document(&mut doc, &JobCtx::default()).unwrap();
+    common::check_plan(&doc, &plan);
+    (doc, plan)
+}
+
+/// The marks of a G-code file as tool-centre polylines. `scanner` names the scanner axis words
+/// of a stage-scanner file (the tool point is then stage X/Y + scanner offset); `None` reads a
+/// tool-centre file.
+fn gcode_marks(gcode: &str, scanner: Option<[&str; 2]>) -> Vec<Vec<Pt>> {
+    let (mut stage, mut scan, mut tcp) = (Pt::default(), Pt::default(), Pt::default());
+    let (mut on, mut marks) = (false, Vec::<Vec<Pt>>::new());
+    for line in gcode.lines().filter(|l| !l.starts_with(';')) {
+        let words: Vec<&str> = line.split_whitespace().collect();
+        match words.first().copied() {
+            Some("M3") | Some("M4") => {
+                on = true;
+                marks.push(vec![stage.plus(scan).plus(tcp)]);
+                continue;
+            }
+            Some("M5") => {
+                on = false;
+                continue;
+            }
+            _ => {}
+        }
+        for w in &words[1..] {
+            let (axis, value) = w.split_at(1);
+            let Ok(v) = value.parse::<f64>() else {
+                continue;
+            };
+            match (axis, scanner) {
+                ("X", Some(_)) => stage.x = v,
+                ("Y", Some(_)) => stage.y = v,
+                ("X", None) => tcp.x = v,
+                ("Y", None) => tcp.y = v,
+                (a, Some([u, _])) if a == u => scan.x = v,
+                (a, Some([_, w])) if a == w => scan.y = v,
+                _ => {}
+            }
+        }
+        if on && words[0] == "G1" {
+            marks.last_mut().unwrap().push(stage.plus(scan).plus(tcp));
+        }
+    }
+    marks
+}
+
+fn same_marks(a: &[Vec<Pt>], b: &[Vec<Pt>], tol_mm: f64) {
+    assert_eq!(a.len(), b.len(), "mark count");
+    for (k, (p, q)) in a.iter().zip(b).enumerate() {
+        assert_eq!(p.len(), q.len(), "mark {k}: point count");
+        for (x, y) in p.iter().zip(q) {
+            assert!(x.dist(*y) <= tol_mm, "mark {k}: {x:?} vs {y:?}");
+        }
+    }
+}
+
+#[test]
+fn stage_scanner_gcode_marks_what_the_tcp_gcode_marks() {
+    for flip in [false, true] {
+        let mut profile = MachineProfile::default();
+        profile.gcode.flip_y = flip;
+        let (doc, plan) = plan_example("demo.svg", profile, SolverSettings::default());
+        let toolpath = lower_plan(&doc, &plan).unwrap();
+        let tcp = write_gcode(&toolpath, &plan, &doc.profile, doc.page_mm[1], "t");
+        let mut p2 = doc.profile.clone();
+        p2.gcode.mode = GcodeMode::StageScanner;
+        p2.gcode.scanner_axes = ["A".into(), "B".into()];
+        let split = write_gcode(&toolpath, &plan, &p2, doc.page_mm[1], "t");
+        assert!(
+            split.contains("G0 A") && split.contains("G1 A"),
+            "scanner words"
+        );
+        let (a, b) = (
+            gcode_marks(&tcp, None),
+            gcode_marks(&split, Some(["A", "B"])),
+        );
+        assert_eq!(a.len(), plan.order.len());
+        // both are written with 4 decimals: stage + offset rounds twice
+        same_marks(&a, &b, 2e-4);
+        // in stage-scanner mode every scanner word stays inside the field
+        for line in split
+            .lines()
+            .filter(|l| l.starts_with("G1") || l.starts_with("G0 A"))
+        {
+            for w in line
+                .split_whitespace()
+                .filter(|w| w.starts_with('A') || w.starts_with('B'))
+            {
+                let v: f64 = w[1..].parse().unwrap();
+                assert!(v.abs() <= 35.0 + 1e-4, "{line}");
+            }
+        }
+    }
+}
+
+/// Laser-on rows of a trajectory CSV as tool-centre points.
+fn laser_on_points(csv: &str, period_s: f64) -> Vec<Pt> {
+    let mut lines = csv.lines();
+    assert_eq!(lines.next(), Some(TRAJECTORY_HEADER));
+    let mut out = Vec::new();
+    for (k, line) in lines.enumerate() {
+        let v: Vec<f64> = line.split(',').map(|x| x.parse().unwrap()).collect();
+        assert_eq!(v.len(), 6);
+        assert!((v[0] - k as f64 * period_s).abs() < 1e-6, "constant period");
+        if v[5] == 1.0 {
+            out.push(Pt::new(v[1] + v[3], v[2] + v[4]));
+        }
+    }
+    out
+}
+
+#[test]
+fn trajectory_marks_the_gcode_path() {
+    let (doc, plan) = plan_example(
+        "demo.svg",
+        MachineProfile::default(),
+        SolverSettings::default(),
+    );
+    let toolpath = lower_plan(&doc, &plan).unwrap();
+    let marks = gcode_marks(
+        &write_gcode(&toolpath, &plan, &doc.profile, doc.page_mm[1], "t"),
+        None,
+    );
+    let period_s = 1e-3;
+    let clocked = toolpath.on_clock(period_s);
+    let on = laser_on_points(&trajectory_csv(&clocked, period_s), period_s);
+    assert!(!on.is_empty());
+    let on_gcode_path = |p: Pt| {
+        marks.iter().any(|m| {
+            m.windows(2)
+                .any(|w| point_segment_dist(p, w[0], w[1]) < 1e-3)
+        })
+    };
+    // every laser-on sample lies on a G-code mark ...
+    assert!(on.iter().all(|&p| on_gcode_path(p)));
+    // ... and every G-code mark's ends are laser-on samples
+    for m in &marks {
+        for end in [m[0], m[m.len() - 1]] {
+            // the G-code rounds to 4 decimals
+            assert!(on.iter().any(|p| p.dist(end) < 1e-4), "{end:?} not sampled");
+        }
+    }
+}
+
+fn job_time(doc: &Document, plan: &Plan) -> f64 {
+    let toolpath: Toolpath = lower_plan(doc, plan).unwrap();
+    assert_eq!(plan.metrics.job_time_s, Some(toolpath.duration_s()));
+    let b = plan.metrics.job_time_breakdown_s.unwrap();
+    assert!((b.total() - toolpath.duration_s()).abs() < 1e-9);
+    toolpath.duration_s()
+}
+
+#[test]
+fn time_cost_is_never_slower_than_distance_and_as_is_is_slowest() {
+    for example in ["demo.svg", "oversize.svg"] {
+        let settings = |algo, cost_model| SolverSettings {
+            algo,
+            cost_model,
+            split_oversize: true,
+            ..SolverSettings::default()
+        };
+        let time = |algo, cost| {
+            let (doc, plan) =
+                plan_example(example, MachineProfile::default(), settings(algo, cost));
+            job_time(&doc, &plan)
+        };
+        let by_time = time(Algo::Hha, CostModel::Time);
+        let by_distance = time(Algo::Hha, CostModel::Distance);
+        let as_is = time(Algo::AsIs, CostModel::Time);
+        assert!(
+            by_time <= by_distance,
+            "{example}: {by_time} > {by_distance}"
+        );
+        assert!(as_is > by_time, "{example}: as-is {as_is} vs {by_time}");
+    }
+}
+
+#[test]
+fn time_cost_orders_fields_on_stage_time() {
+    // slow y axis: moving along y costs ten times more than along x, so the time plan visits the
+    // fields row by row where a distance plan does not care
+    let mut profile = MachineProfile::default();
+    profile.axis_y.max_velocity_mm_s = 50.0;
+    profile.axis_y.max_accel_mm_s2 = 500.0;
+    let run = |cost_model| {
+        let settings = SolverSettings {
+            cost_model,
+            ..SolverSettings::default()
+        };
+        let (doc, plan) = plan_example("demo.svg", profile.clone(), settings);
+        (lower_plan(&doc, &plan).unwrap().breakdown().stage, plan)
+    };
+    let (stage_time, plan_t) = run(CostModel::Time);
+    let (stage_distance, plan_d) = run(CostModel::Distance);
+    assert!(
+        stage_time < stage_distance,
+        "{stage_time} vs {stage_distance}"
+    );
+    assert_ne!(
+        plan_t.fields.iter().map(|f| f.id).collect::<Vec<_>>(),
+        plan_d.fields.iter().map(|f| f.id).collect::<Vec<_>>()
+    );
+}
+
+#[test]
+fn version_1_profiles_upgrade() {
+    let path = common::root().join("tests/data/profiles/v1-seed000.toml");
+    let old = MachineProfile::load(path.to_str().unwrap()).unwrap();
+    let current = MachineProfile::builtin("seed000").unwrap();
+    assert_eq!(old, current);
+    assert_eq!(old.version, galvoplan::document::PROFILE_VERSION);
+    assert_eq!(old.axis_x.settle_s, 0.0);
+    assert_eq!(old.gcode.mode, GcodeMode::Tcp);
+}
+
+#[test]
+fn profile_errors_name_the_value() {
+    let both = "version = 2\n[axis_x]\nmax_accel_mm_s2 = 100.0\nramp_s = 0.2\n";
+    let e = MachineProfile::from_toml(both, "p.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("p.toml") && e.contains("not both"), "{e}");
+    let bad_ramp = "version = 2\n[axis_y]\nramp_s = 0.0\n";
+    let e = MachineProfile::from_toml(bad_ramp, "p.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("ramp_s"), "{e}");
+    let settle = "version = 2\n[axis_y]\nsettle_s = -1.0\n";
+    let e = MachineProfile::from_toml(settle, "p.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("axis_y.settle_s"), "{e}");
+    let axes = "version = 2\n[gcode]\nmode = \"stage-scanner\"\nscanner_axes = [\"X\", \"V\"]\n";
+    let e = MachineProfile::from_toml(axes, "p.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("scanner_axes"), "{e}");
+}
