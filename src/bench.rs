@@ -66,8 +66,10 @@ pub struct BenchRow {
     pub marked_mm: f64,
     /// Direction changes.
     pub direction_changes: Stat,
-    /// Estimated job time, s.
+    /// Job time (the lowered toolpath's duration), s.
     pub job_time_s: Stat,
+    /// Stage moves and settling in the job time, s.
+    pub stage_time_s: Stat,
     /// Import, ms.
     pub import_ms: f64,
     /// Field placement, ms.
@@ -123,7 +125,7 @@ pub fn run_instance(
     ctx: &JobCtx,
 ) -> Result<BenchRow, PipelineError> {
     let mut times: [Vec<f64>; 5] = Default::default();
-    let mut quality: [Vec<f64>; 6] = Default::default();
+    let mut quality: [Vec<f64>; 7] = Default::default();
     let (mut geometries, mut marked_mm, mut lower) = (0, 0.0, None);
     for k in 0..seeds.max(1) {
         let mut s = settings.clone();
@@ -149,13 +151,15 @@ pub fn run_instance(
             }
             if r == 0 {
                 let m = &plan.metrics;
+                let b = toolpath.breakdown();
                 for (v, x) in quality.iter_mut().zip([
                     m.fields as f64,
                     m.overlap_pct,
                     m.idle_mm,
                     m.base_mm,
                     m.direction_changes as f64,
-                    m.job_time_s.unwrap_or(0.0),
+                    toolpath.duration_s(),
+                    b.stage + b.settle,
                 ]) {
                     v.push(x);
                 }
@@ -166,7 +170,7 @@ pub fn run_instance(
         }
     }
     let [mut a, mut b, mut c, mut d, mut e] = times;
-    let [f, o, i, bm, dc, jt] = quality;
+    let [f, o, i, bm, dc, jt, st] = quality;
     Ok(BenchRow {
         instance: path
             .file_stem()
@@ -182,6 +186,7 @@ pub fn run_instance(
         marked_mm,
         direction_changes: Stat::of(&dc),
         job_time_s: Stat::of(&jt),
+        stage_time_s: Stat::of(&st),
         import_ms: median(&mut a),
         fields_ms: median(&mut b),
         order_ms: median(&mut c),
@@ -193,12 +198,12 @@ pub fn run_instance(
 /// Formats rows as a Markdown table (quality as mean ± sd when several seeds ran).
 pub fn format_table(rows: &[BenchRow]) -> String {
     let mut s = String::from(
-        "| instance | geometries | fields | LB | overlap % | idle mm | base mm | marked mm | dir. changes | job s | import ms | fields ms | order ms | export ms | total ms |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "| instance | geometries | fields | LB | overlap % | idle mm | base mm | marked mm | dir. changes | job s | stage s | import ms | fields ms | order ms | export ms | total ms |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
         let sd = r.seeds > 1;
         s.push_str(&format!(
-            "| {} | {} | {} | {} | {} | {} | {} | {:.1} | {} | {} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} |\n",
+            "| {} | {} | {} | {} | {} | {} | {} | {:.1} | {} | {} | {} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} |\n",
             r.instance,
             r.geometries,
             r.fields.show(if sd { 1 } else { 0 }, sd),
@@ -209,6 +214,7 @@ pub fn format_table(rows: &[BenchRow]) -> String {
             r.marked_mm,
             r.direction_changes.show(if sd { 1 } else { 0 }, sd),
             r.job_time_s.show(2, sd),
+            r.stage_time_s.show(2, sd),
             r.import_ms,
             r.fields_ms,
             r.order_ms,

@@ -164,3 +164,64 @@ fn bench_prints_a_row_per_instance() {
         serde_json::from_str(&std::fs::read_to_string(json).unwrap()).unwrap();
     assert!(rows[0]["idle_mm"]["mean"].as_f64().unwrap() > 0.0);
 }
+
+#[test]
+fn plan_writes_a_trajectory_whose_duration_is_the_reported_job_time() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = |n: &str| dir.path().join(n).display().to_string();
+    let demo = common::root()
+        .join("assets/examples/demo.svg")
+        .display()
+        .to_string();
+    let run = |period: &str, cost: &str| {
+        galvoplan(&[
+            "plan",
+            &demo,
+            "-o",
+            &d("job.gcode"),
+            "--report",
+            &d("job.json"),
+            "--trajectory",
+            &d("job.csv"),
+            "--trajectory-period-ms",
+            period,
+            "--cost",
+            cost,
+        ])
+    };
+    let out = run("0.5", "time");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let csv = std::fs::read_to_string(d("job.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(
+        lines.next(),
+        Some("t_s,stage_x_mm,stage_y_mm,scan_x_mm,scan_y_mm,laser")
+    );
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows[0][0], 0.0);
+    assert!((rows[1][0] - 0.0005).abs() < 1e-9, "period 0.5 ms");
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d("job.json")).unwrap()).unwrap();
+    let job_s = report["metrics"]["job_time_s"].as_f64().unwrap();
+    let last_s = rows[rows.len() - 1][0];
+    assert!(last_s >= job_s - 1e-9 && last_s < job_s + 0.0005 + 1e-9);
+    let parts = &report["metrics"]["job_time_breakdown_s"];
+    let sum: f64 = ["stage", "settle", "jump", "mark", "laser_delays"]
+        .iter()
+        .map(|k| parts[k].as_f64().unwrap())
+        .sum();
+    assert!((sum - job_s).abs() < 1e-6);
+    // an impossible period is refused before any work, naming the flag's value
+    let out = run("0", "time");
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("trajectory period 0 ms"), "{err}");
+    let out = run("1", "nonsense");
+    assert!(!out.status.success());
+}
