@@ -120,6 +120,16 @@ impl BucketGrid {
         }
     }
 
+    /// Unregisters `id` from the cells of the box it was inserted with.
+    pub(crate) fn remove(&mut self, id: usize, x: Range1, y: Range1) {
+        let cells: Vec<usize> = self.cells_of(x, y).collect();
+        for k in cells {
+            if let Some(p) = self.buckets[k].iter().position(|&q| q == id) {
+                self.buckets[k].swap_remove(p);
+            }
+        }
+    }
+
     /// Items registered in cell `id`.
     pub(crate) fn bucket(&self, id: usize) -> &[usize] {
         &self.buckets[id]
@@ -174,18 +184,26 @@ mod tests {
             for (i, b) in boxes.iter().enumerate() {
                 g.insert(i, b.0, b.1);
             }
+            // moving some of them keeps the answers right
+            for i in (0..boxes.len()).step_by(7) {
+                g.remove(i, boxes[i].0, boxes[i].1);
+            }
+            let live = |i: usize| i % 7 != 0;
             let mut out = Vec::new();
             for _ in 0..200 {
                 let (x, y) = (coord(&mut rng), coord(&mut rng));
                 let q = ((x, x + rng.random_range(0..10) as f64), (y, y));
                 g.query(q.0, q.1, &mut out);
-                let brute: Vec<usize> = (0..boxes.len()).filter(|&i| meets(boxes[i], q)).collect();
+                let brute: Vec<usize> = (0..boxes.len())
+                    .filter(|&i| live(i) && meets(boxes[i], q))
+                    .collect();
                 let found: Vec<usize> = out
                     .iter()
                     .copied()
                     .filter(|&i| meets(boxes[i], q))
                     .collect();
                 assert_eq!(found, brute, "round {round}");
+                assert!(out.iter().all(|&i| live(i)));
             }
         }
     }
