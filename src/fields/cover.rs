@@ -66,9 +66,19 @@ impl FRect {
     }
 }
 
-/// An empty grid over the rectangles `rects[ids]`, with cells as large as the largest of them
-/// (so that each rectangle touches at most 2 × 2 cells).
-fn grid_for(rects: &[FRect], ids: impl Iterator<Item = usize>) -> BucketGrid {
+/// Cell side of the greedy piercing's grid, in sides of the largest rectangle: a field's
+/// rectangles share a point, so they touch at most 2 × 2 cells, and on instances with few
+/// fields per stroke the grid has so few cells that the sweep per cell costs about what one
+/// sweep over all rectangles did.
+const GREEDY_CELL_PER_RECT: f64 = 2.0;
+
+/// Fewest cells worth a grid in the greedy piercing; below, one cell (a sweep over all
+/// remaining rectangles per field, as without the grid).
+const GREEDY_MIN_CELLS: usize = 64;
+
+/// An empty grid over the rectangles `rects[ids]`, with cells `scale` times as large as the
+/// largest of them (so that each rectangle touches at most 2 × 2 cells).
+fn grid_for(rects: &[FRect], ids: impl Iterator<Item = usize>, scale: f64) -> BucketGrid {
     let (mut x, mut y) = (
         (f64::INFINITY, f64::NEG_INFINITY),
         (f64::INFINITY, f64::NEG_INFINITY),
@@ -81,7 +91,7 @@ fn grid_for(rects: &[FRect], ids: impl Iterator<Item = usize>) -> BucketGrid {
         cell_mm[0] = cell_mm[0].max((r.x.hi - r.x.lo).abs());
         cell_mm[1] = cell_mm[1].max((r.y.hi - r.y.lo).abs());
     }
-    BucketGrid::new(x, y, cell_mm)
+    BucketGrid::new(x, y, [cell_mm[0] * scale, cell_mm[1] * scale])
 }
 
 /// A group of geometries sharing one field, with the rectangle of centres that covers them all.
@@ -330,6 +340,18 @@ impl Eq for CellBest {}
 /// The deepest point is kept per grid cell and recomputed only in the cells whose rectangles
 /// changed; the groups are exactly [`greedy_reference`]'s.
 fn greedy(rects: &[FRect], active: Vec<usize>, ctx: &JobCtx) -> Result<Vec<Group>, Cancelled> {
+    greedy_on_grid(rects, active, GREEDY_CELL_PER_RECT, GREEDY_MIN_CELLS, ctx)
+}
+
+/// [`greedy`] with cells `cell_per_rect` times the largest rectangle, or one cell when that
+/// makes fewer than `min_cells`.
+fn greedy_on_grid(
+    rects: &[FRect],
+    active: Vec<usize>,
+    cell_per_rect: f64,
+    min_cells: usize,
+    ctx: &JobCtx,
+) -> Result<Vec<Group>, Cancelled> {
     let total = active.len();
     let mut alive = vec![false; rects.len()];
     let mut rank = vec![0usize; rects.len()];
@@ -341,7 +363,11 @@ fn greedy(rects: &[FRect], active: Vec<usize>, ctx: &JobCtx) -> Result<Vec<Group
         alive[i] = true;
         rank[i] = k;
     }
-    let mut grid = grid_for(rects, active.iter().copied());
+    let mut grid = grid_for(rects, active.iter().copied(), cell_per_rect);
+    if grid.len() < min_cells {
+        // rectangles touching several of a few cells would be swept several times over
+        grid = BucketGrid::single();
+    }
     for &i in &active {
         grid.insert(i, rects[i].x_range(), rects[i].y_range());
     }
@@ -492,10 +518,9 @@ fn group_rect(rects: &[FRect], members: &[usize]) -> Option<FRect> {
 /// rectangle keeps the most room with it, the first such group on ties. The groups a member
 /// can join are looked up in a grid over the group rectangles (which only shrink here).
 fn eliminate(rects: &[FRect], groups: &mut Vec<Group>, ctx: &JobCtx) -> Result<(), Cancelled> {
-    let mut grid = grid_for(
-        &groups.iter().map(|g| g.rect).collect::<Vec<_>>(),
-        0..groups.len(),
-    );
+    // cells of the members' size: a member's look-up touches at most 2 × 2 of them
+    let members = groups.iter().flat_map(|g| g.members.iter().copied());
+    let mut grid = grid_for(rects, members, 1.0);
     for (h, g) in groups.iter().enumerate() {
         grid.insert(h, g.rect.x_range(), g.rect.y_range());
     }
@@ -592,7 +617,7 @@ pub fn cover(rects: &[FRect], active: Vec<usize>, ctx: &JobCtx) -> Result<Vec<Gr
 /// no two of which meet (greedy, in two orders; the larger set counts). The rectangles already
 /// chosen are looked up in a grid.
 pub fn lower_bound(rects: &[FRect]) -> usize {
-    let empty = grid_for(rects, 0..rects.len());
+    let empty = grid_for(rects, 0..rects.len(), 1.0);
     let pick = |order: &[usize]| -> usize {
         let mut grid = empty.clone();
         let mut chosen: Vec<FRect> = Vec::new();
@@ -813,8 +838,12 @@ mod tests {
             for k in (1..active.len()).rev() {
                 active.swap(k, rng.random_range(0..=k));
             }
-            let fast = greedy(&rects, active.clone(), &ctx).unwrap();
             let slow = greedy_reference(&rects, active.clone(), &ctx).unwrap();
+            for (scale, min_cells) in [(0.5, 0), (1.0, 0), (3.0, 0)] {
+                let on_grid = greedy_on_grid(&rects, active.clone(), scale, min_cells, &ctx);
+                assert_eq!(on_grid.unwrap(), slow, "round {round}, cells {scale}");
+            }
+            let fast = greedy(&rects, active.clone(), &ctx).unwrap();
             assert_eq!(fast, slow, "round {round}");
             let (mut fast, mut slow) = (fast, slow);
             eliminate(&rects, &mut fast, &ctx).unwrap();

@@ -70,6 +70,11 @@ impl BucketGrid {
         }
     }
 
+    /// A grid of one cell holding everything.
+    pub(crate) fn single() -> Self {
+        BucketGrid::new((0.0, 0.0), (0.0, 0.0), [1.0, 1.0])
+    }
+
     /// Column of `x` (monotone in `x`).
     pub(crate) fn col(&self, x: f64) -> usize {
         Self::index(x, self.x0, self.cell_x_mm, self.nx)
