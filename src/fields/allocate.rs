@@ -5,7 +5,7 @@
 //! are marked together; when none of its fields holds anything yet, the field with the nearest
 //! centre. A uniform grid over the allocated centroids keeps the nearest search local.
 
-use super::grid::{expand, BucketGrid};
+use super::grid::{expand, BucketGrid, SCAN_MAX_ITEMS};
 use super::INSIDE_EPS_MM;
 use crate::document::{Geometry, ScanField};
 use crate::geom::{BBox, Pt};
@@ -76,11 +76,22 @@ impl Grid {
 /// Margin of the field look-up, mm (well above [`INSIDE_EPS_MM`]).
 const LOOKUP_MARGIN_MM: f64 = 1e-6;
 
-/// Fields (slots into `fields`, ascending) holding each geometry wholly. The fields that may
-/// hold a geometry are looked up in a grid over the field squares (by the geometry's
-/// bounding-box corner); every field is checked only for a geometry without a finite box.
+/// Fields (slots into `fields`, ascending) holding each geometry wholly. With many fields, the
+/// fields that may hold a geometry are looked up in a grid over the field squares (by the
+/// geometry's bounding-box corner); a geometry without a finite box checks every field.
 pub fn holders(geometries: &[Geometry], fields: &[ScanField]) -> Vec<Vec<usize>> {
     let boxes: Vec<BBox> = fields.iter().map(ScanField::bbox).collect();
+    if boxes.len() <= SCAN_MAX_ITEMS {
+        return geometries
+            .iter()
+            .map(|g| {
+                let b = g.bbox();
+                (0..boxes.len())
+                    .filter(|&k| boxes[k].contains_box(&b, INSIDE_EPS_MM))
+                    .collect()
+            })
+            .collect();
+    }
     let bounds = boxes.iter().fold(BBox::EMPTY, |acc, b| acc.union(*b));
     let cell_mm = fields.iter().fold([0.0f64; 2], |acc, f| {
         [acc[0].max(f.size[0]), acc[1].max(f.size[1])]
@@ -210,7 +221,7 @@ mod tests {
                 })
                 .collect();
             gs.push(Geometry::new(Vec::new(), false, Default::default()));
-            let mut fs: Vec<ScanField> = (0..60)
+            let mut fs: Vec<ScanField> = (0..rng.random_range(1..150))
                 .map(|k| field(k, c(&mut rng), c(&mut rng)))
                 .collect();
             for fl in &mut fs {

@@ -16,7 +16,7 @@
 //! 3. a lower bound: rectangles that pairwise do not meet need one field each (a greedy maximal
 //!    set of such rectangles, taken in two orders, the larger counts).
 
-use super::grid::{expand, BucketGrid, Range1};
+use super::grid::{expand, BucketGrid, Range1, SCAN_MAX_ITEMS};
 use super::reach::Span;
 use crate::job::{Cancelled, JobCtx};
 use std::cmp::Ordering;
@@ -398,7 +398,6 @@ fn greedy_on_grid(
     let mut groups = Vec::new();
     let mut left = total;
     let mut first = 0;
-    let mut near = Vec::new();
     let mut dirty = Vec::new();
     let mut is_dirty = vec![false; cells];
     while left > 0 {
@@ -413,17 +412,22 @@ fn greedy_on_grid(
                 None => break (0.0, 0.0),
             }
         };
-        grid.query(
+        let mut hit: Vec<usize> = Vec::new();
+        let cells_near = grid.cells_of(
             expand((x, x), LOOKUP_MARGIN_MM),
             expand((y, y), LOOKUP_MARGIN_MM),
-            &mut near,
         );
-        let mut hit: Vec<usize> = near
-            .iter()
-            .copied()
-            .filter(|&i| alive[i] && rects[i].contains(x, y))
-            .collect();
+        for cell in cells_near {
+            hit.extend(
+                grid.bucket(cell)
+                    .iter()
+                    .copied()
+                    .filter(|&i| alive[i] && rects[i].contains(x, y)),
+            );
+        }
+        // a rectangle in several of the cells comes once per cell
         hit.sort_unstable_by_key(|&i| rank[i]);
+        hit.dedup();
         if hit.is_empty() {
             // numerical corner case: pierce the first rectangle on its own
             while first < total && !alive[active[first]] {
@@ -518,12 +522,16 @@ fn group_rect(rects: &[FRect], members: &[usize]) -> Option<FRect> {
 /// rectangle keeps the most room with it, the first such group on ties. The groups a member
 /// can join are looked up in a grid over the group rectangles (which only shrink here).
 fn eliminate(rects: &[FRect], groups: &mut Vec<Group>, ctx: &JobCtx) -> Result<(), Cancelled> {
-    // cells of the members' size: a member's look-up touches at most 2 × 2 of them
-    let members = groups.iter().flat_map(|g| g.members.iter().copied());
-    let mut grid = grid_for(rects, members, 1.0);
-    for (h, g) in groups.iter().enumerate() {
-        grid.insert(h, g.rect.x_range(), g.rect.y_range());
-    }
+    // cells of the members' size: a member's look-up touches at most 2 × 2 of them (few
+    // groups are scanned instead)
+    let grid = (groups.len() > SCAN_MAX_ITEMS).then(|| {
+        let members = groups.iter().flat_map(|g| g.members.iter().copied());
+        let mut grid = grid_for(rects, members, 1.0);
+        for (h, g) in groups.iter().enumerate() {
+            grid.insert(h, g.rect.x_range(), g.rect.y_range());
+        }
+        grid
+    });
     // groups keep their index until the end (a dissolved one is marked dead), so that index
     // order, which decides ties, is the order of the remaining groups
     let mut alive = vec![true; groups.len()];
@@ -542,11 +550,17 @@ fn eliminate(rects: &[FRect], groups: &mut Vec<Group>, ctx: &JobCtx) -> Result<(
             let mut ok = true;
             for &m in &groups[f].members {
                 let r = &rects[m];
-                grid.query(
-                    expand(r.x_range(), LOOKUP_MARGIN_MM),
-                    expand(r.y_range(), LOOKUP_MARGIN_MM),
-                    &mut near,
-                );
+                match &grid {
+                    Some(grid) => grid.query(
+                        expand(r.x_range(), LOOKUP_MARGIN_MM),
+                        expand(r.y_range(), LOOKUP_MARGIN_MM),
+                        &mut near,
+                    ),
+                    None => {
+                        near.clear();
+                        near.extend(0..groups.len());
+                    }
+                }
                 let mut best: Option<(f64, usize)> = None;
                 for &h in &near {
                     if h == f || !alive[h] {
@@ -614,24 +628,38 @@ pub fn cover(rects: &[FRect], active: Vec<usize>, ctx: &JobCtx) -> Result<Vec<Gr
 }
 
 /// A lower bound on the number of points piercing all `rects`: the size of a set of rectangles
-/// no two of which meet (greedy, in two orders; the larger set counts). The rectangles already
-/// chosen are looked up in a grid.
+/// no two of which meet (greedy, in two orders; the larger set counts). Once many are chosen,
+/// the chosen rectangles are looked up in a grid.
 pub fn lower_bound(rects: &[FRect]) -> usize {
-    let empty = grid_for(rects, 0..rects.len(), 1.0);
     let pick = |order: &[usize]| -> usize {
-        let mut grid = empty.clone();
+        let mut grid: Option<BucketGrid> = None;
         let mut chosen: Vec<FRect> = Vec::new();
         let mut near = Vec::new();
         for &i in order {
             let r = rects[i];
-            grid.query(
-                expand(r.x_range(), LOOKUP_MARGIN_MM),
-                expand(r.y_range(), LOOKUP_MARGIN_MM),
-                &mut near,
-            );
-            if near.iter().all(|&c| !chosen[c].meet(&r).is_valid()) {
-                grid.insert(chosen.len(), r.x_range(), r.y_range());
+            let free = match &grid {
+                Some(grid) => {
+                    grid.query(
+                        expand(r.x_range(), LOOKUP_MARGIN_MM),
+                        expand(r.y_range(), LOOKUP_MARGIN_MM),
+                        &mut near,
+                    );
+                    near.iter().all(|&c| !chosen[c].meet(&r).is_valid())
+                }
+                None => chosen.iter().all(|c| !c.meet(&r).is_valid()),
+            };
+            if free {
+                if let Some(grid) = &mut grid {
+                    grid.insert(chosen.len(), r.x_range(), r.y_range());
+                }
                 chosen.push(r);
+                if grid.is_none() && chosen.len() > SCAN_MAX_ITEMS {
+                    let mut g = grid_for(rects, 0..rects.len(), 1.0);
+                    for (k, c) in chosen.iter().enumerate() {
+                        g.insert(k, c.x_range(), c.y_range());
+                    }
+                    grid = Some(g);
+                }
             }
         }
         chosen.len()

@@ -6,6 +6,8 @@
 //! monotone function of it (values outside the grid fall into the border cells), so two boxes
 //! that share a point always share a cell: no item is missed, whatever the rounding.
 
+/// Up to this many items a scan of all of them costs less than building and asking a grid.
+pub(crate) const SCAN_MAX_ITEMS: usize = 64;
 /// Most cells along one axis (larger extents get larger cells).
 const MAX_CELLS_PER_AXIS: usize = 256;
 /// Smallest cell side, mm.

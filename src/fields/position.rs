@@ -8,7 +8,7 @@
 //! least-overlap positions, the one nearest the centre of the field's geometries is found too.
 
 use super::cover::FRect;
-use super::grid::{expand, BucketGrid};
+use super::grid::{expand, BucketGrid, SCAN_MAX_ITEMS};
 use crate::geom::Pt;
 use crate::job::{Cancelled, JobCtx};
 
@@ -57,10 +57,14 @@ pub fn place(
         ),
         |(x, y), p| ((x.0.min(p.x), x.1.max(p.x)), (y.0.min(p.y), y.1.max(p.y))),
     );
-    let mut grid = BucketGrid::new(bounds.0, bounds.1, [2.0 * field[0], 2.0 * field[1]]);
-    for (i, p) in c.iter().enumerate() {
-        grid.insert(i, (p.x, p.x), (p.y, p.y));
-    }
+    // few fields are scanned instead
+    let mut grid = (n > SCAN_MAX_ITEMS).then(|| {
+        let mut grid = BucketGrid::new(bounds.0, bounds.1, [2.0 * field[0], 2.0 * field[1]]);
+        for (i, p) in c.iter().enumerate() {
+            grid.insert(i, (p.x, p.x), (p.y, p.y));
+        }
+        grid
+    });
     let mut cand = Vec::new();
     for _ in 0..rounds {
         ctx.check()?;
@@ -74,11 +78,17 @@ pub fn place(
             let window = |v: f64, w: f64| {
                 expand((v, v), w.max(0.0) * (1.0 + WINDOW_SLACK) + WINDOW_SLACK_MM)
             };
-            grid.query(
-                window(c[i].x, reach[0]),
-                window(c[i].y, reach[1]),
-                &mut cand,
-            );
+            match &grid {
+                Some(grid) => grid.query(
+                    window(c[i].x, reach[0]),
+                    window(c[i].y, reach[1]),
+                    &mut cand,
+                ),
+                None => {
+                    cand.clear();
+                    cand.extend(0..n);
+                }
+            }
             let near: Vec<usize> = cand
                 .iter()
                 .copied()
@@ -118,8 +128,10 @@ pub fn place(
                 }
             }
             if best.1 != c[i] {
-                grid.remove(i, (c[i].x, c[i].x), (c[i].y, c[i].y));
-                grid.insert(i, (best.1.x, best.1.x), (best.1.y, best.1.y));
+                if let Some(grid) = &mut grid {
+                    grid.remove(i, (c[i].x, c[i].x), (c[i].y, c[i].y));
+                    grid.insert(i, (best.1.x, best.1.x), (best.1.y, best.1.y));
+                }
                 c[i] = best.1;
                 moved = true;
             }
