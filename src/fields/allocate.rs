@@ -5,6 +5,7 @@
 //! are marked together; when none of its fields holds anything yet, the field with the nearest
 //! centre. A uniform grid over the allocated centroids keeps the nearest search local.
 
+use super::grid::{expand, BucketGrid, SCAN_MAX_ITEMS};
 use super::INSIDE_EPS_MM;
 use crate::document::{Geometry, ScanField};
 use crate::geom::{BBox, Pt};
@@ -72,18 +73,57 @@ impl Grid {
     }
 }
 
-/// Fields (slots into `fields`) holding each geometry wholly.
+/// Margin of the field look-up, mm (well above [`INSIDE_EPS_MM`]).
+const LOOKUP_MARGIN_MM: f64 = 1e-6;
+
+/// Fields (slots into `fields`, ascending) holding each geometry wholly. With many fields, the
+/// fields that may hold a geometry are looked up in a grid over the field squares (by the
+/// geometry's bounding-box corner); a geometry without a finite box checks every field.
 pub fn holders(geometries: &[Geometry], fields: &[ScanField]) -> Vec<Vec<usize>> {
     let boxes: Vec<BBox> = fields.iter().map(ScanField::bbox).collect();
+    if boxes.len() <= SCAN_MAX_ITEMS {
+        return geometries
+            .iter()
+            .map(|g| {
+                let b = g.bbox();
+                (0..boxes.len())
+                    .filter(|&k| boxes[k].contains_box(&b, INSIDE_EPS_MM))
+                    .collect()
+            })
+            .collect();
+    }
+    let bounds = boxes.iter().fold(BBox::EMPTY, |acc, b| acc.union(*b));
+    let cell_mm = fields.iter().fold([0.0f64; 2], |acc, f| {
+        [acc[0].max(f.size[0]), acc[1].max(f.size[1])]
+    });
+    let mut grid = BucketGrid::new(
+        (bounds.min_x, bounds.max_x),
+        (bounds.min_y, bounds.max_y),
+        cell_mm,
+    );
+    for (k, fb) in boxes.iter().enumerate() {
+        grid.insert(
+            k,
+            expand((fb.min_x, fb.max_x), LOOKUP_MARGIN_MM),
+            expand((fb.min_y, fb.max_y), LOOKUP_MARGIN_MM),
+        );
+    }
+    let all: Vec<usize> = (0..boxes.len()).collect();
+    let mut near = Vec::new();
     geometries
         .iter()
         .map(|g| {
             let b = g.bbox();
-            boxes
+            let candidates = if b.min_x.is_finite() && b.min_y.is_finite() {
+                grid.query((b.min_x, b.min_x), (b.min_y, b.min_y), &mut near);
+                &near
+            } else {
+                &all
+            };
+            candidates
                 .iter()
-                .enumerate()
-                .filter(|(_, fb)| fb.contains_box(&b, INSIDE_EPS_MM))
-                .map(|(k, _)| k)
+                .copied()
+                .filter(|&k| boxes[k].contains_box(&b, INSIDE_EPS_MM))
                 .collect()
         })
         .collect()
@@ -146,6 +186,62 @@ pub fn allocate(geometries: &[Geometry], fields: &mut [ScanField]) -> Allocation
 mod tests {
     use super::*;
     use crate::fields::tests_support::rect;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    /// The previous [`holders`]: every field checked for every geometry.
+    fn holders_reference(geometries: &[Geometry], fields: &[ScanField]) -> Vec<Vec<usize>> {
+        let boxes: Vec<BBox> = fields.iter().map(ScanField::bbox).collect();
+        geometries
+            .iter()
+            .map(|g| {
+                let b = g.bbox();
+                boxes
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, fb)| fb.contains_box(&b, INSIDE_EPS_MM))
+                    .map(|(k, _)| k)
+                    .collect()
+            })
+            .collect()
+    }
+
+    #[test]
+    fn holders_with_the_grid_match_checking_every_field() {
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        for round in 0..20 {
+            let f = rng.random_range(2..80) as f64;
+            // coarse positions: geometries often touch field borders exactly
+            let c = |rng: &mut ChaCha8Rng| rng.random_range(-20..320) as f64 * 0.5;
+            let mut gs: Vec<Geometry> = (0..200)
+                .map(|_| {
+                    let (x, y) = (c(&mut rng), c(&mut rng));
+                    let w = rng.random_range(0..=(f as i32)) as f64 * 0.5;
+                    rect(x, y, w, w * 0.5)
+                })
+                .collect();
+            gs.push(Geometry::new(Vec::new(), false, Default::default()));
+            let mut fs: Vec<ScanField> = (0..rng.random_range(1..150))
+                .map(|k| field(k, c(&mut rng), c(&mut rng)))
+                .collect();
+            for fl in &mut fs {
+                fl.size = [
+                    f,
+                    f * if rng.random_range(0..2) == 0 {
+                        1.0
+                    } else {
+                        0.5
+                    },
+                ];
+            }
+            assert_eq!(
+                holders(&gs, &fs),
+                holders_reference(&gs, &fs),
+                "round {round}"
+            );
+            assert_eq!(holders(&gs, &[]), holders_reference(&gs, &[]));
+        }
+    }
 
     fn field(id: usize, x: f64, y: f64) -> ScanField {
         ScanField {

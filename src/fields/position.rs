@@ -8,6 +8,7 @@
 //! least-overlap positions, the one nearest the centre of the field's geometries is found too.
 
 use super::cover::FRect;
+use super::grid::{expand, BucketGrid, SCAN_MAX_ITEMS};
 use crate::geom::Pt;
 use crate::job::{Cancelled, JobCtx};
 
@@ -27,8 +28,14 @@ pub fn total_overlap(centers: &[Pt], f: [f64; 2]) -> f64 {
     s
 }
 
+/// Relative slack of the grid look-up window, so that rounding never hides a neighbour.
+const WINDOW_SLACK: f64 = 1e-9;
+/// Absolute slack of the grid look-up window, mm.
+const WINDOW_SLACK_MM: f64 = 1e-9;
+
 /// Moves each centre within its rectangle to reduce overlap, then towards its target (the centre
-/// of its content). Deterministic; at most `rounds` passes.
+/// of its content). Deterministic; at most `rounds` passes. The fields near the one moving are
+/// looked up in a grid over the current centres.
 pub fn place(
     rects: &[FRect],
     targets: &[Pt],
@@ -43,16 +50,52 @@ pub fn place(
         .map(|(r, &t)| clamp(r, t))
         .collect();
     let n = c.len();
+    let bounds = c.iter().fold(
+        (
+            (f64::INFINITY, f64::NEG_INFINITY),
+            (f64::INFINITY, f64::NEG_INFINITY),
+        ),
+        |(x, y), p| ((x.0.min(p.x), x.1.max(p.x)), (y.0.min(p.y), y.1.max(p.y))),
+    );
+    // few fields are scanned instead
+    let mut grid = (n > SCAN_MAX_ITEMS).then(|| {
+        let mut grid = BucketGrid::new(bounds.0, bounds.1, [2.0 * field[0], 2.0 * field[1]]);
+        for (i, p) in c.iter().enumerate() {
+            grid.insert(i, (p.x, p.x), (p.y, p.y));
+        }
+        grid
+    });
+    let mut cand = Vec::new();
     for _ in 0..rounds {
         ctx.check()?;
         let mut moved = false;
         for i in 0..n {
             let r = &rects[i];
-            let near: Vec<usize> = (0..n)
+            let reach = [
+                2.0 * field[0] + (r.x.hi - r.x.lo),
+                2.0 * field[1] + (r.y.hi - r.y.lo),
+            ];
+            let window = |v: f64, w: f64| {
+                expand((v, v), w.max(0.0) * (1.0 + WINDOW_SLACK) + WINDOW_SLACK_MM)
+            };
+            match &grid {
+                Some(grid) => grid.query(
+                    window(c[i].x, reach[0]),
+                    window(c[i].y, reach[1]),
+                    &mut cand,
+                ),
+                None => {
+                    cand.clear();
+                    cand.extend(0..n);
+                }
+            }
+            let near: Vec<usize> = cand
+                .iter()
+                .copied()
                 .filter(|&j| {
                     j != i
-                        && (c[j].x - c[i].x).abs() < 2.0 * field[0] + (r.x.hi - r.x.lo)
-                        && (c[j].y - c[i].y).abs() < 2.0 * field[1] + (r.y.hi - r.y.lo)
+                        && (c[j].x - c[i].x).abs() < reach[0]
+                        && (c[j].y - c[i].y).abs() < reach[1]
                 })
                 .collect();
             let mut xs = vec![r.x.lo, r.x.hi, targets[i].x];
@@ -85,6 +128,10 @@ pub fn place(
                 }
             }
             if best.1 != c[i] {
+                if let Some(grid) = &mut grid {
+                    grid.remove(i, (c[i].x, c[i].x), (c[i].y, c[i].y));
+                    grid.insert(i, (best.1.x, best.1.x), (best.1.y, best.1.y));
+                }
                 c[i] = best.1;
                 moved = true;
             }
@@ -100,6 +147,113 @@ pub fn place(
 mod tests {
     use super::*;
     use crate::fields::reach::Span;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    /// The previous [`place`]: every other field checked for nearness.
+    /// Moves each centre within its rectangle to reduce overlap, then towards its target (the centre
+    /// of its content). Deterministic; at most `rounds` passes.
+    fn place_reference(
+        rects: &[FRect],
+        targets: &[Pt],
+        field: [f64; 2],
+        rounds: usize,
+        ctx: &JobCtx,
+    ) -> Result<Vec<Pt>, Cancelled> {
+        let clamp = |r: &FRect, p: Pt| Pt::new(r.x.clamp(p.x), r.y.clamp(p.y));
+        let mut c: Vec<Pt> = rects
+            .iter()
+            .zip(targets)
+            .map(|(r, &t)| clamp(r, t))
+            .collect();
+        let n = c.len();
+        for _ in 0..rounds {
+            ctx.check()?;
+            let mut moved = false;
+            for i in 0..n {
+                let r = &rects[i];
+                let near: Vec<usize> = (0..n)
+                    .filter(|&j| {
+                        j != i
+                            && (c[j].x - c[i].x).abs() < 2.0 * field[0] + (r.x.hi - r.x.lo)
+                            && (c[j].y - c[i].y).abs() < 2.0 * field[1] + (r.y.hi - r.y.lo)
+                    })
+                    .collect();
+                let mut xs = vec![r.x.lo, r.x.hi, targets[i].x];
+                let mut ys = vec![r.y.lo, r.y.hi, targets[i].y];
+                for &j in &near {
+                    xs.extend([c[j].x - field[0], c[j].x, c[j].x + field[0]]);
+                    ys.extend([c[j].y - field[1], c[j].y, c[j].y + field[1]]);
+                }
+                let mut xs: Vec<f64> = xs.into_iter().map(|v| r.x.clamp(v)).collect();
+                let mut ys: Vec<f64> = ys.into_iter().map(|v| r.y.clamp(v)).collect();
+                xs.sort_by(f64::total_cmp);
+                xs.dedup();
+                ys.sort_by(f64::total_cmp);
+                ys.dedup();
+                let score = |p: Pt| -> (f64, f64) {
+                    let ov: f64 = near.iter().map(|&j| pair_overlap(p, c[j], field)).sum();
+                    (ov, p.dist2(targets[i]))
+                };
+                let better = |a: (f64, f64), b: (f64, f64)| {
+                    a.0 < b.0 - 1e-6 || (a.0 <= b.0 + 1e-6 && a.1 < b.1 - 1e-9)
+                };
+                let mut best = (score(c[i]), c[i]);
+                for &x in &xs {
+                    for &y in &ys {
+                        let p = Pt::new(x, y);
+                        let s = score(p);
+                        if better(s, best.0) {
+                            best = (s, p);
+                        }
+                    }
+                }
+                if best.1 != c[i] {
+                    c[i] = best.1;
+                    moved = true;
+                }
+            }
+            if !moved {
+                break;
+            }
+        }
+        Ok(c)
+    }
+
+    #[test]
+    fn place_with_the_grid_matches_checking_every_field() {
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let ctx = JobCtx::default();
+        for round in 0..30 {
+            let f = rng.random_range(1..40) as f64;
+            let n = rng.random_range(1..120);
+            let span = |rng: &mut ChaCha8Rng| {
+                let lo = rng.random_range(0..300) as f64;
+                Span {
+                    lo,
+                    hi: lo + rng.random_range(0..=(f as i32)) as f64 * 0.5,
+                }
+            };
+            let rects: Vec<FRect> = (0..n)
+                .map(|_| FRect {
+                    x: span(&mut rng),
+                    y: span(&mut rng),
+                })
+                .collect();
+            let targets: Vec<Pt> = rects
+                .iter()
+                .map(|r| {
+                    Pt::new(
+                        r.x.lo + rng.random_range(-2.0..2.0) * f,
+                        r.y.lo + rng.random_range(-2.0..2.0) * f,
+                    )
+                })
+                .collect();
+            let fast = place(&rects, &targets, [f, f * 0.75], 30, &ctx).unwrap();
+            let slow = place_reference(&rects, &targets, [f, f * 0.75], 30, &ctx).unwrap();
+            assert_eq!(fast, slow, "round {round}");
+        }
+    }
 
     #[test]
     fn two_fields_slide_apart_then_centre() {
