@@ -2,6 +2,7 @@
 //! optional run recorder (rerun).
 
 use crate::document::{Geometry, Plan, ScanField};
+use crate::motion::Toolpath;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Instant;
@@ -64,8 +65,8 @@ pub trait RunRecorder: Send + Sync {
     fn geometry(&self, geometries: &[Geometry]);
     /// The scan fields.
     fn fields(&self, fields: &[ScanField]);
-    /// A finished plan (marks and idle moves).
-    fn plan(&self, geometries: &[Geometry], plan: &Plan);
+    /// A finished plan (marks and idle moves of its lowered toolpath).
+    fn plan(&self, plan: &Plan, toolpath: &Toolpath);
     /// One GA generation: best and mean idle travel.
     fn generation(&self, generation: usize, best_idle_mm: f64, mean_idle_mm: f64);
 }

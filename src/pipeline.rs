@@ -164,7 +164,7 @@ pub fn order_document(doc: &Document, ctx: &JobCtx) -> Result<Plan, PipelineErro
     .map_err(|source| PipelineError::Order { file, source })?;
     plan.metrics.solve_s.total = plan.metrics.solve_s.order;
     if let Some(r) = ctx.recorder() {
-        r.plan(&doc.geometries, &plan);
+        r.plan(&plan, &lower_plan(doc, &plan)?);
     }
     Ok(plan)
 }

@@ -2,8 +2,9 @@
 //! GA's convergence, written to an `.rrd` file without opening a viewer.
 
 use crate::document::{Geometry, Plan, ScanField};
+use crate::geom::Pt;
 use crate::job::RunRecorder;
-use crate::order::metrics::step_ends;
+use crate::motion::Toolpath;
 use thiserror::Error;
 
 /// The recording could not be created or written.
@@ -83,29 +84,21 @@ impl RunRecorder for RerunRecorder {
         );
     }
 
-    fn plan(&self, geometries: &[Geometry], plan: &Plan) {
-        let marks: Vec<rerun::LineStrip2D> = plan
-            .order
-            .iter()
-            .map(|s| {
-                let g = &geometries[s.geometry];
-                rerun::LineStrip2D::from_iter(
-                    g.marking_path(s.start_vertex, s.reversed)
-                        .into_iter()
-                        .map(xy),
-                )
+    fn plan(&self, plan: &Plan, toolpath: &Toolpath) {
+        let marks: Vec<rerun::LineStrip2D> = (0..toolpath.strokes.len())
+            .map(|k| {
+                rerun::LineStrip2D::from_iter(toolpath.stroke_points(k).iter().map(|&p| xy(p)))
             })
             .collect();
-        let idle: Vec<rerun::LineStrip2D> = plan
-            .order
-            .windows(2)
-            .map(|w| {
-                let (a, b) = (
-                    step_ends(geometries, &w[0]).1,
-                    step_ends(geometries, &w[1]).0,
-                );
-                rerun::LineStrip2D::from_iter([xy(a), xy(b)])
+        let ends: Vec<(Pt, Pt)> = (0..toolpath.strokes.len())
+            .filter_map(|k| {
+                let pts = toolpath.stroke_points(k);
+                Some((*pts.first()?, *pts.last()?))
             })
+            .collect();
+        let idle: Vec<rerun::LineStrip2D> = ends
+            .windows(2)
+            .map(|w| rerun::LineStrip2D::from_iter([xy(w[0].1), xy(w[1].0)]))
             .collect();
         let base: Vec<[f32; 2]> = plan.fields.iter().map(|f| xy(f.center)).collect();
         let root = format!("plans/{}", plan.name);
