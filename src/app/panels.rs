@@ -474,8 +474,12 @@ impl Editors {
             ui,
             "Cost model",
             &mut s.cost_model,
-            &[(CostModel::Distance, "distance"), (CostModel::Time, "time")],
-        );
+            &[
+                (CostModel::Time, "Job time (machine dynamics)"),
+                (CostModel::Distance, "Idle distance (seed 000)"),
+            ],
+        )
+        .on_hover_text(COST_MODEL_HELP);
         ui.checkbox(&mut s.hha_improve, "HHA local search and alternation");
         ui.checkbox(
             &mut s.split_oversize,
@@ -495,12 +499,22 @@ impl Editors {
     }
 }
 
+/// What the cost model means for the operator.
+const COST_MODEL_HELP: &str = "What the ordering minimises.\n\
+    Job time: the machine's time from the profile's dynamics (stage moves with acceleration \
+    and settling, scanner jumps, laser delays); the plan is never slower than the \
+    idle-distance plan.\n\
+    Idle distance: the laser-off travel in mm (seed 000's objective), ignoring the machine's \
+    dynamics.\n\
+    Used by the next solve (HHA, HGA and baseline; as-is keeps the document order).";
+
+/// A labelled combo box; returns the combo's response.
 fn combo<T: PartialEq + Copy>(
     ui: &mut egui::Ui,
     label: &str,
     value: &mut T,
     options: &[(T, &str)],
-) {
+) -> egui::Response {
     ui.horizontal(|ui| {
         let l = ui.label(label);
         let current = options
@@ -516,6 +530,7 @@ fn combo<T: PartialEq + Copy>(
                 }
             })
             .response
-            .labelled_by(l.id);
-    });
+            .labelled_by(l.id)
+    })
+    .inner
 }
