@@ -9,8 +9,9 @@ use egui::{Event, Key, Modifiers, PointerButton, Vec2};
 use egui_kittest::kittest::Queryable;
 use egui_kittest::Harness;
 use galvoplan::app::commands::Command;
+use galvoplan::app::playback::{state_text, time_text};
 use galvoplan::app::App;
-use galvoplan::document::{Algo, SolverSettings};
+use galvoplan::document::{Algo, CostModel, SolverSettings};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
@@ -54,7 +55,7 @@ fn open_demo_run_hha_shows_metrics() {
     assert_eq!(h.state().doc.geometries.len(), 122);
     assert!(!h.state().doc.fields.is_empty());
     assert!(h.state().uncovered().is_empty());
-    assert!(h.query_by_label("idle_mm").is_none());
+    assert!(h.query_by_label("Idle travel (mm)").is_none());
     h.get_by_label("Run HHA").click();
     h.step();
     assert!(h.state().is_busy(), "the solve runs in the background");
@@ -63,10 +64,21 @@ fn open_demo_run_hha_shows_metrics() {
     assert_eq!(plan.algo, Algo::Hha);
     assert_eq!(plan.name, "HHA #1");
     common::check_plan(&h.state().doc, &plan);
-    // the metrics table shows idle_mm with the plan's value
-    h.get_by_label("idle_mm");
+    // the metrics table: worded rows with units, the job time first with the plan's value
+    h.get_by_label("Idle travel (mm)");
     h.get_by_label(&format!("{:.1}", plan.metrics.idle_mm));
+    h.get_by_label("Stage travel (mm)");
     h.get_by_label(&format!("{:.1}", plan.metrics.base_mm));
+    let job_s = plan.metrics.job_time_s.expect("a job time");
+    h.get_by_label(&format!("{job_s:.3}"));
+    let breakdown = plan.metrics.job_time_breakdown_s.expect("a breakdown");
+    h.get_by_label("Marking (s)");
+    h.get_by_label(&format!("{:.2}", breakdown.mark));
+    let job_row = h.get_by_label("Job time (s)").rect();
+    let idle_row = h.get_by_label("Idle travel (mm)").rect();
+    let solve_row = h.get_by_label("Solve time (s)").rect();
+    assert!(job_row.top() < idle_row.top() && idle_row.top() < solve_row.top());
+    assert!(h.query_by_label("idle_mm").is_none(), "no internal keys");
 }
 
 #[test]
@@ -344,11 +356,18 @@ fn compare_view_shows_both_plans_and_the_difference() {
     h.run();
     h.get_by_label("B vs A");
     // the compare table and the active plan's table in the side panel
-    assert_eq!(h.get_all_by_label("direction_changes").count(), 2);
+    assert_eq!(h.get_all_by_label("Direction changes").count(), 2);
     let plans = &h.state().doc.plans;
     let (a, b) = (&plans[0].metrics, &plans[1].metrics);
     let pct = (b.idle_mm - a.idle_mm) / a.idle_mm * 100.0;
     h.get_by_label(&format!("{pct:+.1} %"));
+    // the faster plan's job time is marked, once (the side panel shows one plan)
+    let faster = h.get_by_label("faster").rect();
+    let best_s = a.job_time_s.unwrap().min(b.job_time_s.unwrap());
+    assert!(h
+        .get_all_by_label(&format!("{best_s:.3}"))
+        .any(|n| (n.rect().center().y - faster.center().y).abs() < 4.0
+            && n.rect().right() <= faster.left()));
     h.get_by_label("Overlay").click();
     h.run();
     h.get_by_label("Compare (overlay)");
@@ -496,4 +515,136 @@ fn frame_time_while_solving() {
         v.len(),
         h.state().status()
     );
+}
+
+/// Runs `button`'s solver to the end; returns the new plan.
+fn solve(h: &mut Harness<'_, App>, button: &str) -> galvoplan::document::Plan {
+    let n = h.state().doc.plans.len();
+    h.get_by_label(button).click();
+    h.step();
+    wait_idle(h, Duration::from_secs(120));
+    assert_eq!(h.state().doc.plans.len(), n + 1, "{}", h.state().status());
+    h.state().active_plan().unwrap().clone()
+}
+
+#[test]
+fn the_cost_switch_decides_what_the_solve_minimises() {
+    let mut h = opened(&demo());
+    assert_eq!(h.state().doc.settings.cost_model, CostModel::Time);
+    h.get_by_label("Cost model").hover();
+    h.run();
+    h.get_by_label_contains("What the ordering minimises");
+    let by_time = solve(&mut h, "Run HHA");
+    h.get_by_label("Cost model").click();
+    h.run();
+    h.get_by_label("Idle distance (seed 000)").click();
+    h.run();
+    assert_eq!(h.state().doc.settings.cost_model, CostModel::Distance);
+    let by_distance = solve(&mut h, "Run HHA");
+    assert_eq!(by_distance.name, "HHA #2");
+    assert_ne!(by_time.order, by_distance.order);
+    // each plan is best at what it minimised (demo: 9.116 s / 1848 mm against 9.142 s / 1704 mm)
+    let (t_time, t_dist) = (
+        by_time.metrics.job_time_s.unwrap(),
+        by_distance.metrics.job_time_s.unwrap(),
+    );
+    assert!(t_time < t_dist, "{t_time} s !< {t_dist} s");
+    assert!(by_distance.metrics.idle_mm < by_time.metrics.idle_mm);
+    // the change is one undoable settings step
+    h.get_by_label("Undo").click();
+    h.run();
+    assert_eq!(h.state().doc.settings.cost_model, CostModel::Time);
+}
+
+#[test]
+fn run_as_is_keeps_the_document_order() {
+    let mut h = opened(&demo());
+    let plan = solve(&mut h, "Run as-is");
+    assert_eq!(plan.algo, Algo::AsIs);
+    assert_eq!(plan.name, "As-is #1");
+    common::check_plan(&h.state().doc, &plan);
+    let hha = solve(&mut h, "Run HHA");
+    assert!(hha.metrics.job_time_s.unwrap() < plan.metrics.job_time_s.unwrap());
+}
+
+#[test]
+fn playback_scrubs_plays_pauses_and_rewinds() {
+    let mut h = opened(&demo());
+    h.get_by_label("No plan yet: run a solver to play the job back.");
+    let plan = solve(&mut h, "Run HHA");
+    let l = h.state().toolpath(0).unwrap().unwrap().clone();
+    let end_s = l.duration_s();
+    assert!((end_s - plan.metrics.job_time_s.unwrap()).abs() < 1e-9);
+    h.get_by_label(&time_text(0.0, end_s));
+    assert_eq!(h.state().playback().shown_t_s(), None);
+    // scrub to the middle of the middle stroke: the machine is marking it
+    let n = l.toolpath.strokes.len();
+    let (s0, s1) = l.mark_s[n / 2];
+    let t_s = (s0 + s1) / 2.0;
+    h.get_by_label("Time").set_value_accesskit(t_s);
+    h.run();
+    assert!((h.state().playback().t_s - t_s).abs() < 1e-9);
+    assert_eq!(
+        h.state().playback().shown_t_s(),
+        Some(h.state().playback().t_s)
+    );
+    h.get_by_label(&time_text(t_s, end_s));
+    let words = state_text(&l, t_s);
+    assert!(
+        words.starts_with(&format!("marking stroke {} of {n};", n / 2 + 1))
+            && words.ends_with("laser on"),
+        "{words}"
+    );
+    h.get_by_label(&words);
+    // the strip and the canvas fit the window
+    let canvas = h.get_by_label("Work area").rect();
+    assert!(
+        canvas.right() <= 1500.0 && canvas.width() > 500.0,
+        "{canvas:?}"
+    );
+    let (play, slider) = (h.get_by_label("Play").rect(), h.get_by_label("Time").rect());
+    // play: each frame (0.25 s, counted as at most 0.1 s) advances 0.1 s at 1× (auto, short job)
+    h.get_by_label("Play").click();
+    h.step();
+    assert!(h.state().playback().playing);
+    h.step();
+    // nothing moved under the pointer: Pause where Play was, the slider in place
+    assert_eq!(h.get_by_label("Pause").rect().min, play.min);
+    assert_eq!(h.get_by_label("Time").rect(), slider);
+    let t0_s = h.state().playback().t_s;
+    for _ in 0..5 {
+        h.step();
+    }
+    let t1_s = h.state().playback().t_s;
+    assert!((t1_s - t0_s - 0.5).abs() < 1e-9, "{t0_s} -> {t1_s}");
+    h.get_by_label(&time_text(t1_s, end_s));
+    assert!(
+        h.query_by_label(&words).is_none(),
+        "the state shown moved on"
+    );
+    // pause: time stands
+    h.get_by_label("Pause").click();
+    h.run();
+    let t2_s = h.state().playback().t_s;
+    h.step();
+    h.step();
+    assert_eq!(h.state().playback().t_s, t2_s);
+    // 100×: plays to the end of the job and stops there
+    h.get_by_label("Speed").click();
+    h.run();
+    h.get_by_label("100×").click();
+    h.run();
+    h.get_by_label("Play").click();
+    for _ in 0..20 {
+        h.step();
+    }
+    assert!(!h.state().playback().playing);
+    assert_eq!(h.state().playback().t_s, end_s);
+    h.get_by_label_contains(&format!("job done: {n} strokes marked"));
+    // rewind: back to the planned path
+    h.get_by_label("Rewind").click();
+    h.run();
+    assert_eq!(h.state().playback().t_s, 0.0);
+    assert_eq!(h.state().playback().shown_t_s(), None);
+    assert_eq!(h.state().playback().speed_x, Some(100.0), "the speed stays");
 }

@@ -3,6 +3,7 @@
 //! [`CanvasAction`]s that the app turns into commands.
 
 use super::paint;
+use super::toolpaths::Lowered;
 use crate::document::{Geometry, MachineProfile, Plan, ScanField};
 use crate::geom::{point_segment_dist, BBox, Pt};
 use egui::{Color32, PointerButton, Pos2, Rect, Sense, Vec2};
@@ -125,6 +126,8 @@ pub enum CanvasAction {
 pub struct PathLayer<'a> {
     /// The plan.
     pub plan: &'a Plan,
+    /// Its lowered toolpath (what is drawn), or why it could not be lowered.
+    pub lowered: Result<&'a Lowered, &'a str>,
     /// Colour of its idle moves and markers.
     pub colour: Color32,
 }
@@ -155,6 +158,8 @@ pub struct Canvas<'a> {
     pub layers: Layers,
     /// The path was planned on other fields than those shown.
     pub stale: bool,
+    /// Playback time: the machine is drawn at this job time (`None`: the planned path only).
+    pub playback_t_s: Option<f64>,
 }
 
 /// Screen distance within which the pointer "hovers" a geometry, px.
@@ -353,13 +358,10 @@ impl Canvas<'_> {
                 None => {}
             }
             for path in &self.paths {
-                if let Some(i) = path.plan.order.iter().position(|s| s.geometry == k) {
-                    lines.push(format!(
-                        "  {}: stroke {} of {}",
-                        path.plan.name,
-                        i + 1,
-                        path.plan.order.len()
-                    ));
+                let Ok(l) = path.lowered else { continue };
+                if let Some(i) = l.stroke_of_geometry(k) {
+                    let n = l.toolpath.strokes.len();
+                    lines.push(format!("  {}: stroke {} of {n}", path.plan.name, i + 1));
                 }
             }
         }

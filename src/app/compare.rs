@@ -1,9 +1,12 @@
-//! The compare view: two plans side by side (synchronised canvases) or overlaid, a metrics
-//! table with the better value highlighted, and the GA convergence plot.
+//! The compare view: two plans side by side (synchronised canvases) or overlaid, played back on
+//! one clock, a metrics table led by the job time (the better value highlighted), and the GA
+//! convergence plot.
 
 use super::canvas::{Canvas, CanvasState, Layers, PathLayer};
 use super::paint::colour;
-use crate::document::{Algo, Document, Metrics, Plan};
+use super::playback::{self, Playback};
+use super::toolpaths::{Lowered, ToolpathCache};
+use crate::document::{Algo, Document, Metrics, Plan, TimeBreakdown};
 use egui::{Color32, RichText, Vec2};
 use egui_plot::{HLine, Legend, Line, LineStyle, Plot, PlotPoints};
 
@@ -18,6 +21,8 @@ pub struct CompareState {
     pub overlay: bool,
     /// Pan and zoom, shared by both canvases.
     pub canvas: CanvasState,
+    /// Playback of both plans on one clock (run time only).
+    pub playback: Playback,
 }
 
 impl CompareState {
@@ -44,73 +49,128 @@ impl CompareState {
     }
 }
 
+/// What a row of the metrics table says about the plans.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum RowKind {
+    /// The figure that decides (job time): emphasised, the better plan marked.
+    Decides,
+    /// A part of the job time (indented, not ranked).
+    Part,
+    /// Lower is better (highlighted in green).
+    Ranked,
+    /// Information only (never highlighted).
+    Info,
+}
+
 /// One row of the metrics table.
 struct Row {
-    key: &'static str,
+    label: &'static str,
     help: &'static str,
     value: fn(&Metrics) -> Option<f64>,
     decimals: usize,
-    /// Lower is better (else: information only).
-    ranked: bool,
+    kind: RowKind,
+}
+
+fn part(m: &Metrics, pick: fn(&TimeBreakdown) -> f64) -> Option<f64> {
+    m.job_time_breakdown_s.as_ref().map(pick)
 }
 
 const ROWS: &[Row] = &[
     Row {
-        key: "idle_mm",
-        help: "laser-off travel between strokes, mm",
+        label: "Job time (s)",
+        help: "machine time of the whole job, from the lowered toolpath (stage moves, settling, \
+               scanner jumps, marking, laser delays): the figure that decides",
+        value: |m| m.job_time_s,
+        decimals: 3,
+        kind: RowKind::Decides,
+    },
+    Row {
+        label: "Stage moves (s)",
+        help: "part of the job time: the stage travelling between fields",
+        value: |m| part(m, |b| b.stage),
+        decimals: 2,
+        kind: RowKind::Part,
+    },
+    Row {
+        label: "Stage settling (s)",
+        help: "part of the job time: the stage settling after its moves",
+        value: |m| part(m, |b| b.settle),
+        decimals: 2,
+        kind: RowKind::Part,
+    },
+    Row {
+        label: "Scanner jumps (s)",
+        help: "part of the job time: scanner jumps and jump delays not hidden in a stage move",
+        value: |m| part(m, |b| b.jump),
+        decimals: 2,
+        kind: RowKind::Part,
+    },
+    Row {
+        label: "Marking (s)",
+        help: "part of the job time: marking at mark speed (the same for every plan)",
+        value: |m| part(m, |b| b.mark),
+        decimals: 2,
+        kind: RowKind::Part,
+    },
+    Row {
+        label: "Laser delays (s)",
+        help: "part of the job time: laser-on and laser-off delays around the marks",
+        value: |m| part(m, |b| b.laser_delays),
+        decimals: 2,
+        kind: RowKind::Part,
+    },
+    Row {
+        label: "Idle travel (mm)",
+        help: "laser-off travel of the tool point between strokes",
         value: |m| Some(m.idle_mm),
         decimals: 1,
-        ranked: true,
+        kind: RowKind::Ranked,
     },
     Row {
-        key: "base_mm",
-        help: "base-stage travel through the field centres, mm",
+        label: "Stage travel (mm)",
+        help: "base-stage travel through the field centres in visiting order",
         value: |m| Some(m.base_mm),
         decimals: 1,
-        ranked: true,
+        kind: RowKind::Ranked,
     },
     Row {
-        key: "fields",
-        help: "number of scan fields",
+        label: "Scan fields",
+        help: "number of scan fields the job visits",
         value: |m| Some(m.fields as f64),
         decimals: 0,
-        ranked: true,
+        kind: RowKind::Ranked,
     },
     Row {
-        key: "direction_changes",
-        help: "reversals of the travel direction along the base path",
+        label: "Direction changes",
+        help: "reversals of the travel direction along the stage path",
         value: |m| Some(m.direction_changes as f64),
         decimals: 0,
-        ranked: true,
+        kind: RowKind::Ranked,
     },
     Row {
-        key: "solve_s",
-        help: "wall time of the solve, s",
-        value: |m| Some(m.solve_s.total),
-        decimals: 3,
-        ranked: true,
-    },
-    Row {
-        key: "job_time_s",
-        help: "estimated step-and-scan machine time, s (when known)",
-        value: |m| m.job_time_s,
-        decimals: 2,
-        ranked: true,
-    },
-    Row {
-        key: "marked_mm",
-        help: "marked length, mm (the same for every plan)",
+        label: "Marked length (mm)",
+        help: "marked length (the same for every plan)",
         value: |m| Some(m.marked_mm),
         decimals: 1,
-        ranked: false,
+        kind: RowKind::Info,
+    },
+    Row {
+        label: "Solve time (s)",
+        help: "how long the computer took to make the plan: says nothing about the plan's quality",
+        value: |m| Some(m.solve_s.total),
+        decimals: 3,
+        kind: RowKind::Info,
     },
 ];
 
 const BETTER_BG: Color32 = Color32::from_rgb(220, 252, 231);
 const BETTER_FG: Color32 = Color32::from_rgb(21, 128, 61);
 const WORSE_FG: Color32 = Color32::from_rgb(185, 28, 28);
+/// Text size of the job-time row.
+const DECIDES_PT: f32 = 16.0;
 
-/// The metrics table of plan `a` and optionally `b`, with the better value highlighted and the
+/// The metrics table of plan `a` and optionally `b`: job time first and emphasised (the
+/// faster plan marked), its parts, the other metrics with the better value in green, and the
 /// difference of B against A in %.
 pub fn metrics_table(ui: &mut egui::Ui, id: &str, a: &Plan, b: Option<&Plan>) {
     egui::Grid::new(id)
@@ -118,7 +178,7 @@ pub fn metrics_table(ui: &mut egui::Ui, id: &str, a: &Plan, b: Option<&Plan>) {
         .striped(true)
         .spacing([14.0, 4.0])
         .show(ui, |ui| {
-            ui.label(RichText::new("metric").strong());
+            ui.label(RichText::new("Metric").strong());
             ui.label(RichText::new(&a.name).strong().color(colour::PATH_A));
             if let Some(b) = b {
                 ui.label(RichText::new(&b.name).strong().color(colour::PATH_B));
@@ -126,47 +186,79 @@ pub fn metrics_table(ui: &mut egui::Ui, id: &str, a: &Plan, b: Option<&Plan>) {
             }
             ui.end_row();
             for row in ROWS {
-                ui.label(row.key).on_hover_text(row.help);
-                let va = (row.value)(&a.metrics);
-                let vb = b.and_then(|b| (row.value)(&b.metrics));
-                let text = |v: Option<f64>| {
-                    v.map_or("–".to_string(), |v| format!("{v:.*}", row.decimals))
-                };
-                let better = |mine: Option<f64>, other: Option<f64>| {
-                    row.ranked && matches!((mine, other), (Some(x), Some(y)) if x < y)
-                };
-                let cell = |ui: &mut egui::Ui, mine: Option<f64>, other: Option<f64>| {
-                    let t = RichText::new(text(mine)).monospace();
-                    if better(mine, other) {
-                        ui.label(t.strong().color(BETTER_FG).background_color(BETTER_BG));
-                    } else {
-                        ui.label(t);
-                    }
-                };
-                cell(ui, va, vb);
-                if b.is_some() {
-                    cell(ui, vb, va);
-                    match (va, vb) {
-                        (Some(x), Some(y)) if x.abs() > 1e-12 => {
-                            let pct = (y - x) / x * 100.0;
-                            let t = RichText::new(format!("{pct:+.1} %")).monospace();
-                            let t = if !row.ranked || pct.abs() < 0.05 {
-                                t
-                            } else if pct < 0.0 {
-                                t.color(BETTER_FG)
-                            } else {
-                                t.color(WORSE_FG)
-                            };
-                            ui.label(t);
-                        }
-                        _ => {
-                            ui.label("–");
-                        }
-                    }
-                }
+                metrics_row(ui, row, a, b);
                 ui.end_row();
             }
         });
+}
+
+fn metrics_row(ui: &mut egui::Ui, row: &Row, a: &Plan, b: Option<&Plan>) {
+    let label = RichText::new(row.label);
+    match row.kind {
+        RowKind::Decides => ui.label(label.strong().size(DECIDES_PT)),
+        RowKind::Part => {
+            ui.horizontal(|ui| {
+                ui.add_space(14.0);
+                ui.label(label.small())
+            })
+            .inner
+        }
+        RowKind::Ranked | RowKind::Info => ui.label(label),
+    }
+    .on_hover_text(row.help);
+    let va = (row.value)(&a.metrics);
+    let vb = b.and_then(|b| (row.value)(&b.metrics));
+    value_cell(ui, row, va, vb);
+    if b.is_none() {
+        return;
+    }
+    value_cell(ui, row, vb, va);
+    match (va, vb) {
+        (Some(x), Some(y)) if x.abs() > 1e-12 => {
+            let pct = (y - x) / x * 100.0;
+            let t = RichText::new(format!("{pct:+.1} %")).monospace();
+            let ranked = matches!(row.kind, RowKind::Decides | RowKind::Ranked);
+            let t = if !ranked || pct.abs() < 0.05 {
+                t
+            } else if pct < 0.0 {
+                t.color(BETTER_FG)
+            } else {
+                t.color(WORSE_FG)
+            };
+            ui.label(t);
+        }
+        _ => {
+            ui.label("–");
+        }
+    }
+}
+
+fn value_cell(ui: &mut egui::Ui, row: &Row, mine: Option<f64>, other: Option<f64>) {
+    let text = mine.map_or("–".to_string(), |v| format!("{v:.*}", row.decimals));
+    let better = matches!((mine, other), (Some(x), Some(y)) if x < y);
+    let t = RichText::new(text).monospace();
+    match row.kind {
+        RowKind::Decides => {
+            let t = t.strong().size(DECIDES_PT);
+            if better {
+                ui.horizontal(|ui| {
+                    ui.label(t.color(BETTER_FG).background_color(BETTER_BG));
+                    ui.label(RichText::new("faster").small().strong().color(BETTER_FG));
+                });
+            } else {
+                ui.label(t);
+            }
+        }
+        RowKind::Ranked if better => {
+            ui.label(t.color(BETTER_FG));
+        }
+        RowKind::Part => {
+            ui.label(t.small());
+        }
+        RowKind::Ranked | RowKind::Info => {
+            ui.label(t);
+        }
+    }
 }
 
 /// The GA convergence plot: best and mean idle travel per generation of every plan with a
@@ -234,12 +326,42 @@ fn plan_combo(ui: &mut egui::Ui, label: &str, slot: &mut Option<usize>, plans: &
         .labelled_by(l.id);
 }
 
-/// The whole compare view.
-pub fn show(ui: &mut egui::Ui, st: &mut CompareState, doc: &Document, layers: Layers) {
-    st.fix(doc.plans.len());
+/// The plans compared: A (or B alone) and B, as indices into the document's plans.
+fn shown(st: &CompareState, n: usize) -> Option<(usize, Option<usize>)> {
+    let a = st.a.filter(|&k| k < n);
+    let b = st.b.filter(|&k| k < n);
+    match (a, b) {
+        (Some(a), b) => Some((a, b)),
+        (None, Some(b)) => Some((b, None)),
+        (None, None) => None,
+    }
+}
+
+/// What the compare view's playback plays: the longer of the two jobs (both canvases follow
+/// its clock), or the first lowering error.
+fn played(
+    toolpaths: &ToolpathCache,
+    ka: usize,
+    kb: Option<usize>,
+) -> Option<Result<&Lowered, &str>> {
+    let a = toolpaths.get(ka)?;
+    let Some(b) = kb.and_then(|k| toolpaths.get(k)) else {
+        return Some(a);
+    };
+    Some(match (a, b) {
+        (Ok(x), Ok(y)) => Ok(if y.duration_s() > x.duration_s() {
+            y
+        } else {
+            x
+        }),
+        (Err(e), _) | (_, Err(e)) => Err(e),
+    })
+}
+
+fn toolbar(ui: &mut egui::Ui, st: &mut CompareState, plans: &[Plan]) {
     ui.horizontal(|ui| {
-        plan_combo(ui, "Plan A", &mut st.a, &doc.plans);
-        plan_combo(ui, "Plan B", &mut st.b, &doc.plans);
+        plan_combo(ui, "Plan A", &mut st.a, plans);
+        plan_combo(ui, "Plan B", &mut st.b, plans);
         if ui.button("Swap A/B").clicked() {
             std::mem::swap(&mut st.a, &mut st.b);
         }
@@ -251,61 +373,75 @@ pub fn show(ui: &mut egui::Ui, st: &mut CompareState, doc: &Document, layers: La
             st.canvas.fit_requested = true;
         }
     });
-    let a = st.a.and_then(|k| doc.plans.get(k));
-    let b = st.b.and_then(|k| doc.plans.get(k));
-    let (a, b) = match (a, b) {
-        (Some(a), b) => (a, b),
-        (None, Some(b)) => (b, None),
-        (None, None) => {
-            ui.centered_and_justified(|ui| {
-                ui.label("No plans yet: run HHA (or HGA) to compare plans.");
-            });
-            return;
-        }
+}
+
+/// The whole compare view; `toolpaths` holds the plans' lowered toolpaths.
+pub fn show(
+    ui: &mut egui::Ui,
+    st: &mut CompareState,
+    doc: &Document,
+    toolpaths: &ToolpathCache,
+    layers: Layers,
+) {
+    st.fix(doc.plans.len());
+    toolbar(ui, st, &doc.plans);
+    let Some((ka, kb)) = shown(st, doc.plans.len()) else {
+        ui.centered_and_justified(|ui| {
+            ui.label("No plans yet: run HHA (or HGA) to compare plans.");
+        });
+        return;
     };
-    fn canvas<'a>(doc: &'a Document, p: &'a Plan, col: Color32, layers: Layers) -> Canvas<'a> {
-        Canvas {
-            label: "",
-            geometries: &doc.geometries,
-            profile: &doc.profile,
-            fields: &p.fields,
-            number_by_order: true,
-            paths: vec![PathLayer {
-                plan: p,
-                colour: col,
-            }],
-            uncovered: &[],
-            selected: None,
-            editable: false,
-            add_tool: false,
-            layers,
-            stale: false,
-        }
-    }
+    let job = played(toolpaths, ka, kb);
+    playback::controls(ui, "compare", &mut st.playback, job, false);
+    let playback_t_s = job
+        .and_then(Result::ok)
+        .and_then(|_| st.playback.shown_t_s());
+    let a = &doc.plans[ka];
+    let b = kb.map(|k| &doc.plans[k]);
+    let canvas = |k: usize, col: Color32| Canvas {
+        label: "",
+        geometries: &doc.geometries,
+        profile: &doc.profile,
+        fields: &doc.plans[k].fields,
+        number_by_order: true,
+        paths: vec![PathLayer {
+            plan: &doc.plans[k],
+            lowered: toolpaths.get(k).unwrap_or(Err("not lowered yet")),
+            colour: col,
+        }],
+        uncovered: &[],
+        selected: None,
+        editable: false,
+        add_tool: false,
+        layers,
+        stale: false,
+        playback_t_s,
+    };
     let bottom = 270.0_f32.min(ui.available_height() * 0.45);
     let top = (ui.available_height() - bottom - 8.0).max(100.0);
     let width = ui.available_width();
-    if st.overlay || b.is_none() {
-        let mut c = canvas(doc, a, colour::PATH_A, layers);
-        c.label = "Compare (overlay)";
-        if let Some(b) = b {
-            c.paths.push(PathLayer {
-                plan: b,
-                colour: colour::PATH_B,
+    match kb {
+        Some(kb) if !st.overlay => {
+            let half = (width - ui.spacing().item_spacing.x) / 2.0;
+            ui.horizontal(|ui| {
+                let mut ca = canvas(ka, colour::PATH_A);
+                ca.label = "Plan A";
+                ca.show(ui, &mut st.canvas, Some(Vec2::new(half, top)));
+                let mut cb = canvas(kb, colour::PATH_B);
+                cb.label = "Plan B";
+                cb.show(ui, &mut st.canvas, Some(Vec2::new(half, top)));
             });
-            c.layers.order_colours = false;
         }
-        c.show(ui, &mut st.canvas, Some(Vec2::new(width, top)));
-    } else if let Some(b) = b {
-        let half = (width - ui.spacing().item_spacing.x) / 2.0;
-        ui.horizontal(|ui| {
-            let mut ca = canvas(doc, a, colour::PATH_A, layers);
-            ca.label = "Plan A";
-            ca.show(ui, &mut st.canvas, Some(Vec2::new(half, top)));
-            let mut cb = canvas(doc, b, colour::PATH_B, layers);
-            cb.label = "Plan B";
-            cb.show(ui, &mut st.canvas, Some(Vec2::new(half, top)));
-        });
+        _ => {
+            let mut c = canvas(ka, colour::PATH_A);
+            c.label = "Compare (overlay)";
+            if let Some(kb) = kb {
+                let mut other = canvas(kb, colour::PATH_B).paths;
+                c.paths.append(&mut other);
+                c.layers.order_colours = false;
+            }
+            c.show(ui, &mut st.canvas, Some(Vec2::new(width, top)));
+        }
     }
     ui.add_space(4.0);
     ui.horizontal_top(|ui| {

@@ -4,7 +4,7 @@ use super::canvas::{Canvas, PathLayer};
 use super::commands::Command;
 use super::files::{self, ExportKind, PROJECT_EXT};
 use super::paint::colour;
-use super::{compare, is_stale, App, Tab, SOLVERS};
+use super::{compare, is_stale, playback, App, Tab, SOLVERS};
 use egui::{Color32, RichText};
 
 const ERROR: Color32 = Color32::from_rgb(200, 30, 30);
@@ -33,7 +33,13 @@ impl App {
             Tab::Workbench => self.workbench_view(ui),
             Tab::Compare => {
                 if self.has_document() {
-                    compare::show(ui, &mut self.compare, &self.doc, self.layers);
+                    compare::show(
+                        ui,
+                        &mut self.compare,
+                        &self.doc,
+                        &self.toolpaths,
+                        self.layers,
+                    );
                 } else {
                     ui.label("Open a document first.");
                 }
@@ -424,7 +430,10 @@ impl App {
             let p = &self.doc.plans[k];
             let stale = is_stale(p, &self.doc);
             ui.horizontal(|ui| {
-                let text = format!("{}  idle {:.1} mm", p.name, p.metrics.idle_mm);
+                let text = match p.metrics.job_time_s {
+                    Some(t) => format!("{}  job time {t:.2} s", p.name),
+                    None => format!("{}  idle travel {:.1} mm", p.name, p.metrics.idle_mm),
+                };
                 if ui.selectable_label(self.active == Some(k), text).clicked() {
                     self.active = Some(k);
                 }
@@ -443,6 +452,7 @@ impl App {
         }
         if let Some(k) = remove {
             let p = self.doc.plans.remove(k);
+            self.toolpaths.sync(&self.doc);
             self.compare = super::CompareState {
                 canvas: std::mem::take(&mut self.compare.canvas),
                 ..Default::default()
@@ -468,7 +478,12 @@ impl App {
             return;
         }
         let plan = self.active.and_then(|k| self.doc.plans.get(k));
+        let lowered = self.active.and_then(|k| self.toolpaths.get(k));
+        playback::controls(ui, "workbench", &mut self.playback, lowered, true);
         let stale = plan.is_some_and(|p| is_stale(p, &self.doc));
+        let playback_t_s = lowered
+            .and_then(Result::ok)
+            .and_then(|_| self.playback.shown_t_s());
         let canvas = Canvas {
             label: "Work area",
             geometries: &self.doc.geometries,
@@ -476,8 +491,10 @@ impl App {
             fields: &self.doc.fields,
             number_by_order: false,
             paths: plan
-                .map(|p| PathLayer {
+                .zip(lowered)
+                .map(|(p, lowered)| PathLayer {
                     plan: p,
+                    lowered,
                     colour: colour::PATH_A,
                 })
                 .into_iter()
@@ -488,6 +505,7 @@ impl App {
             add_tool: self.add_tool,
             layers: self.layers,
             stale,
+            playback_t_s,
         };
         let (_, actions) = canvas.show(ui, &mut self.workbench, None);
         self.on_canvas(actions);

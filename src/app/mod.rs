@@ -7,9 +7,11 @@
 //! (egui_kittest) both call it.
 //!
 //! Modules: [`canvas`] (pan/zoom, field dragging, hover) and `paint` (drawing), [`panels`]
-//! (profile and settings editors), [`jobs`] (background solves), [`compare`] (side-by-side
-//! view, metrics table, convergence plot), [`commands`] (edits and undo), [`files`]
-//! (open/save/export/recent), `layout` (menus, toolbar, side panels, status bar).
+//! (profile and settings editors), [`jobs`] (background solves), [`toolpaths`] (each plan's
+//! lowered toolpath, the one the canvas draws and plays), [`playback`] (playing a job on the
+//! canvas), [`compare`] (side-by-side view, metrics table, convergence plot), [`commands`]
+//! (edits and undo), [`files`] (open/save/export/recent), `layout` (menus, toolbar, side
+//! panels, status bar).
 
 pub mod canvas;
 pub mod commands;
@@ -19,6 +21,8 @@ pub mod jobs;
 mod layout;
 mod paint;
 pub mod panels;
+pub mod playback;
+pub mod toolpaths;
 
 pub use canvas::{Canvas, CanvasAction, CanvasState, Layers, View};
 
@@ -27,9 +31,11 @@ use commands::{Command, History, Outcome};
 use compare::CompareState;
 use files::{ExportKind, Recent};
 use jobs::{Job, JobOutcome};
+use playback::Playback;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
+use toolpaths::{Lowered, ToolpathCache};
 
 /// Key of the preferences in eframe's storage.
 const PREFS_KEY: &str = "galvoplan-prefs";
@@ -39,6 +45,7 @@ pub const SOLVERS: &[(Algo, &str)] = &[
     (Algo::Hha, "Run HHA"),
     (Algo::Hga, "Run HGA"),
     (Algo::Baseline, "Run baseline"),
+    (Algo::AsIs, "Run as-is"),
 ];
 
 /// What is kept between runs (eframe storage).
@@ -163,6 +170,10 @@ pub struct App {
     pub tab: Tab,
     /// Index of the plan drawn on the workbench.
     active: Option<usize>,
+    /// Each plan's lowered toolpath (run time only).
+    toolpaths: ToolpathCache,
+    /// Playback on the workbench canvas (run time only).
+    playback: Playback,
     uncovered: Vec<usize>,
     /// A problem with the open document (e.g. fields could not be placed).
     problem: Option<String>,
@@ -202,6 +213,8 @@ impl App {
             add_tool: false,
             tab: Tab::Workbench,
             active: None,
+            toolpaths: ToolpathCache::default(),
+            playback: Playback::default(),
             uncovered: Vec::new(),
             problem: None,
             recent: prefs.recent,
@@ -257,6 +270,7 @@ impl App {
                 self.selected = None;
                 self.active = self.doc.plans.len().checked_sub(1);
                 self.compare = CompareState::default();
+                self.playback = Playback::default();
                 self.workbench.fit_requested = true;
                 self.compare.canvas.fit_requested = true;
                 self.recent.push(path);
@@ -376,6 +390,7 @@ impl App {
         if self.active.is_some_and(|k| k >= self.doc.plans.len()) {
             self.active = self.doc.plans.len().checked_sub(1);
         }
+        self.toolpaths.sync(&self.doc);
     }
 
     /// Geometries no field holds.
@@ -391,6 +406,16 @@ impl App {
     /// The plan drawn on the workbench.
     pub fn active_plan(&self) -> Option<&Plan> {
         self.active.and_then(|k| self.doc.plans.get(k))
+    }
+
+    /// Plan `k`'s lowered toolpath, or why it could not be lowered (`None`: no such plan).
+    pub fn toolpath(&self, k: usize) -> Option<Result<&Lowered, &str>> {
+        self.toolpaths.get(k)
+    }
+
+    /// The workbench playback (time, playing, speed).
+    pub fn playback(&self) -> &Playback {
+        &self.playback
     }
 
     /// True while a solve runs.
@@ -458,10 +483,10 @@ impl App {
     }
 
     fn next_plan_name(&self, algo: Algo) -> String {
-        let label = if algo == Algo::Baseline {
-            "Baseline".to_string()
-        } else {
-            format!("{algo:?}").to_uppercase()
+        let label = match algo {
+            Algo::Baseline => "Baseline".to_string(),
+            Algo::AsIs => "As-is".to_string(),
+            Algo::Hha | Algo::Hga => algo.label().to_uppercase(),
         };
         (1..)
             .map(|n| format!("{label} #{n}"))
@@ -487,19 +512,31 @@ impl App {
                 } else {
                     name
                 };
+                let m = &plan.metrics;
+                let job = m.job_time_s.map_or("job time unknown".to_string(), |t| {
+                    format!("job time {t:.2} s")
+                });
                 let msg = format!(
-                    "{}: idle {:.1} mm, base {:.1} mm, {} fields, {:.2} s",
+                    "{}: {job}, idle travel {:.1} mm, stage travel {:.1} mm, {} scan fields \
+                     (solved in {:.2} s)",
                     plan.name,
-                    plan.metrics.idle_mm,
-                    plan.metrics.base_mm,
-                    plan.metrics.fields,
+                    m.idle_mm,
+                    m.base_mm,
+                    m.fields,
                     elapsed.as_secs_f64()
                 );
                 self.doc.plans.push(*plan);
+                self.toolpaths.sync(&self.doc);
                 let k = self.doc.plans.len() - 1;
                 self.active = Some(k);
                 self.compare.push(k);
-                self.set_status(msg, false);
+                match self.toolpaths.get(k) {
+                    Some(Err(why)) => {
+                        let msg = format!("{msg}; {why}");
+                        self.set_status(msg, true);
+                    }
+                    _ => self.set_status(msg, false),
+                }
             }
             JobOutcome::Failed(e) if cancelled => {
                 self.set_status(format!("{name}: cancelled ({e})"), false)
@@ -549,6 +586,8 @@ impl App {
         let t0 = Instant::now();
         self.poll_job();
         self.handle_input(ui.ctx());
+        // plans added, loaded or removed, the profile or the geometries changed
+        self.toolpaths.sync(&self.doc);
         self.layout(ui);
         if self.job.is_some() {
             // keep the elapsed time ticking between progress reports

@@ -1,7 +1,9 @@
-//! Drawing of a [`Canvas`]: base stroke, fields, artwork, uncovered geometries, planned paths.
+//! Drawing of a [`Canvas`]: base stroke, fields, artwork, uncovered geometries, planned paths
+//! (from each plan's lowered toolpath) and the playback of a job.
 
 use super::canvas::{Canvas, PathLayer, View};
-use crate::document::Plan;
+use super::playback;
+use super::toolpaths::Lowered;
 use crate::geom::Pt;
 use egui::{Align2, Color32, FontId, Painter, Pos2, Rect, Shape, Stroke, StrokeKind, Vec2};
 
@@ -77,11 +79,22 @@ pub fn paint(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
     }
     paint_artwork(painter, c, view, rect);
     for (k, path) in c.paths.iter().enumerate() {
+        let Ok(lowered) = path.lowered else { continue };
         if c.layers.base_path && k == 0 {
-            paint_base_path(painter, path.plan, view, rect);
+            paint_base_path(painter, lowered, view, rect);
         }
         if c.layers.path {
-            paint_path(painter, c, path, view, rect);
+            paint_path(painter, c, path, lowered, view, rect);
+        }
+    }
+    if let Some(t_s) = c.playback_t_s {
+        let s = |q: Pt| view.to_screen(rect, q);
+        let overlaid = c.paths.len() > 1;
+        for path in &c.paths {
+            if let Ok(l) = path.lowered {
+                let done = overlaid.then_some(path.colour);
+                playback::paint(painter, l, t_s, c.profile.field_mm, done, &s);
+            }
         }
     }
     paint_caption(painter, c, rect);
@@ -134,21 +147,27 @@ fn paint_fields(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
 
 fn paint_artwork(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
     let s = |q: Pt| view.to_screen(rect, q);
-    // marks coloured by their position in the first plan's order
+    // marks coloured by their position in the first plan's toolpath
     let rank: Option<Vec<f32>> = c
         .paths
         .first()
+        .and_then(|p| p.lowered.ok())
         .filter(|_| c.layers.order_colours && c.layers.path)
-        .map(|p| {
+        .map(|l| {
+            let strokes = &l.toolpath.strokes;
             let mut r = vec![-1.0; c.geometries.len()];
-            let n = (p.plan.order.len().max(2) - 1) as f32;
-            for (i, st) in p.plan.order.iter().enumerate() {
+            let n = (strokes.len().max(2) - 1) as f32;
+            for (i, st) in strokes.iter().enumerate() {
                 if let Some(x) = r.get_mut(st.geometry) {
-                    *x = i as f32 / n;
+                    if *x < 0.0 {
+                        *x = i as f32 / n;
+                    }
                 }
             }
             r
         });
+    // during a playback the artwork is faded: the marks done are drawn over it
+    let fade = if c.playback_t_s.is_some() { 0.3 } else { 1.0 };
     let mut shapes = Vec::with_capacity(c.geometries.len());
     for (k, g) in c.geometries.iter().enumerate() {
         if g.points.is_empty() {
@@ -162,7 +181,8 @@ fn paint_artwork(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
         let col = match &rank {
             Some(r) if r[k] >= 0.0 => lerp(colour::ORDER[0], colour::ORDER[1], r[k]),
             _ => base,
-        };
+        }
+        .gamma_multiply(fade);
         let mut pts: Vec<Pos2> = g.points.iter().map(|&q| s(q)).collect();
         if g.closed {
             pts.push(pts[0]);
@@ -189,12 +209,16 @@ fn paint_artwork(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
     painter.extend(shapes);
 }
 
-fn paint_base_path(painter: &Painter, plan: &Plan, view: &View, rect: Rect) {
-    let pts: Vec<Pos2> = plan
-        .fields
-        .iter()
-        .map(|f| view.to_screen(rect, f.center))
-        .collect();
+/// The stage path: the stage positions of the strokes in marking order.
+fn paint_base_path(painter: &Painter, l: &Lowered, view: &View, rect: Rect) {
+    let mut pts: Vec<Pos2> = Vec::new();
+    let mut last: Option<Pt> = None;
+    for st in &l.toolpath.strokes {
+        if last != Some(st.stage) {
+            pts.push(view.to_screen(rect, st.stage));
+            last = Some(st.stage);
+        }
+    }
     if pts.len() > 1 {
         painter.extend(Shape::dashed_line(
             &pts,
@@ -205,70 +229,87 @@ fn paint_base_path(painter: &Painter, plan: &Plan, view: &View, rect: Rect) {
     }
 }
 
-fn paint_path(painter: &Painter, c: &Canvas<'_>, path: &PathLayer<'_>, view: &View, rect: Rect) {
+/// Idle moves between consecutive strokes (dashed, with arrows), start `S` and end `E`.
+fn paint_path(
+    painter: &Painter,
+    c: &Canvas<'_>,
+    path: &PathLayer<'_>,
+    l: &Lowered,
+    view: &View,
+    rect: Rect,
+) {
     let s = |q: Pt| view.to_screen(rect, q);
     let col = if c.stale {
         path.colour.gamma_multiply(0.45)
     } else {
         path.colour
     };
-    let stroke = Stroke::new(1.3, col);
+    let tp = &l.toolpath;
+    let ends = |k: usize| {
+        let p = tp.stroke_points(k);
+        p.first().copied().zip(p.last().copied())
+    };
     let mut shapes = Vec::new();
-    let mut prev: Option<Pt> = None;
-    let ends =
-        |st: &crate::document::Step| c.geometries.get(st.geometry).map(|g| g.ends(st.choice(g)));
-    for st in &path.plan.order {
-        let Some((a, z)) = ends(st) else { continue };
-        if let Some(pz) = prev {
-            let (p0, p1) = (s(pz), s(a));
-            let len = (p1 - p0).length();
-            if len > 0.5 {
-                shapes.extend(Shape::dashed_line(&[p0, p1], stroke, 5.0, 3.0));
-            }
-            if c.layers.arrows && len > 28.0 {
-                let dir = (p1 - p0) / len;
-                let tip = p0 + (p1 - p0) * 0.55;
-                let back = tip - dir * 7.0;
-                let side = Vec2::new(-dir.y, dir.x) * 3.5;
-                shapes.push(Shape::convex_polygon(
-                    vec![tip, back + side, back - side],
-                    col,
-                    Stroke::NONE,
-                ));
-            }
-        }
-        prev = Some(z);
+    for k in 1..tp.strokes.len() {
+        let (Some((_, z)), Some((a, _))) = (ends(k - 1), ends(k)) else {
+            continue;
+        };
+        idle_move(&mut shapes, s(z), s(a), col, c.layers.arrows);
     }
     painter.extend(shapes);
-    let order = &path.plan.order;
-    if let (Some((start, _)), Some((_, end))) =
-        (order.first().and_then(ends), order.last().and_then(ends))
-    {
-        let (ps, pe) = (s(start), s(end));
-        painter.circle(ps, 7.0, colour::START, Stroke::new(1.5, Color32::WHITE));
-        painter.text(
-            ps,
-            Align2::CENTER_CENTER,
-            "S",
-            FontId::proportional(10.0),
-            Color32::WHITE,
-        );
-        let r = Rect::from_center_size(pe, Vec2::splat(13.0));
-        painter.rect(
-            r,
-            2.0,
-            colour::END,
-            Stroke::new(1.5, Color32::WHITE),
-            StrokeKind::Outside,
-        );
-        painter.text(
-            pe,
-            Align2::CENTER_CENTER,
-            "E",
-            FontId::proportional(10.0),
-            Color32::WHITE,
-        );
+    let n = tp.strokes.len();
+    if let (Some((start, _)), Some((_, end))) = (ends(0), n.checked_sub(1).and_then(ends)) {
+        start_end_markers(painter, s(start), s(end));
     }
+}
+
+fn idle_move(shapes: &mut Vec<Shape>, p0: Pos2, p1: Pos2, col: Color32, arrows: bool) {
+    let len = (p1 - p0).length();
+    if len > 0.5 {
+        shapes.extend(Shape::dashed_line(
+            &[p0, p1],
+            Stroke::new(1.3, col),
+            5.0,
+            3.0,
+        ));
+    }
+    if arrows && len > 28.0 {
+        let dir = (p1 - p0) / len;
+        let tip = p0 + (p1 - p0) * 0.55;
+        let back = tip - dir * 7.0;
+        let side = Vec2::new(-dir.y, dir.x) * 3.5;
+        shapes.push(Shape::convex_polygon(
+            vec![tip, back + side, back - side],
+            col,
+            Stroke::NONE,
+        ));
+    }
+}
+
+fn start_end_markers(painter: &Painter, ps: Pos2, pe: Pos2) {
+    painter.circle(ps, 7.0, colour::START, Stroke::new(1.5, Color32::WHITE));
+    painter.text(
+        ps,
+        Align2::CENTER_CENTER,
+        "S",
+        FontId::proportional(10.0),
+        Color32::WHITE,
+    );
+    let r = Rect::from_center_size(pe, Vec2::splat(13.0));
+    painter.rect(
+        r,
+        2.0,
+        colour::END,
+        Stroke::new(1.5, Color32::WHITE),
+        StrokeKind::Outside,
+    );
+    painter.text(
+        pe,
+        Align2::CENTER_CENTER,
+        "E",
+        FontId::proportional(10.0),
+        Color32::WHITE,
+    );
 }
 
 fn paint_caption(painter: &Painter, c: &Canvas<'_>, rect: Rect) {
@@ -285,13 +326,19 @@ fn paint_caption(painter: &Painter, c: &Canvas<'_>, rect: Rect) {
     };
     line(c.label.to_string(), Color32::from_gray(40));
     for p in &c.paths {
-        line(
-            format!(
-                "{}: idle {:.1} mm, base {:.1} mm, {} fields",
-                p.plan.name, p.plan.metrics.idle_mm, p.plan.metrics.base_mm, p.plan.metrics.fields
+        line(plan_caption(p), p.colour);
+        match (p.lowered, c.playback_t_s) {
+            (Err(why), _) => line(why.to_string(), colour::UNCOVERED),
+            (Ok(l), Some(t_s)) => line(
+                format!(
+                    "{}: {}",
+                    playback::time_text(t_s.min(l.duration_s()), l.duration_s()),
+                    playback::state_text(l, t_s)
+                ),
+                Color32::from_gray(40),
             ),
-            p.colour,
-        );
+            (Ok(_), None) => {}
+        }
     }
     if c.stale {
         line(
@@ -305,6 +352,21 @@ fn paint_caption(painter: &Painter, c: &Canvas<'_>, rect: Rect) {
             colour::UNCOVERED,
         );
     }
+}
+
+/// A plan's caption, led by the figure that decides: its job time.
+fn plan_caption(p: &PathLayer<'_>) -> String {
+    let m = &p.plan.metrics;
+    let job = m
+        .job_time_s
+        .or(p.lowered.ok().map(Lowered::duration_s))
+        .map_or("job time unknown".to_string(), |t| {
+            format!("job time {t:.2} s")
+        });
+    format!(
+        "{}: {job} · idle travel {:.0} mm · stage travel {:.0} mm · {} scan fields",
+        p.plan.name, m.idle_mm, m.base_mm, m.fields
+    )
 }
 
 fn paint_scale_bar(painter: &Painter, view: &View, rect: Rect) {

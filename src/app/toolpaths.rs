@@ -1,0 +1,188 @@
+//! The GUI's one lowering: each plan's [`Toolpath`] (from [`lower_plan`]) kept at run time, so
+//! that the canvas, its hover, the captions and the playback all read the same timed job.
+//! Nothing here is saved; a plan that cannot be lowered keeps the error in words.
+
+use crate::document::{Document, MachineProfile, Plan};
+use crate::motion::{ScanMotion, Toolpath};
+use crate::pipeline::lower_plan;
+use std::sync::Arc;
+
+/// A plan's lowered toolpath with the time window of each stroke's mark.
+#[derive(Debug, Clone)]
+pub struct Lowered {
+    /// The toolpath.
+    pub toolpath: Toolpath,
+    /// Per stroke (index into `toolpath.strokes`): (start, end) of its mark, s.
+    pub mark_s: Vec<(f64, f64)>,
+}
+
+impl Lowered {
+    /// Wraps a toolpath and indexes its mark segments by stroke.
+    pub fn new(toolpath: Toolpath) -> Self {
+        let mut mark_s = vec![(f64::INFINITY, f64::INFINITY); toolpath.strokes.len()];
+        for seg in &toolpath.segments {
+            if let ScanMotion::Mark { stroke } = seg.scan {
+                if let Some(m) = mark_s.get_mut(stroke) {
+                    *m = (seg.start_s, seg.end_s());
+                }
+            }
+        }
+        Self { toolpath, mark_s }
+    }
+
+    /// The job time, s.
+    pub fn duration_s(&self) -> f64 {
+        self.toolpath.duration_s()
+    }
+
+    /// How many strokes are completely marked at `t_s` (strokes are marked in order).
+    pub fn strokes_done(&self, t_s: f64) -> usize {
+        self.mark_s.partition_point(|&(_, end_s)| end_s <= t_s)
+    }
+
+    /// The position (from 0) of the first stroke of geometry `g` in marking order.
+    pub fn stroke_of_geometry(&self, g: usize) -> Option<usize> {
+        self.toolpath.strokes.iter().position(|s| s.geometry == g)
+    }
+}
+
+/// What a cached toolpath was lowered from; a different key means lowering again.
+#[derive(Debug, Clone, PartialEq)]
+struct Key {
+    name: String,
+    steps: usize,
+    job_time_bits: Option<u64>,
+    fields: usize,
+    geometries: usize,
+    profile: MachineProfile,
+}
+
+impl Key {
+    fn of(doc: &Document, plan: &Plan) -> Self {
+        Self {
+            name: plan.name.clone(),
+            steps: plan.order.len(),
+            job_time_bits: plan.metrics.job_time_s.map(f64::to_bits),
+            fields: plan.fields.len(),
+            geometries: doc.geometries.len(),
+            profile: doc.profile.clone(),
+        }
+    }
+}
+
+/// One plan's lowering: the toolpath, or why there is none.
+#[derive(Debug, Clone)]
+struct Entry {
+    key: Key,
+    result: Result<Arc<Lowered>, String>,
+}
+
+/// The toolpaths of a document's plans, by plan index.
+#[derive(Debug, Clone, Default)]
+pub struct ToolpathCache {
+    entries: Vec<Entry>,
+}
+
+impl ToolpathCache {
+    /// Lowers the plans that are new or changed (a plan added, loaded or removed, another
+    /// profile, other geometries); returns how many were lowered. Cheap when nothing changed.
+    pub fn sync(&mut self, doc: &Document) -> usize {
+        self.entries.truncate(doc.plans.len());
+        let mut lowered = 0;
+        for (k, plan) in doc.plans.iter().enumerate() {
+            let key = Key::of(doc, plan);
+            if self.entries.get(k).is_some_and(|e| e.key == key) {
+                continue;
+            }
+            let result = lower_plan(doc, plan)
+                .map(|t| Arc::new(Lowered::new(t)))
+                .map_err(|e| format!("cannot lower {} to a toolpath: {e}", plan.name));
+            let entry = Entry { key, result };
+            if k < self.entries.len() {
+                self.entries[k] = entry;
+            } else {
+                self.entries.push(entry);
+            }
+            lowered += 1;
+        }
+        lowered
+    }
+
+    /// Plan `k`'s toolpath, or the lowering error in words (`None`: no such plan, or not yet
+    /// synchronised).
+    pub fn get(&self, k: usize) -> Option<Result<&Lowered, &str>> {
+        self.entries
+            .get(k)
+            .map(|e| e.result.as_deref().map_err(String::as_str))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used, clippy::expect_used)]
+    use super::*;
+    use crate::document::{Algo, Geometry, Metrics, ScanField, Source, Step};
+    use crate::geom::Pt;
+
+    fn doc_with_plan(bad_geometry: bool) -> Document {
+        let line = Geometry::new(
+            vec![Pt::new(10.0, 10.0), Pt::new(20.0, 10.0)],
+            false,
+            Source::default(),
+        );
+        let field = ScanField {
+            id: 0,
+            center: Pt::new(15.0, 10.0),
+            size: [70.0; 2],
+            locked: false,
+            geometries: vec![0],
+        };
+        let plan = Plan {
+            name: "P".into(),
+            algo: Algo::AsIs,
+            fields: vec![field.clone()],
+            order: vec![Step {
+                geometry: if bad_geometry { 7 } else { 0 },
+                field: 0,
+                start_vertex: 0,
+                reversed: false,
+            }],
+            metrics: Metrics::default(),
+            history: Vec::new(),
+        };
+        Document {
+            geometries: vec![line],
+            fields: vec![field],
+            plans: vec![plan],
+            ..Document::default()
+        }
+    }
+
+    #[test]
+    fn lowers_once_and_again_after_a_profile_change() {
+        let mut doc = doc_with_plan(false);
+        let mut cache = ToolpathCache::default();
+        assert_eq!(cache.sync(&doc), 1);
+        assert_eq!(cache.sync(&doc), 0);
+        let l = cache.get(0).unwrap().unwrap();
+        assert_eq!(l.toolpath.strokes.len(), 1);
+        let (s0, s1) = l.mark_s[0];
+        assert!(0.0 < s0 && s0 < s1 && s1 <= l.duration_s());
+        assert_eq!(l.strokes_done(s0), 0);
+        assert_eq!(l.strokes_done(s1), 1);
+        doc.profile.scanner.mark_speed_mm_s *= 2.0;
+        assert_eq!(cache.sync(&doc), 1);
+        doc.plans.clear();
+        cache.sync(&doc);
+        assert!(cache.get(0).is_none());
+    }
+
+    #[test]
+    fn a_lowering_error_is_kept_in_words() {
+        let doc = doc_with_plan(true);
+        let mut cache = ToolpathCache::default();
+        cache.sync(&doc);
+        let e = cache.get(0).unwrap().unwrap_err();
+        assert!(e.starts_with("cannot lower P to a toolpath:"), "{e}");
+    }
+}
