@@ -14,7 +14,8 @@ pub use as_is::as_is_order;
 pub use baseline::baseline_order;
 
 use crate::document::{
-    Algo, CostModel, Geometry, MachineProfile, Plan, ScanField, SolverSettings, Step,
+    Algo, CostModel, GenerationRecord, Geometry, MachineProfile, Plan, ScanField, SolverSettings,
+    Step,
 };
 use crate::job::{Cancelled, JobCtx};
 use crate::motion::{lower, LowerError, Toolpath};
@@ -55,54 +56,25 @@ pub fn order_plan(
     check_allocation(geometries.len(), fields)?;
     let t0 = std::time::Instant::now();
     let mut detail = Vec::new();
-    let mut history = Vec::new();
-    // what a time search starts from: the algorithm's plan, and HGA's HHA seed plan too
-    let mut starts = Vec::new();
-    match settings.algo {
-        Algo::AsIs => starts.push(as_is_order(geometries, fields, ctx)?),
-        Algo::Baseline => starts.push(baseline_order(geometries, fields, ctx)?),
-        Algo::Hha => starts.push(hha::hha_order(
-            geometries,
-            fields,
-            profile,
-            settings,
-            ctx,
-            &mut detail,
-        )?),
-        Algo::Hga => {
-            let (r, seed_plan) = run_hga(geometries, fields, profile, settings, ctx, &mut detail)?;
-            history = r.history;
-            starts.push(r.ordering);
-            starts.extend(seed_plan);
-        }
-    };
-    let by_time = settings.cost_model == CostModel::Time && settings.algo != Algo::AsIs;
-    let t = std::time::Instant::now();
-    let mut best: Option<(Ordering, Toolpath)> = None;
-    for start in starts {
-        let candidate = if by_time {
-            time_ordering(geometries, fields, profile, settings, start, ctx)?
+    let (ordering, seed_ordering, history) =
+        run_algorithm(geometries, fields, profile, settings, ctx, &mut detail)?;
+    let (ordering, toolpath) =
+        if settings.cost_model == CostModel::Time && settings.algo != Algo::AsIs {
+            let t = std::time::Instant::now();
+            let mut best = time_ordering(geometries, fields, profile, settings, ordering, ctx)?;
+            if let Some(seed) = seed_ordering {
+                // HGA's own objective is idle travel: on time, its HHA seed may still be faster
+                let other = time_ordering(geometries, fields, profile, settings, seed, ctx)?;
+                if other.1.duration_s() < best.1.duration_s() {
+                    best = other;
+                }
+            }
+            detail.push(("time".into(), t.elapsed().as_secs_f64()));
+            best
         } else {
-            let toolpath = lower_ordering(geometries, fields, profile, &start)?;
-            (start, toolpath)
+            let toolpath = lower_ordering(geometries, fields, profile, &ordering)?;
+            (ordering, toolpath)
         };
-        if best
-            .as_ref()
-            .is_none_or(|b| candidate.1.duration_s() < b.1.duration_s())
-        {
-            best = Some(candidate);
-        }
-        // the distance objective is the algorithm's own: its plan alone counts
-        if !by_time {
-            break;
-        }
-    }
-    if by_time {
-        detail.push(("time".into(), t.elapsed().as_secs_f64()));
-    }
-    let Some((ordering, toolpath)) = best else {
-        return Err(OrderError::Cancelled(Cancelled));
-    };
     let order_s = t0.elapsed().as_secs_f64();
     let plan_fields = fields_in_order(fields, &ordering.field_order);
     let mut m = metrics::compute(
@@ -121,6 +93,30 @@ pub fn order_plan(
         order: ordering.steps,
         metrics: m,
         history,
+    })
+}
+
+/// The ordering of the settings' algorithm, HGA's HHA seed ordering (when it had one) and HGA's
+/// convergence history.
+fn run_algorithm(
+    geometries: &[Geometry],
+    fields: &[ScanField],
+    profile: &MachineProfile,
+    settings: &SolverSettings,
+    ctx: &JobCtx,
+    detail: &mut Vec<(String, f64)>,
+) -> Result<(Ordering, Option<Ordering>, Vec<GenerationRecord>), OrderError> {
+    Ok(match settings.algo {
+        Algo::AsIs => (as_is_order(geometries, fields, ctx)?, None, Vec::new()),
+        Algo::Baseline => (baseline_order(geometries, fields, ctx)?, None, Vec::new()),
+        Algo::Hha => {
+            let ordering = hha::hha_order(geometries, fields, profile, settings, ctx, detail)?;
+            (ordering, None, Vec::new())
+        }
+        Algo::Hga => {
+            let (r, seed) = run_hga(geometries, fields, profile, settings, ctx, detail)?;
+            (r.ordering, seed, r.history)
+        }
     })
 }
 
