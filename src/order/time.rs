@@ -20,6 +20,7 @@ use crate::geom::Pt;
 use crate::job::{Cancelled, JobCtx};
 use crate::motion::StageDynamics;
 use rayon::prelude::*;
+use std::collections::HashMap;
 
 /// Fewest iterated-local-search kicks on the field path.
 const STAGE_KICKS_MIN: usize = 32;
@@ -38,59 +39,54 @@ pub fn refine_for_time(
     seed: u64,
     ctx: &JobCtx,
 ) -> Result<Ordering, Cancelled> {
-    let field_order = field_order_on_stage_time(fields, &ordering.field_order, profile, seed, ctx)?;
-    let mut runs: Vec<(usize, Vec<Step>)> = field_runs(&ordering.steps)
+    let runs: Vec<&[Step]> = field_runs(&ordering.steps)
         .into_iter()
-        .map(|(a, b)| (ordering.steps[a].field, ordering.steps[a..b].to_vec()))
+        .map(|(a, b)| &ordering.steps[a..b])
         .collect();
-    let rank: std::collections::HashMap<usize, usize> = field_order
+    let centre: HashMap<usize, Pt> = fields.iter().map(|f| (f.id, f.center)).collect();
+    let Some(centres) = runs
         .iter()
-        .enumerate()
-        .map(|(k, &id)| (id, k))
-        .collect();
-    runs.sort_by_key(|(id, _)| rank.get(id).copied().unwrap_or(usize::MAX));
-    let refined: Vec<Result<Vec<Step>, Cancelled>> = runs
+        .map(|run| centre.get(&run[0].field).copied())
+        .collect::<Option<Vec<Pt>>>()
+    else {
+        // a step names a field that does not exist: lowering reports it with its step
+        return Ok(ordering.clone());
+    };
+    let visit = path_on_stage_time(&centres, profile, seed, ctx)?;
+    let refined: Vec<Result<Vec<Step>, Cancelled>> = visit
         .par_iter()
         .enumerate()
-        .map(|(j, (_, run))| free_field_path(geometries, run, seed ^ ((j as u64) << 32), ctx))
+        .map(|(j, &r)| free_field_path(geometries, runs[r], seed ^ ((j as u64) << 32), ctx))
         .collect();
     let mut steps = Vec::with_capacity(ordering.steps.len());
     for r in refined {
         steps.extend(r?);
     }
+    let field_order = visit.iter().map(|&r| runs[r][0].field).collect();
     Ok(Ordering { field_order, steps })
 }
 
-/// The field path re-optimised on stage time from `order` (field ids), both ends free.
-fn field_order_on_stage_time(
-    fields: &[ScanField],
-    order: &[usize],
+/// The order (indices into `centres`, the stage positions in their current order) that the
+/// stage visits them in, re-optimised on stage time with both ends free.
+fn path_on_stage_time(
+    centres: &[Pt],
     profile: &MachineProfile,
     seed: u64,
     ctx: &JobCtx,
 ) -> Result<Vec<usize>, Cancelled> {
-    let centers: Vec<Pt> = order
-        .iter()
-        .map(|id| {
-            fields
-                .iter()
-                .find(|f| f.id == *id)
-                .map_or(Pt::default(), |f| f.center)
-        })
-        .collect();
-    let n = centers.len();
-    if n < 3 {
-        return Ok(order.to_vec());
-    }
-    let mut prob = PathProblem::points(&centers, &vec![0.0; n], 0.0);
-    prob.metric = TravelCost::StageTime(StageDynamics::of(profile));
+    let n = centres.len();
     let mut tour = Tour {
         order: (0..n).collect(),
         flipped: vec![false; n],
     };
+    if n < 3 {
+        return Ok(tour.order);
+    }
+    let mut prob = PathProblem::points(centres, &vec![0.0; n], 0.0);
+    prob.metric = TravelCost::StageTime(StageDynamics::of(profile));
     let kicks = (2 * n).clamp(STAGE_KICKS_MIN, STAGE_KICKS_MAX);
     LocalSearch::new(&prob, LsOptions::default()).iterated(&mut tour, kicks, seed, ctx)?;
-    Ok(tour.order.iter().map(|&k| order[k]).collect())
+    Ok(tour.order)
 }
 
 /// One field's strokes as a free open path on distance (λ = 0), exact start vertices; the old
