@@ -17,6 +17,7 @@
 
 mod axis;
 mod lower;
+pub mod taut;
 mod toolpath;
 
 pub use axis::{AxisMove, StageDynamics, StageMove};
