@@ -694,22 +694,25 @@ mod tests {
             -3.0f64..3.0,
             prop_oneof![Just(0.0), 0.0f64..2.0, 0.0f64..0.2],
         );
-        prop::collection::vec(sample, 1..=12).prop_map(|v| {
-            let (mut t, mut c) = (0.0, 0.0);
-            let mut tube = Owned {
-                t_s: vec![],
-                lower_mm: vec![],
-                upper_mm: vec![],
-            };
-            for (dt, dc, h) in v {
-                t += dt;
-                c += dc;
-                tube.t_s.push(t);
-                tube.lower_mm.push(c - h);
-                tube.upper_mm.push(c + h);
-            }
-            tube
-        })
+        prop::collection::vec(sample, 1..=12).prop_map(walk_tube)
+    }
+
+    /// A tube around a random walk: per sample (time step, centre step, half-width).
+    fn walk_tube(steps: Vec<(f64, f64, f64)>) -> Owned {
+        let (mut t, mut c) = (0.0, 0.0);
+        let mut tube = Owned {
+            t_s: vec![],
+            lower_mm: vec![],
+            upper_mm: vec![],
+        };
+        for (dt, dc, h) in steps {
+            t += dt;
+            c += dc;
+            tube.t_s.push(t);
+            tube.lower_mm.push(c - h);
+            tube.upper_mm.push(c + h);
+        }
+        tube
     }
 
     /// A tube with ends: each free or fixed at a fraction of its interval.
@@ -736,22 +739,7 @@ mod tests {
     /// ties and collinear points).
     fn long_tube() -> impl Strategy<Value = (Owned, Option<f64>, Option<f64>)> {
         let walk = prop::collection::vec((0.01f64..1.0, -1.0f64..1.0, 0.0f64..0.5), 1..400)
-            .prop_map(|v| {
-                let (mut t, mut c) = (0.0, 0.0);
-                let mut tube = Owned {
-                    t_s: vec![],
-                    lower_mm: vec![],
-                    upper_mm: vec![],
-                };
-                for (dt, dc, h) in v {
-                    t += dt;
-                    c += dc;
-                    tube.t_s.push(t);
-                    tube.lower_mm.push(c - h);
-                    tube.upper_mm.push(c + h);
-                }
-                tube
-            });
+            .prop_map(walk_tube);
         let ints = prop::collection::vec((-3i32..=3, 0i32..=2), 1..400).prop_map(|v| Owned {
             t_s: (0..v.len()).map(|k| k as f64).collect(),
             lower_mm: v.iter().map(|&(c, _)| f64::from(c)).collect(),
