@@ -368,6 +368,13 @@ fn compare_view_shows_both_plans_and_the_difference() {
         .get_all_by_label(&format!("{best_s:.3}"))
         .any(|n| (n.rect().center().y - faster.center().y).abs() < 4.0
             && n.rect().right() <= faster.left()));
+    // one playback clock for both canvases, as long as the longer job
+    let longer_s = a.job_time_s.unwrap().max(b.job_time_s.unwrap());
+    h.get_by_label("Time").set_value_accesskit(1.5);
+    h.run();
+    assert_eq!(h.state().compare.playback.t_s, 1.5);
+    h.get_by_label(&time_text(1.5, longer_s));
+    assert_eq!(h.state().playback().t_s, 0.0, "the workbench keeps its own");
     h.get_by_label("Overlay").click();
     h.run();
     h.get_by_label("Compare (overlay)");

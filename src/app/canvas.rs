@@ -195,6 +195,12 @@ impl Canvas<'_> {
         )
     }
 
+    /// Height kept free for the caption when fitting: its title line and two lines per plan
+    /// (the plan's figures and, during a playback, the machine's state), px.
+    fn caption_px(&self) -> f32 {
+        8.0 + 20.0 * (1 + 2 * self.paths.len()) as f32
+    }
+
     /// Shows the canvas in `size` (the available space when `None`); returns the response and
     /// the operator's actions. Drag pans (or moves the field under the pointer when editable),
     /// the middle button always pans, the wheel zooms about the cursor.
@@ -215,7 +221,11 @@ impl Canvas<'_> {
             state.view.offset += (rect.size() - old.size()) / 2.0;
         }
         if state.view.scale == 0.0 || state.fit_requested {
-            state.view.fit(rect, lo, hi);
+            // the caption (top left) keeps its own band above the content
+            let below_caption =
+                Rect::from_min_max(rect.min + Vec2::Y * self.caption_px(), rect.max);
+            state.view.fit(below_caption, lo, hi);
+            state.view.offset += below_caption.min - rect.min;
             state.fit_requested = false;
         }
         state.rect = Some(rect);

@@ -60,6 +60,8 @@ enum RowKind {
     Ranked,
     /// Information only (never highlighted).
     Info,
+    /// The computer's effort (solve time): shown, never ranked, no B against A.
+    Effort,
 }
 
 /// One row of the metrics table.
@@ -159,7 +161,7 @@ const ROWS: &[Row] = &[
         help: "how long the computer took to make the plan: says nothing about the plan's quality",
         value: |m| Some(m.solve_s.total),
         decimals: 3,
-        kind: RowKind::Info,
+        kind: RowKind::Effort,
     },
 ];
 
@@ -176,7 +178,7 @@ pub fn metrics_table(ui: &mut egui::Ui, id: &str, a: &Plan, b: Option<&Plan>) {
     egui::Grid::new(id)
         .num_columns(4)
         .striped(true)
-        .spacing([14.0, 4.0])
+        .spacing([14.0, 3.0])
         .show(ui, |ui| {
             ui.label(RichText::new("Metric").strong());
             ui.label(RichText::new(&a.name).strong().color(colour::PATH_A));
@@ -199,11 +201,11 @@ fn metrics_row(ui: &mut egui::Ui, row: &Row, a: &Plan, b: Option<&Plan>) {
         RowKind::Part => {
             ui.horizontal(|ui| {
                 ui.add_space(14.0);
-                ui.label(label.small())
+                ui.label(label)
             })
             .inner
         }
-        RowKind::Ranked | RowKind::Info => ui.label(label),
+        RowKind::Ranked | RowKind::Info | RowKind::Effort => ui.label(label),
     }
     .on_hover_text(row.help);
     let va = (row.value)(&a.metrics);
@@ -214,9 +216,14 @@ fn metrics_row(ui: &mut egui::Ui, row: &Row, a: &Plan, b: Option<&Plan>) {
     }
     value_cell(ui, row, vb, va);
     match (va, vb) {
-        (Some(x), Some(y)) if x.abs() > 1e-12 => {
+        (Some(x), Some(y)) if x.abs() > 1e-12 && row.kind != RowKind::Effort => {
             let pct = (y - x) / x * 100.0;
-            let t = RichText::new(format!("{pct:+.1} %")).monospace();
+            let text = if pct.abs() < 0.05 {
+                "0.0 %".to_string()
+            } else {
+                format!("{pct:+.1} %")
+            };
+            let t = RichText::new(text).monospace();
             let ranked = matches!(row.kind, RowKind::Decides | RowKind::Ranked);
             let t = if !ranked || pct.abs() < 0.05 {
                 t
@@ -243,7 +250,7 @@ fn value_cell(ui: &mut egui::Ui, row: &Row, mine: Option<f64>, other: Option<f64
             if better {
                 ui.horizontal(|ui| {
                     ui.label(t.color(BETTER_FG).background_color(BETTER_BG));
-                    ui.label(RichText::new("faster").small().strong().color(BETTER_FG));
+                    ui.label(RichText::new("faster").strong().color(BETTER_FG));
                 });
             } else {
                 ui.label(t);
@@ -252,10 +259,7 @@ fn value_cell(ui: &mut egui::Ui, row: &Row, mine: Option<f64>, other: Option<f64
         RowKind::Ranked if better => {
             ui.label(t.color(BETTER_FG));
         }
-        RowKind::Part => {
-            ui.label(t.small());
-        }
-        RowKind::Ranked | RowKind::Info => {
+        RowKind::Ranked | RowKind::Part | RowKind::Info | RowKind::Effort => {
             ui.label(t);
         }
     }
@@ -417,7 +421,8 @@ pub fn show(
         stale: false,
         playback_t_s,
     };
-    let bottom = 270.0_f32.min(ui.available_height() * 0.45);
+    // the metrics table's height (13 rows), or less on a small window (it scrolls then)
+    let bottom = 320.0_f32.min(ui.available_height() * 0.45);
     let top = (ui.available_height() - bottom - 8.0).max(100.0);
     let width = ui.available_width();
     match kb {
@@ -447,7 +452,10 @@ pub fn show(
     ui.horizontal_top(|ui| {
         ui.vertical(|ui| {
             ui.set_width((width * 0.42).min(480.0));
-            metrics_table(ui, "compare-metrics", a, b);
+            egui::ScrollArea::vertical()
+                .id_salt("compare-metrics-scroll")
+                .max_height(bottom)
+                .show(ui, |ui| metrics_table(ui, "compare-metrics", a, b));
         });
         ui.separator();
         ui.vertical(|ui| {

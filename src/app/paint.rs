@@ -78,10 +78,12 @@ pub fn paint(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
         paint_fields(painter, c, view, rect);
     }
     paint_artwork(painter, c, view, rect);
+    // during a playback the planned path steps back behind the machine
+    let path_fade = if c.playback_t_s.is_some() { 0.35 } else { 1.0 };
     for (k, path) in c.paths.iter().enumerate() {
         let Ok(lowered) = path.lowered else { continue };
         if c.layers.base_path && k == 0 {
-            paint_base_path(painter, lowered, view, rect);
+            paint_base_path(painter, lowered, view, rect, path_fade);
         }
         if c.layers.path {
             paint_path(painter, c, path, lowered, view, rect);
@@ -210,7 +212,7 @@ fn paint_artwork(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
 }
 
 /// The stage path: the stage positions of the strokes in marking order.
-fn paint_base_path(painter: &Painter, l: &Lowered, view: &View, rect: Rect) {
+fn paint_base_path(painter: &Painter, l: &Lowered, view: &View, rect: Rect, fade: f32) {
     let mut pts: Vec<Pos2> = Vec::new();
     let mut last: Option<Pt> = None;
     for st in &l.toolpath.strokes {
@@ -222,7 +224,7 @@ fn paint_base_path(painter: &Painter, l: &Lowered, view: &View, rect: Rect) {
     if pts.len() > 1 {
         painter.extend(Shape::dashed_line(
             &pts,
-            Stroke::new(2.0, colour::FIELD.gamma_multiply(0.6)),
+            Stroke::new(2.0, colour::FIELD.gamma_multiply(0.6 * fade)),
             2.0,
             4.0,
         ));
@@ -243,6 +245,11 @@ fn paint_path(
         path.colour.gamma_multiply(0.45)
     } else {
         path.colour
+    };
+    let col = if c.playback_t_s.is_some() {
+        col.gamma_multiply(0.35)
+    } else {
+        col
     };
     let tp = &l.toolpath;
     let ends = |k: usize| {

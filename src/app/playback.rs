@@ -201,8 +201,10 @@ fn buttons(ui: &mut egui::Ui, id: &str, pb: &mut Playback, duration_s: f64) {
 const DONE: Color32 = Color32::from_rgb(17, 24, 39);
 /// Colour of the laser spot.
 const LASER: Color32 = Color32::from_rgb(220, 38, 38);
-/// Colour of the stage marker and its scan field.
-const STAGE: Color32 = Color32::from_rgb(79, 70, 229);
+/// Colour of the stage marker and its scan field (apart from the placed fields' indigo).
+const STAGE: Color32 = Color32::from_rgb(14, 116, 144);
+/// Fill of the scan field around the stage.
+const STAGE_FILL: Color32 = Color32::from_rgba_premultiplied(2, 16, 20, 36);
 
 /// Draws the job at `t_s`: marks done (the current one up to the tool point), the stage as a
 /// cross with the scan-field outline (`field_mm`) around it, and the laser spot (filled when
@@ -240,16 +242,22 @@ pub fn paint(
         to_screen(state.stage.minus(half)),
         to_screen(state.stage.plus(half)),
     );
-    painter.rect_stroke(r, 0.0, Stroke::new(2.0, STAGE), StrokeKind::Middle);
-    let arm = 9.0;
-    let cross = Stroke::new(2.0, STAGE);
+    painter.rect(
+        r,
+        0.0,
+        STAGE_FILL,
+        Stroke::new(2.5, STAGE),
+        StrokeKind::Middle,
+    );
+    let arm = 10.0;
+    let cross = Stroke::new(2.5, STAGE);
     painter.line_segment([stage - Vec2::X * arm, stage + Vec2::X * arm], cross);
     painter.line_segment([stage - Vec2::Y * arm, stage + Vec2::Y * arm], cross);
     let spot = to_screen(state.tcp());
     if state.laser {
-        painter.circle(spot, 5.0, LASER, Stroke::new(1.5, Color32::WHITE));
+        painter.circle(spot, 6.0, LASER, Stroke::new(1.5, Color32::WHITE));
     } else {
-        painter.circle(spot, 5.0, Color32::WHITE, Stroke::new(2.0, LASER));
+        painter.circle(spot, 6.0, Color32::WHITE, Stroke::new(2.5, LASER));
     }
 }
 
