@@ -136,7 +136,12 @@ pub fn run_instance(
             let plan = plan_document(&mut doc, ctx)?;
             let t0 = Instant::now();
             let toolpath = crate::pipeline::lower_plan(&doc, &plan)?;
-            let g = write_gcode(&toolpath, &plan, &doc.profile, doc.page_mm[1], "bench");
+            let g = write_gcode(&toolpath, &plan, &doc.profile, doc.page_mm[1], "bench").map_err(
+                |source| crate::pipeline::PipelineError::Gcode {
+                    file: path.display().to_string(),
+                    source,
+                },
+            )?;
             let rep = report_json("bench", &plan, &doc.settings, &doc.warnings);
             std::hint::black_box((g.len(), rep.len()));
             let export_s = t0.elapsed().as_secs_f64();

@@ -1,11 +1,11 @@
 //! The whole pipeline on a [`Document`]: import → fields → order → metrics, with stage times.
 
-use crate::document::{Document, MachineProfile, Plan, ScanField, SolverSettings};
-use crate::fields::{place_fields, split_oversize, FieldError};
+use crate::document::{Document, MachineProfile, MotionMode, Plan, ScanField, SolverSettings};
+use crate::fields::{place_fields, split_oversize, FieldError, Placement};
 use crate::hatch::{hatch_geometries, is_hatch_output, HatchError};
 use crate::import::{import_svg_file, ImportError, ImportOptions};
 use crate::job::JobCtx;
-use crate::motion::{lower, LowerError, Toolpath};
+use crate::motion::{lower_motion, MotionError, Toolpath};
 use crate::order::{order_plan, OrderError};
 use std::path::Path;
 use std::time::Instant;
@@ -39,7 +39,15 @@ pub enum PipelineError {
         /// The document's source file.
         file: String,
         /// The cause.
-        source: LowerError,
+        source: MotionError,
+    },
+    /// The plan cannot be written as G-code in the profile's dialect.
+    #[error("{file}: {source}")]
+    Gcode {
+        /// The document's source file.
+        file: String,
+        /// The cause.
+        source: crate::export::GcodeError,
     },
     /// Hatching failed.
     #[error("{file}: {source}")]
@@ -140,10 +148,36 @@ pub fn place_document_fields(doc: &mut Document, ctx: &JobCtx) -> Result<usize, 
         doc.warnings.extend(warnings);
     }
     let locked: Vec<ScanField> = doc.fields.iter().filter(|f| f.locked).cloned().collect();
-    let placement = place_fields(&doc.geometries, &doc.profile, &doc.settings, &locked, ctx)
-        .map_err(|source| PipelineError::Fields { file, source })?;
+    let placed = place_fields(&doc.geometries, &doc.profile, &doc.settings, &locked, ctx);
+    let placement = match placed {
+        // on the fly the stage follows the work: a geometry larger than the field needs no cut,
+        // and one region holding everything is ordered as a whole
+        Err(FieldError::Oversize { .. }) if doc.settings.motion == MotionMode::OnTheFly => {
+            whole_work_region(&doc.geometries)
+        }
+        other => other.map_err(|source| PipelineError::Fields { file, source })?,
+    };
     doc.fields = placement.fields;
     Ok(placement.lower_bound)
+}
+
+/// One region around all the geometries (on-the-fly ordering when some geometry is larger than
+/// a scan field): id 0, centred on their bounding box, as large as it.
+fn whole_work_region(geometries: &[crate::document::Geometry]) -> Placement {
+    let mut b = crate::geom::BBox::EMPTY;
+    for g in geometries {
+        b = b.union(g.bbox());
+    }
+    Placement {
+        fields: vec![ScanField {
+            id: 0,
+            center: b.center(),
+            size: [b.width(), b.height()],
+            locked: false,
+            geometries: (0..geometries.len()).collect(),
+        }],
+        lower_bound: 1,
+    }
 }
 
 /// The ordering stage alone, on the document's current fields and allocation (as the operator
@@ -169,10 +203,23 @@ pub fn order_document(doc: &Document, ctx: &JobCtx) -> Result<Plan, PipelineErro
     Ok(plan)
 }
 
-/// The machine motion of one of the document's plans ([`crate::motion::lower`]).
+/// The machine motion of one of the document's plans, in the settings' motion mode
+/// ([`crate::motion::lower_motion`]).
 pub fn lower_plan(doc: &Document, plan: &Plan) -> Result<Toolpath, PipelineError> {
-    lower(&doc.geometries, plan, &doc.profile).map_err(|source| PipelineError::Lower {
-        file: doc.source.clone().unwrap_or_else(|| "document".into()),
-        source,
+    lower_plan_on(doc, plan, None)
+}
+
+/// [`lower_plan`] on a controller clock of `period_s` (what a trajectory at that period runs).
+pub fn lower_plan_on(
+    doc: &Document,
+    plan: &Plan,
+    clock_s: Option<f64>,
+) -> Result<Toolpath, PipelineError> {
+    let motion = doc.settings.motion;
+    lower_motion(&doc.geometries, plan, &doc.profile, motion, clock_s).map_err(|source| {
+        PipelineError::Lower {
+            file: doc.source.clone().unwrap_or_else(|| "document".into()),
+            source,
+        }
     })
 }

@@ -225,3 +225,45 @@ fn plan_writes_a_trajectory_whose_duration_is_the_reported_job_time() {
     let out = run("1", "nonsense");
     assert!(!out.status.success());
 }
+
+#[test]
+fn on_the_fly_plans_oversize_artwork_without_splitting() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = |n: &str| dir.path().join(n).display().to_string();
+    let svg = common::root()
+        .join("assets/examples/oversize.svg")
+        .display()
+        .to_string();
+    let plan = |motion: &str| {
+        galvoplan(&[
+            "plan",
+            &svg,
+            "-o",
+            &d("job.gcode"),
+            "--motion",
+            motion,
+            "--trajectory",
+            &d("job.csv"),
+        ])
+    };
+    // step-and-scan refuses geometries larger than a field unless told to split them
+    let out = plan("step");
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--split-oversize"));
+    let out = plan("on-the-fly");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let csv = std::fs::read_to_string(d("job.csv")).unwrap();
+    // the stage moves while the laser is on
+    let rows: Vec<Vec<f64>> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    assert!(rows
+        .windows(2)
+        .any(|w| w[0][5] == 1.0 && w[1][5] == 1.0 && (w[0][1] != w[1][1] || w[0][2] != w[1][2])));
+}

@@ -34,6 +34,7 @@ fn gcode_for(profile: MachineProfile, settings: SolverSettings) -> String {
         doc.page_mm[1],
         "small.svg",
     )
+    .unwrap()
 }
 
 fn compare(name: &str, got: &str) {

@@ -82,11 +82,11 @@ fn stage_scanner_gcode_marks_what_the_tcp_gcode_marks() {
         profile.gcode.flip_y = flip;
         let (doc, plan) = plan_example("demo.svg", profile, SolverSettings::default());
         let toolpath = lower_plan(&doc, &plan).unwrap();
-        let tcp = write_gcode(&toolpath, &plan, &doc.profile, doc.page_mm[1], "t");
+        let tcp = write_gcode(&toolpath, &plan, &doc.profile, doc.page_mm[1], "t").unwrap();
         let mut p2 = doc.profile.clone();
         p2.gcode.mode = GcodeMode::StageScanner;
         p2.gcode.scanner_axes = ["A".into(), "B".into()];
-        let split = write_gcode(&toolpath, &plan, &p2, doc.page_mm[1], "t");
+        let split = write_gcode(&toolpath, &plan, &p2, doc.page_mm[1], "t").unwrap();
         assert!(
             split.contains("G0 A") && split.contains("G1 A"),
             "scanner words"
@@ -139,7 +139,7 @@ fn trajectory_marks_the_gcode_path() {
     );
     let toolpath = lower_plan(&doc, &plan).unwrap();
     let marks = gcode_marks(
-        &write_gcode(&toolpath, &plan, &doc.profile, doc.page_mm[1], "t"),
+        &write_gcode(&toolpath, &plan, &doc.profile, doc.page_mm[1], "t").unwrap(),
         None,
     );
     let period_s = 1e-3;
@@ -256,4 +256,119 @@ fn profile_errors_name_the_value() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("scanner_axes"), "{e}");
+}
+
+/// A 260 mm serpentine (far larger than the 70 mm field) and a few small squares.
+fn serpentine_document() -> Document {
+    use galvoplan::document::{Geometry, Source};
+    let mut points = Vec::new();
+    for row in 0..6 {
+        let y = 20.0 + row as f64 * 12.0;
+        let (a, b) = if row % 2 == 0 {
+            (20.0, 280.0)
+        } else {
+            (280.0, 20.0)
+        };
+        points.push(Pt::new(a, y));
+        points.push(Pt::new(b, y));
+    }
+    let mut geometries = vec![Geometry::new(points, false, Source::default())];
+    for k in 0..5 {
+        let (x, y) = (40.0 + 50.0 * k as f64, 200.0 + 15.0 * (k % 2) as f64);
+        let sq = vec![
+            Pt::new(x, y),
+            Pt::new(x + 4.0, y),
+            Pt::new(x + 4.0, y + 4.0),
+            Pt::new(x, y + 4.0),
+        ];
+        geometries.push(Geometry::new(sq, true, Source::default()));
+    }
+    let mut doc = Document {
+        geometries,
+        page_mm: [300.0, 300.0],
+        ..Document::default()
+    };
+    doc.settings.motion = galvoplan::document::MotionMode::OnTheFly;
+    doc.profile.otf_margin_mm = 5.0;
+    doc
+}
+
+#[test]
+fn on_the_fly_keeps_the_scanner_in_reach_and_the_stage_within_its_limits() {
+    let mut doc = serpentine_document();
+    let plan = plan_document(&mut doc, &JobCtx::default()).unwrap();
+    let period_s = 1e-3;
+    let path = galvoplan::pipeline::lower_plan_on(&doc, &plan, Some(period_s)).unwrap();
+    assert!(path.route.is_some());
+    let p = &doc.profile;
+    let reach_mm = p.field_mm[0] / 2.0 - p.otf_margin_mm;
+    let n = (path.duration_s() / period_s).ceil() as usize;
+    let states: Vec<_> = (0..=n)
+        .map(|k| path.state_at(k as f64 * period_s))
+        .collect();
+    // the stage starts at rest
+    assert_eq!(states[0].stage, states[1].stage);
+    let axis = |q: Pt, k: usize| if k == 0 { q.x } else { q.y };
+    let limits = [&p.axis_x, &p.axis_y];
+    let mut moved_mm = 0.0;
+    for (j, w) in states.windows(3).enumerate() {
+        let o = w[0].scan;
+        assert!(
+            o.x.abs() <= reach_mm + 1e-6 && o.y.abs() <= reach_mm + 1e-6,
+            "{o:?} at {j}"
+        );
+        for (k, lim) in limits.iter().enumerate() {
+            let s = w.iter().map(|m| axis(m.stage, k)).collect::<Vec<_>>();
+            assert!((0.0..=p.stroke_mm[k]).contains(&s[0]));
+            let v = (s[1] - s[0]) / period_s;
+            let a = (s[2] - 2.0 * s[1] + s[0]) / (period_s * period_s);
+            assert!(
+                v.abs() <= lim.max_velocity_mm_s * (1.0 + 1e-6),
+                "speed {v} at {j}"
+            );
+            assert!(
+                a.abs() <= lim.max_accel_mm_s2 * 1.001,
+                "acceleration {a} at {j} of {n}"
+            );
+        }
+        if w[0].laser && w[1].laser {
+            let speed = w[1].tcp().dist(w[0].tcp()) / period_s;
+            assert!(speed <= p.scanner.mark_speed_mm_s * (1.0 + 1e-6), "{speed}");
+        }
+        moved_mm += w[1].stage.dist(w[0].stage);
+    }
+    // the stage really follows the work: the serpentine spans 260 mm in x
+    assert!(moved_mm > 500.0, "{moved_mm}");
+    // on the clock, the serpentine's two ends are laser-on samples, and every corner lies
+    // within half a tick of marking of one
+    let on: Vec<Pt> = states.iter().filter(|m| m.laser).map(|m| m.tcp()).collect();
+    let serpentine = &doc.geometries[0].points;
+    for end in [serpentine[0], serpentine[serpentine.len() - 1]] {
+        assert!(on.iter().any(|q| q.dist(end) < 1e-6), "{end:?}");
+    }
+    let half_tick_mm = p.scanner.mark_speed_mm_s * period_s / 2.0;
+    for corner in serpentine {
+        assert!(
+            on.iter().any(|q| q.dist(*corner) <= half_tick_mm + 1e-9),
+            "{corner:?}"
+        );
+    }
+    // no stage-scanner G-code on the fly, a clear error instead
+    let mut split = doc.profile.clone();
+    split.gcode.mode = GcodeMode::StageScanner;
+    let e = write_gcode(&path, &plan, &split, 300.0, "t").unwrap_err();
+    assert!(e.to_string().contains("step-and-scan"), "{e}");
+    assert!(write_gcode(&path, &plan, &doc.profile, 300.0, "t").is_ok());
+}
+
+#[test]
+fn on_the_fly_margin_must_leave_reach() {
+    let text = "version = 2\nfield_mm = [70.0, 70.0]\notf_margin_mm = 35.0\n";
+    let e = MachineProfile::from_toml(text, "p.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("otf_margin_mm") && e.contains("half the field"),
+        "{e}"
+    );
 }

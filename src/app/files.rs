@@ -107,7 +107,8 @@ pub fn export_text(doc: &Document, plan: &Plan, kind: ExportKind) -> Result<Stri
     let source = doc.source.clone().unwrap_or_else(|| "document".into());
     let toolpath = crate::pipeline::lower_plan(doc, plan).map_err(|e| e.to_string())?;
     Ok(match kind {
-        ExportKind::Gcode => write_gcode(&toolpath, plan, &doc.profile, doc.page_mm[1], &source),
+        ExportKind::Gcode => write_gcode(&toolpath, plan, &doc.profile, doc.page_mm[1], &source)
+            .map_err(|e| format!("{source}: {e}"))?,
         ExportKind::Report => report_json(&source, plan, &doc.settings, &doc.warnings),
         ExportKind::Preview => preview_svg(&toolpath, plan, doc.page_mm),
     })

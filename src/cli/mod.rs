@@ -8,7 +8,7 @@ mod progress;
 use anyhow::Result;
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use galvoplan::document::{
-    Algo, CostModel, FieldsMode, MachineProfile, SolverSettings, VertexMode,
+    Algo, CostModel, FieldsMode, MachineProfile, MotionMode, SolverSettings, VertexMode,
 };
 use galvoplan::hatch::{HatchSettings, OutlineMode};
 use galvoplan::import::ImportOptions;
@@ -58,6 +58,22 @@ enum AlgoArg {
     AsIs,
 }
 
+/// How the machine moves, as on the command line.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+enum MotionArg {
+    /// Step-and-scan: the stage stops at every field.
+    Step,
+    /// On the fly: the stage moves on a continuous route (taut string) while the scanner marks.
+    OnTheFly,
+}
+
+/// The stage route on the fly, as on the command line.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+enum StageRouteArg {
+    /// Per-axis taut string through the scanner's reach, retimed and smoothed to the axis limits.
+    Taut,
+}
+
 /// What the ordering minimises, as on the command line.
 #[derive(Debug, Clone, Copy, ValueEnum)]
 enum CostArg {
@@ -91,6 +107,12 @@ struct JobOpts {
     /// What the ordering minimises: job time or idle distance.
     #[arg(long, value_enum, default_value = "time")]
     cost: CostArg,
+    /// Step-and-scan, or on the fly (the stage moves while the scanner marks).
+    #[arg(long, value_enum, default_value = "step")]
+    motion: MotionArg,
+    /// The stage route on the fly.
+    #[arg(long, value_enum, default_value = "taut")]
+    stage_route: StageRouteArg,
     /// Start vertices: exact (layered-graph DP after VEA) or vea (seed 000 only).
     #[arg(long, value_enum, default_value = "exact")]
     vertex: VertexArg,
@@ -170,6 +192,10 @@ impl JobOpts {
                 AlgoArg::Hga => Algo::Hga,
                 AlgoArg::Baseline => Algo::Baseline,
                 AlgoArg::AsIs => Algo::AsIs,
+            },
+            motion: match (self.motion, self.stage_route) {
+                (MotionArg::Step, _) => MotionMode::Step,
+                (MotionArg::OnTheFly, StageRouteArg::Taut) => MotionMode::OnTheFly,
             },
             cost_model: match self.cost {
                 CostArg::Time => CostModel::Time,

@@ -8,7 +8,7 @@ use galvoplan::export::{
     geometry_svg, preview_svg, report_json, trajectory_csv, trajectory_period_s, write_gcode,
 };
 use galvoplan::job::{CancelToken, JobCtx};
-use galvoplan::pipeline::{load_svg, lower_plan, plan_document};
+use galvoplan::pipeline::{load_svg, lower_plan, lower_plan_on, plan_document};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -42,13 +42,17 @@ pub fn run(a: &PlanArgs) -> Result<()> {
     let source = a.input.display().to_string();
     let toolpath = lower_plan(&doc, &plan)?;
     // the trajectory is the toolpath on the controller's clock; the report then gives its time
-    let trajectory = period_s.map(|p| {
-        let clocked = toolpath.on_clock(p);
-        plan.metrics.job_time_s = Some(clocked.duration_s());
-        plan.metrics.job_time_breakdown_s = Some(clocked.breakdown());
-        trajectory_csv(&clocked, p)
-    });
-    let gcode = write_gcode(&toolpath, &plan, &doc.profile, doc.page_mm[1], &source);
+    let trajectory = match period_s {
+        Some(p) => {
+            let clocked = lower_plan_on(&doc, &plan, Some(p))?;
+            plan.metrics.job_time_s = Some(clocked.duration_s());
+            plan.metrics.job_time_breakdown_s = Some(clocked.breakdown());
+            Some(trajectory_csv(&clocked, p))
+        }
+        None => None,
+    };
+    let gcode = write_gcode(&toolpath, &plan, &doc.profile, doc.page_mm[1], &source)
+        .with_context(|| format!("{}: cannot write G-code", a.output.display()))?;
     let preview = a
         .preview
         .as_ref()

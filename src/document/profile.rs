@@ -8,7 +8,8 @@ use thiserror::Error;
 /// * 1: stroke, field, axis velocity and acceleration, scanner, laser, G-code words.
 /// * 2: an axis may give `ramp_s` (seed 002 Table 2's t_a, rest to full speed) instead of
 ///   `max_accel_mm_s2`, and a `settle_s` after each move; `[gcode] mode` (`tcp` or
-///   `stage-scanner`) and `scanner_axes`. Every version-1 file is a valid version-2 file.
+///   `stage-scanner`) and `scanner_axes`; `otf_margin_mm` for on-the-fly marking. Every
+///   version-1 file is a valid version-2 file.
 pub const PROFILE_VERSION: u32 = 2;
 
 /// Limits of one base-stage axis (seed 002, Table 2 style).
@@ -188,6 +189,9 @@ pub struct MachineProfile {
     pub laser: LaserTiming,
     /// G-code output options.
     pub gcode: GcodeDialect,
+    /// On-the-fly marking: following-error headroom kept inside the field, mm (the scanner
+    /// offset stays within half the field less this).
+    pub otf_margin_mm: f64,
 }
 
 impl Default for MachineProfile {
@@ -202,6 +206,7 @@ impl Default for MachineProfile {
             scanner: ScannerSpeeds::default(),
             laser: LaserTiming::default(),
             gcode: GcodeDialect::default(),
+            otf_margin_mm: 0.0,
         }
     }
 }
@@ -328,6 +333,7 @@ impl MachineProfile {
                 false,
             ),
             ("axis_y.max_accel_mm_s2", self.axis_y.max_accel_mm_s2, false),
+            ("otf_margin_mm", self.otf_margin_mm, true),
             ("axis_x.settle_s", self.axis_x.settle_s, true),
             ("axis_y.settle_s", self.axis_y.settle_s, true),
             (
@@ -369,6 +375,13 @@ impl MachineProfile {
             if w.trim().is_empty() {
                 return Err(format!("{name} must not be empty"));
             }
+        }
+        let half_field_mm = self.field_mm[0].min(self.field_mm[1]) / 2.0;
+        if self.otf_margin_mm >= half_field_mm {
+            return Err(format!(
+                "otf_margin_mm = {} must be less than half the field ({half_field_mm} mm)",
+                self.otf_margin_mm
+            ));
         }
         let [u, v] = &self.gcode.scanner_axes;
         if self.gcode.mode == GcodeMode::StageScanner

@@ -65,6 +65,18 @@ pub enum CostModel {
     Time,
 }
 
+/// How the machine moves while it marks.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+pub enum MotionMode {
+    /// Step-and-scan: the stage stops at every field, the scanner marks it.
+    #[default]
+    #[serde(rename = "step")]
+    Step,
+    /// On the fly: the stage moves on a continuous route while the scanner marks.
+    #[serde(rename = "on-the-fly")]
+    OnTheFly,
+}
+
 /// Parameters of the hybrid genetic algorithm (seed 000 §3.3.6 defaults).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
@@ -120,6 +132,8 @@ pub struct SolverSettings {
     pub hha_improve: bool,
     /// Cost model.
     pub cost_model: CostModel,
+    /// Step-and-scan or on the fly.
+    pub motion: MotionMode,
     /// Cut geometries larger than a field at field borders instead of failing.
     pub split_oversize: bool,
     /// GA parameters.
@@ -140,6 +154,7 @@ impl Default for SolverSettings {
             vertex: VertexMode::default(),
             hha_improve: true,
             cost_model: CostModel::default(),
+            motion: MotionMode::default(),
             split_oversize: false,
             ga: GaParams::default(),
             hatch: None,

@@ -10,6 +10,15 @@ use crate::document::{GcodeMode, MachineProfile, Plan};
 use crate::geom::Pt;
 use crate::motion::Toolpath;
 use std::fmt::Write;
+use thiserror::Error;
+
+/// A toolpath the dialect cannot express.
+#[derive(Debug, Error, PartialEq, Eq)]
+pub enum GcodeError {
+    /// The stage moves while marking (on the fly): no per-field stage position to write.
+    #[error("the stage-scanner G-code needs step-and-scan motion (the stage moves while marking on the fly): use the tcp dialect or the trajectory")]
+    StageScannerOnTheFly,
+}
 
 /// Number formatting and the Y mirror of a dialect.
 struct Words<'a> {
@@ -62,7 +71,7 @@ pub fn write_gcode(
     profile: &MachineProfile,
     page_height_mm: f64,
     title: &str,
-) -> String {
+) -> Result<String, GcodeError> {
     let d = &profile.gcode;
     let w = Words {
         profile,
@@ -73,6 +82,9 @@ pub fn write_gcode(
         None => d.laser_on.clone(),
     };
     let stage_scanner = d.mode == GcodeMode::StageScanner;
+    if stage_scanner && toolpath.route.is_some() {
+        return Err(GcodeError::StageScannerOnTheFly);
+    }
     let scan_axes = [d.scanner_axes[0].as_str(), d.scanner_axes[1].as_str()];
     let mut out = String::with_capacity(toolpath.strokes.len() * 64);
     header(&mut out, toolpath, plan, title);
@@ -116,7 +128,7 @@ pub fn write_gcode(
         let _ = writeln!(out, "{}", d.laser_off);
     }
     out.push_str("; end\n");
-    out
+    Ok(out)
 }
 
 fn header(out: &mut String, toolpath: &Toolpath, plan: &Plan, title: &str) {

@@ -6,7 +6,7 @@ mod report;
 mod svg_preview;
 mod trajectory;
 
-pub use gcode::write_gcode;
+pub use gcode::{write_gcode, GcodeError};
 pub use report::{report_json, Report};
 pub use svg_preview::{geometry_svg, preview_svg};
 pub use trajectory::{

@@ -17,14 +17,52 @@
 
 mod axis;
 mod lower;
+mod otf;
+mod route;
 pub mod taut;
 mod toolpath;
 
 pub use axis::{AxisMove, StageDynamics, StageMove};
 pub use lower::{lower, LowerError, REACH_TOLERANCE_MM};
+pub use otf::{lower_on_the_fly, OtfError};
+pub use route::{SmoothedAxis, StageRoute};
 pub use toolpath::{
     MachineState, ScanMotion, Segment, SegmentKind, StageMotion, Stroke, Toolpath, TIME_EPS_S,
 };
+
+use crate::document::{Geometry, MachineProfile, MotionMode, Plan};
+
+/// Why a plan cannot be turned into motion, in either mode.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum MotionError {
+    /// Step-and-scan.
+    #[error(transparent)]
+    Step(#[from] LowerError),
+    /// On the fly.
+    #[error("on the fly: {0}")]
+    OnTheFly(#[from] OtfError),
+}
+
+/// Lowers a plan in the given motion mode; with `clock_s`, on that controller clock (every
+/// mark starts and ends on a tick: what a trajectory sampled at that period can show).
+pub fn lower_motion(
+    geometries: &[Geometry],
+    plan: &Plan,
+    profile: &MachineProfile,
+    motion: MotionMode,
+    clock_s: Option<f64>,
+) -> Result<Toolpath, MotionError> {
+    Ok(match motion {
+        MotionMode::Step => {
+            let path = lower(geometries, plan, profile)?;
+            match clock_s {
+                Some(period_s) => path.on_clock(period_s),
+                None => path,
+            }
+        }
+        MotionMode::OnTheFly => lower_on_the_fly(geometries, plan, profile, clock_s)?,
+    })
+}
 
 #[cfg(test)]
 mod tests;

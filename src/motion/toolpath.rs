@@ -2,6 +2,7 @@
 //! laser state known at any instant.
 
 use super::axis::StageMove;
+use super::route::StageRoute;
 use crate::document::TimeBreakdown;
 use crate::geom::Pt;
 use std::ops::Range;
@@ -35,6 +36,8 @@ pub enum StageMotion {
     Hold(Pt),
     /// A rest-to-rest move starting with the segment.
     Move(StageMove),
+    /// On the toolpath's continuous route ([`Toolpath::route`], on the fly).
+    Route,
 }
 
 /// What the scanner does during a segment; offsets are tool-centre point − stage, mm.
@@ -52,11 +55,23 @@ pub enum ScanMotion {
         /// Duration of the straight move, s.
         move_s: f64,
     },
-    /// Marks stroke `stroke` of the toolpath at constant speed over the whole segment (the
-    /// stage holds, so the offset follows the stroke).
+    /// Marks stroke `stroke` of the toolpath at constant speed over the whole segment; the
+    /// offset is the stroke's point less the stage.
     Mark {
         /// Index into [`Toolpath::strokes`].
         stroke: usize,
+    },
+    /// Holds the tool-centre point (the offset follows the moving stage; on the fly).
+    TcpHold(Pt),
+    /// Moves the tool-centre point straight at constant speed over the first `move_s`, then
+    /// holds it (on the fly).
+    TcpLine {
+        /// Tool-centre point at the segment's start.
+        from: Pt,
+        /// Tool-centre point reached after `move_s`.
+        to: Pt,
+        /// Duration of the straight move, s.
+        move_s: f64,
     },
 }
 
@@ -124,6 +139,8 @@ pub struct Toolpath {
     pub segments: Vec<Segment>,
     /// Marked strokes in marking order.
     pub strokes: Vec<Stroke>,
+    /// The stage's continuous route (on the fly), which [`StageMotion::Route`] segments follow.
+    pub route: Option<StageRoute>,
     /// Tool-centre points of all strokes, concatenated.
     points: Vec<Pt>,
     /// Arc length from each stroke's first point to each point, mm (parallel to `points`).
@@ -141,7 +158,7 @@ fn ceil_to_tick(t_s: f64, period_s: f64) -> f64 {
 
 impl Toolpath {
     /// Adds a stroke's points; returns its index.
-    pub(super) fn push_stroke(
+    pub(crate) fn push_stroke(
         &mut self,
         step: usize,
         geometry: usize,
@@ -176,9 +193,14 @@ impl Toolpath {
     /// Everything else keeps its timing. A sampled trajectory at that period then holds every
     /// mark's start and end point, and never shows a jump as a mark.
     pub fn on_clock(&self, period_s: f64) -> Toolpath {
+        if self.route.is_some() {
+            // an on-the-fly route is a function of time: it is clocked when it is lowered
+            return self.clone();
+        }
         let mut out = Toolpath {
             segments: Vec::with_capacity(self.segments.len() + self.strokes.len()),
             strokes: self.strokes.clone(),
+            route: None,
             points: self.points.clone(),
             arc_mm: self.arc_mm.clone(),
         };
@@ -288,9 +310,23 @@ impl Toolpath {
         let stage = match &seg.stage {
             StageMotion::Hold(p) => *p,
             StageMotion::Move(m) => m.position(local_s),
+            // the route goes on past the job's end (the stage comes to rest on it)
+            StageMotion::Route => self
+                .route
+                .as_ref()
+                .map_or(Pt::default(), |r| r.position(t_s.max(0.0))),
         };
         let (scan, laser) = match seg.scan {
             ScanMotion::Hold(o) => (o, false),
+            ScanMotion::TcpHold(p) => (p.minus(stage), false),
+            ScanMotion::TcpLine { from, to, move_s } => {
+                let u = if move_s > 0.0 {
+                    (local_s / move_s).min(1.0)
+                } else {
+                    1.0
+                };
+                (from.plus(to.minus(from).scale(u)).minus(stage), false)
+            }
             ScanMotion::Line { from, to, move_s } => {
                 let u = if move_s > 0.0 {
                     (local_s / move_s).min(1.0)

@@ -14,11 +14,11 @@ pub use as_is::as_is_order;
 pub use baseline::baseline_order;
 
 use crate::document::{
-    Algo, CostModel, GenerationRecord, Geometry, MachineProfile, Plan, ScanField, SolverSettings,
-    Step,
+    Algo, CostModel, GenerationRecord, Geometry, MachineProfile, MotionMode, Plan, ScanField,
+    SolverSettings, Step,
 };
 use crate::job::{Cancelled, JobCtx};
-use crate::motion::{lower, LowerError, Toolpath};
+use crate::motion::{lower_motion, MotionError, Toolpath};
 use thiserror::Error;
 
 /// Why ordering failed.
@@ -32,7 +32,7 @@ pub enum OrderError {
     Unallocated(usize, usize),
     /// The plan cannot be turned into machine motion.
     #[error(transparent)]
-    Lower(#[from] LowerError),
+    Lower(#[from] MotionError),
 }
 
 /// The ordered strokes of a run, before metrics.
@@ -58,23 +58,25 @@ pub fn order_plan(
     let mut detail = Vec::new();
     let (ordering, seed_ordering, history) =
         run_algorithm(geometries, fields, profile, settings, ctx, &mut detail)?;
-    let (ordering, toolpath) =
-        if settings.cost_model == CostModel::Time && settings.algo != Algo::AsIs {
-            let t = std::time::Instant::now();
-            let mut best = time_ordering(geometries, fields, profile, settings, ordering, ctx)?;
-            if let Some(seed) = seed_ordering {
-                // HGA's own objective is idle travel: on time, its HHA seed may still be faster
-                let other = time_ordering(geometries, fields, profile, settings, seed, ctx)?;
-                if other.1.duration_s() < best.1.duration_s() {
-                    best = other;
-                }
+    let (ordering, toolpath) = if settings.cost_model == CostModel::Time
+        && settings.algo != Algo::AsIs
+        && settings.motion == MotionMode::Step
+    {
+        let t = std::time::Instant::now();
+        let mut best = time_ordering(geometries, fields, profile, settings, ordering, ctx)?;
+        if let Some(seed) = seed_ordering {
+            // HGA's own objective is idle travel: on time, its HHA seed may still be faster
+            let other = time_ordering(geometries, fields, profile, settings, seed, ctx)?;
+            if other.1.duration_s() < best.1.duration_s() {
+                best = other;
             }
-            detail.push(("time".into(), t.elapsed().as_secs_f64()));
-            best
-        } else {
-            let toolpath = lower_ordering(geometries, fields, profile, &ordering)?;
-            (ordering, toolpath)
-        };
+        }
+        detail.push(("time".into(), t.elapsed().as_secs_f64()));
+        best
+    } else {
+        let toolpath = lower_ordering(geometries, fields, profile, settings, &ordering)?;
+        (ordering, toolpath)
+    };
     let order_s = t0.elapsed().as_secs_f64();
     let plan_fields = fields_in_order(fields, &ordering.field_order);
     let mut m = metrics::compute(
@@ -164,8 +166,9 @@ fn lower_ordering(
     geometries: &[Geometry],
     fields: &[ScanField],
     profile: &MachineProfile,
+    settings: &SolverSettings,
     ordering: &Ordering,
-) -> Result<Toolpath, LowerError> {
+) -> Result<Toolpath, MotionError> {
     let plan = Plan {
         name: String::new(),
         algo: Algo::default(),
@@ -174,7 +177,7 @@ fn lower_ordering(
         metrics: Default::default(),
         history: Vec::new(),
     };
-    lower(geometries, &plan, profile)
+    lower_motion(geometries, &plan, profile, settings.motion, None)
 }
 
 /// The distance ordering refined for job time ([`time::refine_for_time`]); the refinement is
@@ -188,13 +191,13 @@ fn time_ordering(
     ordering: Ordering,
     ctx: &JobCtx,
 ) -> Result<(Ordering, Toolpath), OrderError> {
-    let by_distance = lower_ordering(geometries, fields, profile, &ordering)?;
+    let by_distance = lower_ordering(geometries, fields, profile, settings, &ordering)?;
     let refined =
         match time::refine_for_time(geometries, fields, &ordering, profile, settings.seed, ctx) {
             Ok(refined) => refined,
             Err(Cancelled) => return Ok((ordering, by_distance)),
         };
-    let by_time = lower_ordering(geometries, fields, profile, &refined)?;
+    let by_time = lower_ordering(geometries, fields, profile, settings, &refined)?;
     Ok(if by_time.duration_s() <= by_distance.duration_s() {
         (refined, by_time)
     } else {
