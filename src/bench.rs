@@ -70,6 +70,10 @@ pub struct BenchRow {
     pub job_time_s: Stat,
     /// Stage moves and settling in the job time, s.
     pub stage_time_s: Stat,
+    /// Length of the stage's route, mm.
+    pub stage_route_mm: Stat,
+    /// Largest scanner offset, mm.
+    pub scan_peak_offset_mm: Stat,
     /// Import, ms.
     pub import_ms: f64,
     /// Field placement, ms.
@@ -125,7 +129,7 @@ pub fn run_instance(
     ctx: &JobCtx,
 ) -> Result<BenchRow, PipelineError> {
     let mut times: [Vec<f64>; 5] = Default::default();
-    let mut quality: [Vec<f64>; 7] = Default::default();
+    let mut quality: [Vec<f64>; 9] = Default::default();
     let (mut geometries, mut marked_mm, mut lower) = (0, 0.0, None);
     for k in 0..seeds.max(1) {
         let mut s = settings.clone();
@@ -157,6 +161,7 @@ pub fn run_instance(
             if r == 0 {
                 let m = &plan.metrics;
                 let b = toolpath.breakdown();
+                let motion = toolpath.motion_figures(crate::order::metrics::MOTION_SAMPLE_PERIOD_S);
                 for (v, x) in quality.iter_mut().zip([
                     m.fields as f64,
                     m.overlap_pct,
@@ -165,6 +170,8 @@ pub fn run_instance(
                     m.direction_changes as f64,
                     toolpath.duration_s(),
                     b.stage + b.settle,
+                    motion.stage_route_mm,
+                    motion.scan_peak_offset_mm,
                 ]) {
                     v.push(x);
                 }
@@ -175,7 +182,7 @@ pub fn run_instance(
         }
     }
     let [mut a, mut b, mut c, mut d, mut e] = times;
-    let [f, o, i, bm, dc, jt, st] = quality;
+    let [f, o, i, bm, dc, jt, st, route, offset] = quality;
     Ok(BenchRow {
         instance: path
             .file_stem()
@@ -192,6 +199,8 @@ pub fn run_instance(
         direction_changes: Stat::of(&dc),
         job_time_s: Stat::of(&jt),
         stage_time_s: Stat::of(&st),
+        stage_route_mm: Stat::of(&route),
+        scan_peak_offset_mm: Stat::of(&offset),
         import_ms: median(&mut a),
         fields_ms: median(&mut b),
         order_ms: median(&mut c),
@@ -203,12 +212,12 @@ pub fn run_instance(
 /// Formats rows as a Markdown table (quality as mean ± sd when several seeds ran).
 pub fn format_table(rows: &[BenchRow]) -> String {
     let mut s = String::from(
-        "| instance | geometries | fields | LB | overlap % | idle mm | base mm | marked mm | dir. changes | job s | stage s | import ms | fields ms | order ms | export ms | total ms |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "| instance | geometries | fields | LB | overlap % | idle mm | base mm | marked mm | dir. changes | job s | stage s | route mm | offset mm | import ms | fields ms | order ms | export ms | total ms |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
         let sd = r.seeds > 1;
         s.push_str(&format!(
-            "| {} | {} | {} | {} | {} | {} | {} | {:.1} | {} | {} | {} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} |\n",
+            "| {} | {} | {} | {} | {} | {} | {} | {:.1} | {} | {} | {} | {} | {} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} |\n",
             r.instance,
             r.geometries,
             r.fields.show(if sd { 1 } else { 0 }, sd),
@@ -220,6 +229,8 @@ pub fn format_table(rows: &[BenchRow]) -> String {
             r.direction_changes.show(if sd { 1 } else { 0 }, sd),
             r.job_time_s.show(2, sd),
             r.stage_time_s.show(2, sd),
+            r.stage_route_mm.show(0, sd),
+            r.scan_peak_offset_mm.show(2, sd),
             r.import_ms,
             r.fields_ms,
             r.order_ms,

@@ -211,6 +211,16 @@ fn plan_writes_a_trajectory_whose_duration_is_the_reported_job_time() {
     let job_s = report["metrics"]["job_time_s"].as_f64().unwrap();
     let last_s = rows[rows.len() - 1][0];
     assert!(last_s >= job_s - 1e-9 && last_s < job_s + 0.0005 + 1e-9);
+    let motion = &report["metrics"]["motion"];
+    for key in [
+        "stage_route_mm",
+        "stage_peak_speed_mm_s",
+        "stage_speed_variation_mm_s",
+        "scan_peak_offset_mm",
+    ] {
+        assert!(motion[key].as_f64().unwrap() >= 0.0, "metrics.motion.{key}");
+    }
+    assert!(motion["scan_peak_offset_mm"].as_f64().unwrap() <= 35.0 + 1e-6);
     let parts = &report["metrics"]["job_time_breakdown_s"];
     let sum: f64 = ["stage", "settle", "jump", "mark", "laser_delays"]
         .iter()

@@ -339,6 +339,23 @@ fn on_the_fly_keeps_the_scanner_in_reach_and_the_stage_within_its_limits() {
     }
     // the stage really follows the work: the serpentine spans 260 mm in x
     assert!(moved_mm > 500.0, "{moved_mm}");
+    // the plan's motion figures describe the same route
+    let figures = path.motion_figures(period_s);
+    // (the loop above stops one sample short: at most one sample of stage travel)
+    let last_step_mm = p.axis_x.max_velocity_mm_s.hypot(p.axis_y.max_velocity_mm_s) * period_s;
+    assert!((figures.stage_route_mm - moved_mm).abs() <= last_step_mm + 1e-9);
+    assert!(
+        figures.scan_peak_offset_mm <= reach_mm + 1e-6
+            && figures.scan_peak_offset_mm > 0.5 * reach_mm
+    );
+    let peak = p.axis_x.max_velocity_mm_s.hypot(p.axis_y.max_velocity_mm_s);
+    assert!(
+        figures.stage_peak_speed_mm_s > 0.0 && figures.stage_peak_speed_mm_s <= peak * (1.0 + 1e-6)
+    );
+    assert!(plan
+        .metrics
+        .motion
+        .is_some_and(|m| m.stage_route_mm > 500.0));
     // on the clock, the serpentine's two ends are laser-on samples, and every corner lies
     // within half a tick of marking of one
     let on: Vec<Pt> = states.iter().filter(|m| m.laser).map(|m| m.tcp()).collect();

@@ -47,6 +47,7 @@ pub fn run(a: &PlanArgs) -> Result<()> {
             let clocked = lower_plan_on(&doc, &plan, Some(p))?;
             plan.metrics.job_time_s = Some(clocked.duration_s());
             plan.metrics.job_time_breakdown_s = Some(clocked.breakdown());
+            plan.metrics.motion = Some(clocked.motion_figures(p));
             Some(trajectory_csv(&clocked, p))
         }
         None => None,

@@ -7,7 +7,9 @@ mod project;
 mod settings;
 
 pub use geometry::{Geometry, Source};
-pub use plan::{GenerationRecord, Metrics, Plan, ScanField, StageTimes, Step, TimeBreakdown};
+pub use plan::{
+    GenerationRecord, Metrics, MotionFigures, Plan, ScanField, StageTimes, Step, TimeBreakdown,
+};
 pub use profile::{
     AxisLimits, GcodeDialect, GcodeMode, LaserTiming, MachineProfile, ProfileError, ScannerSpeeds,
     BUILTIN, PROFILE_VERSION,

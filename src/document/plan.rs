@@ -127,6 +127,20 @@ impl TimeBreakdown {
     }
 }
 
+/// The stage's route and the scanner's reach over a job, from the toolpath sampled at a
+/// constant period (seed 001 Table IV's figures; `check_trajectory.py` computes the same).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct MotionFigures {
+    /// Length of the sampled stage route, mm.
+    pub stage_route_mm: f64,
+    /// Largest stage speed between two samples (vector), mm/s.
+    pub stage_peak_speed_mm_s: f64,
+    /// Total variation of the stage speed (Σ |Δ speed| between samples), mm/s.
+    pub stage_speed_variation_mm_s: f64,
+    /// Largest scanner offset on either axis, mm.
+    pub scan_peak_offset_mm: f64,
+}
+
 /// Metrics of a plan (definitions in DESIGN.md and [`crate::order::metrics`]).
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct Metrics {
@@ -151,6 +165,9 @@ pub struct Metrics {
     /// The job time by what the machine does, s.
     #[serde(default)]
     pub job_time_breakdown_s: Option<TimeBreakdown>,
+    /// The stage's route, its speeds and the scanner's reach, sampled every millisecond.
+    #[serde(default)]
+    pub motion: Option<MotionFigures>,
     /// Wall time per stage, s.
     pub solve_s: StageTimes,
 }

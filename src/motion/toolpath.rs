@@ -3,7 +3,7 @@
 
 use super::axis::StageMove;
 use super::route::StageRoute;
-use crate::document::TimeBreakdown;
+use crate::document::{MotionFigures, TimeBreakdown};
 use crate::geom::Pt;
 use std::ops::Range;
 
@@ -265,6 +265,31 @@ impl Toolpath {
             *slot += s.duration_s;
         }
         b
+    }
+
+    /// The stage's route, speeds and the scanner's reach, sampled every `period_s` from 0 to the
+    /// end (DESIGN.md: the total variation of the stage speed over the samples).
+    pub fn motion_figures(&self, period_s: f64) -> MotionFigures {
+        let n = (self.duration_s() / period_s).ceil() as usize;
+        let mut f = MotionFigures::default();
+        let mut last: Option<(Pt, f64)> = None;
+        for k in 0..=n {
+            let m = self.state_at(k as f64 * period_s);
+            f.scan_peak_offset_mm = f
+                .scan_peak_offset_mm
+                .max(m.scan.x.abs())
+                .max(m.scan.y.abs());
+            let speed_mm_s = last.map_or(0.0, |(p, _)| m.stage.dist(p) / period_s);
+            if let Some((p, previous_mm_s)) = last {
+                f.stage_route_mm += m.stage.dist(p);
+                f.stage_peak_speed_mm_s = f.stage_peak_speed_mm_s.max(speed_mm_s);
+                if k >= 2 {
+                    f.stage_speed_variation_mm_s += (speed_mm_s - previous_mm_s).abs();
+                }
+            }
+            last = Some((m.stage, speed_mm_s));
+        }
+        f
     }
 
     /// The index of the segment running at `t_s` (the last one starting at or before it;

@@ -15,6 +15,10 @@ use crate::document::{Geometry, MachineProfile, Metrics, ScanField, Step};
 use crate::geom::Pt;
 use crate::motion::Toolpath;
 
+/// Sampling period of the motion figures, s: the trajectory's default period, so that the
+/// figures match what `check_trajectory.py` reports for a default `--trajectory`.
+pub const MOTION_SAMPLE_PERIOD_S: f64 = 1e-3;
+
 /// Computes all metrics of an ordering; `fields` in visiting order, `toolpath` its lowering.
 pub fn compute(
     geometries: &[Geometry],
@@ -43,6 +47,7 @@ pub fn compute(
         direction_changes: direction_changes(geometries, fields, steps, profile.field_mm),
         job_time_s: Some(toolpath.duration_s()),
         job_time_breakdown_s: Some(toolpath.breakdown()),
+        motion: Some(toolpath.motion_figures(MOTION_SAMPLE_PERIOD_S)),
         solve_s: Default::default(),
     }
 }
