@@ -11,7 +11,7 @@ use egui_kittest::Harness;
 use galvoplan::app::commands::Command;
 use galvoplan::app::playback::{state_text, time_text};
 use galvoplan::app::App;
-use galvoplan::document::{Algo, CostModel, SolverSettings};
+use galvoplan::document::{Algo, CostModel, MotionMode, SolverSettings};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
@@ -654,4 +654,106 @@ fn playback_scrubs_plays_pauses_and_rewinds() {
     assert_eq!(h.state().playback().t_s, 0.0);
     assert_eq!(h.state().playback().shown_t_s(), None);
     assert_eq!(h.state().playback().speed_x, Some(100.0), "the speed stays");
+}
+
+/// Switches the motion mode through the settings panel's combo box.
+fn set_motion(h: &mut Harness<'_, App>, option: &str) {
+    h.get_by_label("Motion").click();
+    h.run();
+    h.get_by_label(option).click();
+    h.run();
+}
+
+#[test]
+fn the_motion_switch_plans_on_the_fly() {
+    let mut h = opened(&demo());
+    assert_eq!(h.state().doc.settings.motion, MotionMode::Step);
+    h.get_by_label("Motion").hover();
+    h.run();
+    h.get_by_label_contains("How the machine moves while it marks");
+    let step = solve(&mut h, "Run HHA");
+    assert!(!h.state().toolpath(0).unwrap().unwrap().on_the_fly());
+    set_motion(&mut h, "On the fly (stage moves while marking)");
+    assert_eq!(h.state().doc.settings.motion, MotionMode::OnTheFly);
+    // the step plan is shown with the toolpath of the current setting, and says so
+    let relowered = h.state().toolpath(0).unwrap().unwrap().clone();
+    assert!(relowered.on_the_fly() && !relowered.route_mm.is_empty());
+    assert!(relowered.job_time_mismatch_s(&step).is_some());
+    h.get_by_label_contains("toolpath re-lowered with current settings");
+    // the solve uses the setting: a route, and another job time than the step plan's
+    let otf = solve(&mut h, "Run HHA");
+    let l = h.state().toolpath(1).unwrap().unwrap().clone();
+    assert!(l.on_the_fly());
+    let (t_step, t_otf) = (
+        step.metrics.job_time_s.unwrap(),
+        otf.metrics.job_time_s.unwrap(),
+    );
+    assert!(
+        (t_otf - t_step).abs() > 0.01 * t_step,
+        "{t_otf} s vs {t_step} s"
+    );
+    assert!(
+        l.job_time_mismatch_s(&otf).is_none(),
+        "{} s",
+        l.duration_s()
+    );
+    // the compare view puts both side by side, each with the job time of its solve
+    h.get_by_label("Compare").click();
+    h.run();
+    for t_s in [t_step, t_otf] {
+        let text = format!("{t_s:.3}");
+        assert!(h.query_all_by_label(&text).count() >= 1, "{text}");
+    }
+    h.get_by_label_contains("HHA #1: toolpath re-lowered with current settings");
+    assert!(h
+        .query_by_label_contains("HHA #2: toolpath re-lowered")
+        .is_none());
+    // one undoable settings step back to step-and-scan
+    h.get_by_label("Workbench").click();
+    h.run();
+    h.get_by_label("Undo").click();
+    h.run();
+    assert_eq!(h.state().doc.settings.motion, MotionMode::Step);
+    assert!(!h.state().toolpath(1).unwrap().unwrap().on_the_fly());
+}
+
+#[test]
+fn motion_plots_show_an_on_the_fly_plan() {
+    let mut h = opened(&demo());
+    set_motion(&mut h, "On the fly (stage moves while marking)");
+    assert!(h.query_by_label_contains("Scanner offset").is_none());
+    solve(&mut h, "Run HHA");
+    let l = h.state().toolpath(0).unwrap().unwrap().clone();
+    let s = l.motion.as_ref().expect("motion samples");
+    assert!(
+        s.t_s.len() > 100 && s.t_s.len() <= 20_001,
+        "{}",
+        s.t_s.len()
+    );
+    let reach_mm = 35.0 - h.state().doc.profile.otf_margin_mm;
+    assert!(
+        s.peak_offset_mm() <= reach_mm + 1e-6,
+        "{}",
+        s.peak_offset_mm()
+    );
+    assert!(s.peak_speed_mm_s() > 0.0);
+    h.get_by_label_contains("Scanner offset (tool - stage), mm");
+    h.get_by_label_contains("Stage speed, mm/s");
+    // they fit under the canvas
+    let canvas = h.get_by_label("Work area").rect();
+    let speed = h.get_by_label_contains("Stage speed, mm/s").rect();
+    assert!(
+        canvas.bottom() < speed.top() && speed.bottom() < 950.0,
+        "{speed:?}"
+    );
+    // hidden with their header, and gone for a step-and-scan toolpath
+    h.get_by_label_contains("Motion plots").click();
+    h.run();
+    assert!(h.query_by_label_contains("Scanner offset").is_none());
+    h.get_by_label_contains("Motion plots").click();
+    h.run();
+    h.get_by_label_contains("Scanner offset");
+    set_motion(&mut h, "Step-and-scan");
+    assert!(h.query_by_label_contains("Scanner offset").is_none());
+    assert!(h.query_by_label_contains("Motion plots").is_none());
 }

@@ -195,11 +195,11 @@ impl Canvas<'_> {
         )
     }
 
-    /// Height kept free for the caption when fitting: its title line and two lines per plan
-    /// (the plan's figures and, during a playback, the machine's state; room for one plan
-    /// before the first solve), px.
+    /// Height kept free for the caption when fitting: its title line and per plan the plan's
+    /// figures, the machine's state during a playback, and on the fly the route legend and a
+    /// re-lowered note (room for one plan before the first solve), px.
     fn caption_px(&self) -> f32 {
-        8.0 + 20.0 * (1 + 2 * self.paths.len().max(1)) as f32
+        8.0 + 20.0 * paint::caption_lines(self) as f32
     }
 
     /// Shows the canvas in `size` (the available space when `None`); returns the response and

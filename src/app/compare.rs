@@ -265,6 +265,30 @@ fn value_cell(ui: &mut egui::Ui, row: &Row, mine: Option<f64>, other: Option<f64
     }
 }
 
+/// A visible note under a metrics table for each plan whose toolpath (lowered with the
+/// current settings, the one drawn and played) does not have the job time of its solve, which
+/// the table shows.
+pub fn relowered_notes(ui: &mut egui::Ui, plans: &[(&Plan, Option<Result<&Lowered, &str>>)]) {
+    for (plan, lowered) in plans {
+        let Some(Ok(l)) = lowered else { continue };
+        if let Some((stored_s, now_s)) = l.job_time_mismatch_s(plan) {
+            ui.label(
+                RichText::new(format!(
+                    "{}: {}",
+                    plan.name,
+                    super::paint::relowered_note(stored_s, now_s)
+                ))
+                .small()
+                .color(Color32::from_rgb(180, 83, 9)),
+            )
+            .on_hover_text(
+                "The table shows the job time computed when the plan was solved; the canvas and \
+                 the playback use the toolpath lowered with the current motion mode and profile.",
+            );
+        }
+    }
+}
+
 /// The GA convergence plot: best and mean idle travel per generation of every plan with a
 /// history, and the HHA plan's idle travel as a horizontal line.
 pub fn convergence_plot(ui: &mut egui::Ui, plans: &[(&Plan, Color32)], hha: Option<&Plan>) {
@@ -455,7 +479,14 @@ pub fn show(
             egui::ScrollArea::vertical()
                 .id_salt("compare-metrics-scroll")
                 .max_height(bottom)
-                .show(ui, |ui| metrics_table(ui, "compare-metrics", a, b));
+                .show(ui, |ui| {
+                    metrics_table(ui, "compare-metrics", a, b);
+                    let mut notes = vec![(a, toolpaths.get(ka))];
+                    if let (Some(b), Some(kb)) = (b, kb) {
+                        notes.push((b, toolpaths.get(kb)));
+                    }
+                    relowered_notes(ui, &notes);
+                });
         });
         ui.separator();
         ui.vertical(|ui| {

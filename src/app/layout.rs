@@ -4,7 +4,7 @@ use super::canvas::{Canvas, PathLayer};
 use super::commands::Command;
 use super::files::{self, ExportKind, PROJECT_EXT};
 use super::paint::colour;
-use super::{compare, is_stale, playback, App, Tab, SOLVERS};
+use super::{compare, is_stale, motion_plots, playback, App, Tab, SOLVERS};
 use egui::{Color32, RichText};
 
 const ERROR: Color32 = Color32::from_rgb(200, 30, 30);
@@ -167,7 +167,7 @@ impl App {
         ui.checkbox(&mut l.fields, "Scan fields");
         ui.checkbox(&mut l.path, "Planned path");
         ui.checkbox(&mut l.arrows, "Direction arrows");
-        ui.checkbox(&mut l.base_path, "Base path");
+        ui.checkbox(&mut l.base_path, "Base path / stage route");
         ui.checkbox(&mut l.order_colours, "Colour marks by order");
     }
 
@@ -373,6 +373,8 @@ impl App {
             ui.separator();
             ui.heading("Metrics");
             compare::metrics_table(ui, "active-metrics", plan, None);
+            let lowered = self.active.and_then(|k| self.toolpaths.get(k));
+            compare::relowered_notes(ui, &[(plan, lowered)]);
         }
         ui.separator();
         let n = self.doc.warnings.len();
@@ -507,7 +509,42 @@ impl App {
             stale,
             playback_t_s,
         };
-        let (_, actions) = canvas.show(ui, &mut self.workbench, None);
+        let motion = lowered.and_then(Result::ok).and_then(|l| l.motion.as_ref());
+        let header_px = 2.0 * ui.spacing().interact_size.y;
+        let plots_px = motion_plots::PLOTS_HEIGHT_PX.min(ui.available_height() * 0.4);
+        let below_px = match motion {
+            Some(_) if self.motion_plots_open => header_px + plots_px,
+            Some(_) => header_px,
+            None => 0.0,
+        };
+        let size = ui.available_size() - egui::Vec2::Y * below_px;
+        let (_, actions) = canvas.show(ui, &mut self.workbench, Some(size));
+        if let Some(samples) = motion {
+            motion_plots_header(ui, &mut self.motion_plots_open);
+            if self.motion_plots_open {
+                motion_plots::show(ui, samples, &self.doc.profile, playback_t_s, plots_px);
+            }
+        }
         self.on_canvas(actions);
+    }
+}
+
+/// The header of the motion plots: shows or hides them.
+fn motion_plots_header(ui: &mut egui::Ui, open: &mut bool) {
+    let shown = *open;
+    let text = if shown {
+        "Motion plots (on the fly): hide"
+    } else {
+        "Motion plots (on the fly): show"
+    };
+    if ui
+        .selectable_label(shown, text)
+        .on_hover_text(
+            "The scanner offset against the field limits and the stage speed over the job \
+             (of the toolpath shown, lowered with the current settings)",
+        )
+        .clicked()
+    {
+        *open = !shown;
     }
 }

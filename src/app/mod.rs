@@ -10,8 +10,8 @@
 //! (profile and settings editors), [`jobs`] (background solves), [`toolpaths`] (each plan's
 //! lowered toolpath, the one the canvas draws and plays), [`playback`] (playing a job on the
 //! canvas), [`compare`] (side-by-side view, metrics table, convergence plot), [`commands`]
-//! (edits and undo), [`files`] (open/save/export/recent), `layout` (menus, toolbar, side
-//! panels, status bar).
+//! (edits and undo), [`motion_plots`] (the on-the-fly stage route and motion plots), [`files`]
+//! (open/save/export/recent), `layout` (menus, toolbar, side panels, status bar).
 
 pub mod canvas;
 pub mod commands;
@@ -19,6 +19,7 @@ pub mod compare;
 pub mod files;
 pub mod jobs;
 mod layout;
+pub mod motion_plots;
 mod paint;
 pub mod panels;
 pub mod playback;
@@ -174,6 +175,8 @@ pub struct App {
     toolpaths: ToolpathCache,
     /// Playback on the workbench canvas (run time only).
     playback: Playback,
+    /// The motion plots below the workbench canvas are shown (on-the-fly plans).
+    motion_plots_open: bool,
     uncovered: Vec<usize>,
     /// A problem with the open document (e.g. fields could not be placed).
     problem: Option<String>,
@@ -215,6 +218,7 @@ impl App {
             active: None,
             toolpaths: ToolpathCache::default(),
             playback: Playback::default(),
+            motion_plots_open: true,
             uncovered: Vec::new(),
             problem: None,
             recent: prefs.recent,

@@ -2,6 +2,7 @@
 //! (from each plan's lowered toolpath) and the playback of a job.
 
 use super::canvas::{Canvas, PathLayer, View};
+use super::motion_plots;
 use super::playback;
 use super::toolpaths::Lowered;
 use crate::geom::Pt;
@@ -82,7 +83,14 @@ pub fn paint(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
     let path_fade = if c.playback_t_s.is_some() { 0.35 } else { 1.0 };
     for (k, path) in c.paths.iter().enumerate() {
         let Ok(lowered) = path.lowered else { continue };
-        if c.layers.base_path && k == 0 {
+        if c.layers.base_path && lowered.on_the_fly() {
+            let col = if k == 0 {
+                motion_plots::ROUTE
+            } else {
+                path.colour
+            };
+            paint_route(painter, lowered, view, rect, col.gamma_multiply(path_fade));
+        } else if c.layers.base_path && k == 0 {
             paint_base_path(painter, lowered, view, rect, path_fade);
         }
         if c.layers.path {
@@ -231,6 +239,18 @@ fn paint_base_path(painter: &Painter, l: &Lowered, view: &View, rect: Rect, fade
     }
 }
 
+/// The stage route of an on-the-fly job: a solid line through the sampled stage positions.
+fn paint_route(painter: &Painter, l: &Lowered, view: &View, rect: Rect, col: Color32) {
+    let pts: Vec<Pos2> = l
+        .route_mm
+        .iter()
+        .map(|&p| view.to_screen(rect, p))
+        .collect();
+    if pts.len() > 1 {
+        painter.add(Shape::line(pts, Stroke::new(2.5, col.gamma_multiply(0.8))));
+    }
+}
+
 /// Idle moves between consecutive strokes (dashed, with arrows), start `S` and end `E`.
 fn paint_path(
     painter: &Painter,
@@ -332,8 +352,27 @@ fn paint_caption(painter: &Painter, c: &Canvas<'_>, rect: Rect) {
         y = r.max.y + 2.0;
     };
     line(c.label.to_string(), Color32::from_gray(40));
-    for p in &c.paths {
+    for (k, p) in c.paths.iter().enumerate() {
         line(plan_caption(p), p.colour);
+        if let Ok(l) = p.lowered {
+            if l.on_the_fly() && c.layers.base_path {
+                let col = if k == 0 {
+                    motion_plots::ROUTE
+                } else {
+                    p.colour
+                };
+                line(
+                    "stage route (solid line in this colour): where the stage travels while the scanner marks".into(),
+                    col,
+                );
+            }
+            if let Some((stored_s, now_s)) = l.job_time_mismatch_s(p.plan) {
+                line(
+                    relowered_note(stored_s, now_s),
+                    Color32::from_rgb(180, 83, 9),
+                );
+            }
+        }
         match (p.lowered, c.playback_t_s) {
             (Err(why), _) => line(why.to_string(), colour::UNCOVERED),
             (Ok(l), Some(t_s)) => line(
@@ -361,6 +400,26 @@ fn paint_caption(painter: &Painter, c: &Canvas<'_>, rect: Rect) {
     }
 }
 
+/// The note shown when a plan's toolpath no longer has the job time of its solve.
+pub fn relowered_note(stored_s: f64, now_s: f64) -> String {
+    format!(
+        "toolpath re-lowered with current settings: plays {now_s:.2} s, solved as {stored_s:.2} s \
+         (solve again for matching figures)"
+    )
+}
+
+/// How many caption lines a canvas shows at most (title, and per plan: figures, playback
+/// state, stage route legend, re-lowered note).
+pub fn caption_lines(c: &Canvas<'_>) -> usize {
+    let per_plan = |p: &PathLayer<'_>| match p.lowered {
+        Ok(l) => {
+            2 + usize::from(l.on_the_fly()) + usize::from(l.job_time_mismatch_s(p.plan).is_some())
+        }
+        Err(_) => 2,
+    };
+    1 + c.paths.iter().map(per_plan).sum::<usize>().max(2)
+}
+
 /// A plan's caption, led by the figure that decides: its job time.
 fn plan_caption(p: &PathLayer<'_>) -> String {
     let m = &p.plan.metrics;
@@ -370,8 +429,13 @@ fn plan_caption(p: &PathLayer<'_>) -> String {
         .map_or("job time unknown".to_string(), |t| {
             format!("job time {t:.2} s")
         });
+    let motion = match p.lowered {
+        Ok(l) if l.on_the_fly() => " · on the fly",
+        Ok(_) => " · step-and-scan",
+        Err(_) => "",
+    };
     format!(
-        "{}: {job} · idle travel {:.0} mm · stage travel {:.0} mm · {} scan fields",
+        "{}: {job}{motion} · idle travel {:.0} mm · stage travel {:.0} mm · {} scan fields",
         p.plan.name, m.idle_mm, m.base_mm, m.fields
     )
 }

@@ -6,7 +6,9 @@
 //! [`Command::SetProfile`] / [`Command::SetSettings`] (so it can be undone).
 
 use super::commands::Command;
-use crate::document::{CostModel, FieldsMode, MachineProfile, SolverSettings, VertexMode, BUILTIN};
+use crate::document::{
+    CostModel, FieldsMode, MachineProfile, MotionMode, SolverSettings, VertexMode, BUILTIN,
+};
 use egui::{Color32, RichText};
 
 /// One editable value of a `T`: shown as text, parsed back when committed.
@@ -480,6 +482,14 @@ impl Editors {
             ],
         )
         .on_hover_text(COST_MODEL_HELP);
+        combo(ui, "Motion", &mut s.motion, MOTION_MODES).on_hover_text(MOTION_HELP);
+        ui.add_enabled_ui(s.motion == MotionMode::OnTheFly, |ui| {
+            // the library has one stage route; the choice shows which one is used
+            let mut route = ();
+            combo(ui, "Stage route", &mut route, &[((), "Taut string")])
+                .on_hover_text(STAGE_ROUTE_HELP)
+                .on_disabled_hover_text("Only used on the fly: step-and-scan has no route.");
+        });
         ui.checkbox(&mut s.hha_improve, "HHA local search and alternation");
         ui.checkbox(
             &mut s.split_oversize,
@@ -507,6 +517,31 @@ const COST_MODEL_HELP: &str = "What the ordering minimises.\n\
     Idle distance: the laser-off travel in mm (seed 000's objective), ignoring the machine's \
     dynamics.\n\
     Used by the next solve (HHA, HGA and baseline; as-is keeps the document order).";
+
+/// The motion modes offered, in words.
+pub const MOTION_MODES: &[(MotionMode, &str)] = &[
+    (MotionMode::Step, "Step-and-scan"),
+    (
+        MotionMode::OnTheFly,
+        "On the fly (stage moves while marking)",
+    ),
+];
+
+/// What the motion modes mean for the operator.
+const MOTION_HELP: &str = "How the machine moves while it marks.\n\
+    Step-and-scan: the stage drives to a scan field, stops and settles, the scanner marks \
+    the field, then the stage drives to the next one.\n\
+    On the fly: the stage never stops; it follows a smooth route while the scanner marks, \
+    keeping the laser point inside the field (less the profile's on-the-fly margin). Shapes \
+    larger than the field need no splitting.\n\
+    Used by the next solve; the plans' toolpaths on the canvas, the playback and the motion \
+    plots are re-computed at once with this setting.";
+
+/// What the stage route means for the operator.
+const STAGE_ROUTE_HELP: &str = "How the stage's route is computed on the fly.\n\
+    Taut string: per axis, the shortest route that keeps the laser point within the \
+    scanner's reach, then smoothed to the axes' speed and acceleration limits (the only \
+    route available for now).";
 
 /// A labelled combo box; returns the combo's response.
 fn combo<T: PartialEq + Copy>(

@@ -2,7 +2,9 @@
 //! that the canvas, its hover, the captions and the playback all read the same timed job.
 //! Nothing here is saved; a plan that cannot be lowered keeps the error in words.
 
-use crate::document::{Document, MachineProfile, Plan};
+use super::motion_plots::{route_points_mm, MotionSamples};
+use crate::document::{Document, MachineProfile, MotionMode, Plan};
+use crate::geom::Pt;
 use crate::motion::{ScanMotion, Toolpath};
 use crate::pipeline::lower_plan;
 use std::sync::Arc;
@@ -14,6 +16,10 @@ pub struct Lowered {
     pub toolpath: Toolpath,
     /// Per stroke (index into `toolpath.strokes`): (start, end) of its mark, s.
     pub mark_s: Vec<(f64, f64)>,
+    /// The stage route sampled for the canvas, mm (empty for step-and-scan).
+    pub route_mm: Vec<Pt>,
+    /// The on-the-fly motion sampled for the plots (`None` for step-and-scan).
+    pub motion: Option<MotionSamples>,
 }
 
 impl Lowered {
@@ -27,7 +33,28 @@ impl Lowered {
                 }
             }
         }
-        Self { toolpath, mark_s }
+        let route_mm = route_points_mm(&toolpath);
+        let motion = MotionSamples::of(&toolpath);
+        Self {
+            toolpath,
+            mark_s,
+            route_mm,
+            motion,
+        }
+    }
+
+    /// True when the stage moves on a continuous route while the scanner marks.
+    pub fn on_the_fly(&self) -> bool {
+        self.toolpath.route.is_some()
+    }
+
+    /// When the plan's stored job time (from its solve) and this toolpath's differ by more
+    /// than 1 %: (stored, toolpath) in s. The toolpath is lowered with the current settings
+    /// and profile, which may not be those the plan was solved with.
+    pub fn job_time_mismatch_s(&self, plan: &Plan) -> Option<(f64, f64)> {
+        let stored_s = plan.metrics.job_time_s?;
+        let now_s = self.duration_s();
+        ((stored_s - now_s).abs() > 0.01 * stored_s.max(now_s)).then_some((stored_s, now_s))
     }
 
     /// The job time, s.
@@ -55,6 +82,7 @@ struct Key {
     fields: usize,
     geometries: usize,
     profile: MachineProfile,
+    motion: MotionMode,
 }
 
 impl Key {
@@ -66,6 +94,7 @@ impl Key {
             fields: plan.fields.len(),
             geometries: doc.geometries.len(),
             profile: doc.profile.clone(),
+            motion: doc.settings.motion,
         }
     }
 }
@@ -85,7 +114,7 @@ pub struct ToolpathCache {
 
 impl ToolpathCache {
     /// Lowers the plans that are new or changed (a plan added, loaded or removed, another
-    /// profile, other geometries); returns how many were lowered. Cheap when nothing changed.
+    /// profile, another motion mode, other geometries); returns how many were lowered. Cheap when nothing changed.
     pub fn sync(&mut self, doc: &Document) -> usize {
         self.entries.truncate(doc.plans.len());
         let mut lowered = 0;
@@ -159,7 +188,7 @@ mod tests {
     }
 
     #[test]
-    fn lowers_once_and_again_after_a_profile_change() {
+    fn lowers_once_and_again_after_a_profile_or_motion_change() {
         let mut doc = doc_with_plan(false);
         let mut cache = ToolpathCache::default();
         assert_eq!(cache.sync(&doc), 1);
@@ -172,6 +201,11 @@ mod tests {
         assert_eq!(l.strokes_done(s1), 1);
         doc.profile.scanner.mark_speed_mm_s *= 2.0;
         assert_eq!(cache.sync(&doc), 1);
+        assert!(!cache.get(0).unwrap().unwrap().on_the_fly());
+        doc.settings.motion = MotionMode::OnTheFly;
+        assert_eq!(cache.sync(&doc), 1);
+        let l = cache.get(0).unwrap().unwrap();
+        assert!(l.on_the_fly() && !l.route_mm.is_empty() && l.motion.is_some());
         doc.plans.clear();
         cache.sync(&doc);
         assert!(cache.get(0).is_none());
