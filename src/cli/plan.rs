@@ -8,7 +8,7 @@ use galvoplan::export::{
     geometry_svg, preview_svg, report_json, trajectory_csv, trajectory_period_s, write_gcode,
 };
 use galvoplan::job::{CancelToken, JobCtx};
-use galvoplan::pipeline::{load_svg, lower_plan, lower_plan_on, plan_document};
+use galvoplan::pipeline::{load_svg, lower_plan_on, plan_document};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -40,18 +40,15 @@ pub fn run(a: &PlanArgs) -> Result<()> {
     let mut plan = result?;
     let t0 = Instant::now();
     let source = a.input.display().to_string();
-    let toolpath = lower_plan(&doc, &plan)?;
-    // the trajectory is the toolpath on the controller's clock; the report then gives its time
-    let trajectory = match period_s {
-        Some(p) => {
-            let clocked = lower_plan_on(&doc, &plan, Some(p))?;
-            plan.metrics.job_time_s = Some(clocked.duration_s());
-            plan.metrics.job_time_breakdown_s = Some(clocked.breakdown());
-            plan.metrics.motion = Some(clocked.motion_figures(p));
-            Some(trajectory_csv(&clocked, p))
-        }
-        None => None,
-    };
+    // with a trajectory, everything is written from the toolpath on the controller's clock (the
+    // same strokes; the report then gives its time)
+    let toolpath = lower_plan_on(&doc, &plan, period_s)?;
+    let trajectory = period_s.map(|p| {
+        plan.metrics.job_time_s = Some(toolpath.duration_s());
+        plan.metrics.job_time_breakdown_s = Some(toolpath.breakdown());
+        plan.metrics.motion = Some(toolpath.motion_figures(p));
+        trajectory_csv(&toolpath, p)
+    });
     let gcode = write_gcode(&toolpath, &plan, &doc.profile, doc.page_mm[1], &source)
         .with_context(|| format!("{}: cannot write G-code", a.output.display()))?;
     let preview = a
