@@ -130,10 +130,41 @@ const ROWS: &[Row] = &[
     },
     Row {
         label: "Stage travel (mm)",
-        help: "base-stage travel through the field centres in visiting order",
+        help: "base-stage travel through the field centres in visiting order (step-and-scan; \
+               on the fly the stage follows its route instead: see Stage route)",
         value: |m| Some(m.base_mm),
         decimals: 1,
         kind: RowKind::Ranked,
+    },
+    Row {
+        label: "Stage route (mm)",
+        help: "length of the stage's route, sampled every millisecond (on the fly: the route it \
+               follows while the scanner marks; step-and-scan: its moves between fields)",
+        value: |m| m.motion.map(|f| f.stage_route_mm),
+        decimals: 1,
+        kind: RowKind::Ranked,
+    },
+    Row {
+        label: "Peak stage speed (mm/s)",
+        help: "the stage's largest speed (both axes together), sampled every millisecond",
+        value: |m| m.motion.map(|f| f.stage_peak_speed_mm_s),
+        decimals: 0,
+        kind: RowKind::Ranked,
+    },
+    Row {
+        label: "Stage speed variation (mm/s)",
+        help: "sum of the stage's speed changes between samples (seed 001 Table IV): lower is \
+               a smoother ride",
+        value: |m| m.motion.map(|f| f.stage_speed_variation_mm_s),
+        decimals: 0,
+        kind: RowKind::Ranked,
+    },
+    Row {
+        label: "Peak scanner offset (mm)",
+        help: "the largest distance of the laser point from the field centre on either axis",
+        value: |m| m.motion.map(|f| f.scan_peak_offset_mm),
+        decimals: 1,
+        kind: RowKind::Info,
     },
     Row {
         label: "Scan fields",
@@ -445,8 +476,8 @@ pub fn show(
         stale: false,
         playback_t_s,
     };
-    // the metrics table's height (13 rows), or less on a small window (it scrolls then)
-    let bottom = 320.0_f32.min(ui.available_height() * 0.45);
+    // the metrics table's height (17 rows), or less on a small window (it scrolls then)
+    let bottom = 400.0_f32.min(ui.available_height() * 0.45);
     let top = (ui.available_height() - bottom - 8.0).max(100.0);
     let width = ui.available_width();
     match kb {

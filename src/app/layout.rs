@@ -517,6 +517,12 @@ impl App {
             Some(_) => header_px,
             None => 0.0,
         };
+        let below = (motion.is_some(), motion.is_some() && self.motion_plots_open);
+        if below != self.workbench_below {
+            // the canvas changes height when the plots come or go: fit the content again
+            self.workbench_below = below;
+            self.workbench.fit_requested = true;
+        }
         let size = ui.available_size() - egui::Vec2::Y * below_px;
         let (_, actions) = canvas.show(ui, &mut self.workbench, Some(size));
         if let Some(samples) = motion {

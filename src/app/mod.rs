@@ -177,6 +177,8 @@ pub struct App {
     playback: Playback,
     /// The motion plots below the workbench canvas are shown (on-the-fly plans).
     motion_plots_open: bool,
+    /// What was under the workbench canvas in the last frame: (plots header, plots).
+    workbench_below: (bool, bool),
     uncovered: Vec<usize>,
     /// A problem with the open document (e.g. fields could not be placed).
     problem: Option<String>,
@@ -219,6 +221,7 @@ impl App {
             toolpaths: ToolpathCache::default(),
             playback: Playback::default(),
             motion_plots_open: true,
+            workbench_below: (false, false),
             uncovered: Vec::new(),
             problem: None,
             recent: prefs.recent,

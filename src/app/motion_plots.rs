@@ -143,16 +143,16 @@ fn offset_plot(
 ) {
     let [rx, ry] = reach_mm(profile);
     ui.label(format!(
-        "Scanner offset (tool - stage), mm: peak {:.1} of ± {:.1} mm reach \
-         (half the field less the {:.1} mm margin)",
+        "Scanner offset (tool - stage), mm: peak {:.1} of ±{:.1}",
         s.peak_offset_mm(),
-        rx.min(ry),
-        profile.otf_margin_mm
+        rx.min(ry)
     ))
-    .on_hover_text(
+    .on_hover_text(format!(
         "Where the laser point is inside the scan field while the stage moves. The scanner \
-         can reach up to the red lines; the planner keeps the offset inside them.",
-    );
+         can reach up to the red dashed lines: half the field less the profile's on-the-fly \
+         margin ({:.1} mm); the planner keeps the offset inside them.",
+        profile.otf_margin_mm
+    ));
     Plot::new("otf-offset")
         .height(height_px)
         .legend(Legend::default())
@@ -190,7 +190,7 @@ fn speed_plot(
         profile.axis_y.max_velocity_mm_s,
     );
     ui.label(format!(
-        "Stage speed, mm/s: peak {:.0} (axis limit {:.0} mm/s each)",
+        "Stage speed, mm/s: peak {:.0}, axis limit {:.0}",
         s.peak_speed_mm_s(),
         vx.max(vy)
     ))

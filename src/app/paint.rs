@@ -429,15 +429,31 @@ fn plan_caption(p: &PathLayer<'_>) -> String {
         .map_or("job time unknown".to_string(), |t| {
             format!("job time {t:.2} s")
         });
-    let motion = match p.lowered {
-        Ok(l) if l.on_the_fly() => " · on the fly",
-        Ok(_) => " · step-and-scan",
-        Err(_) => "",
-    };
-    format!(
-        "{}: {job}{motion} · idle travel {:.0} mm · stage travel {:.0} mm · {} scan fields",
-        p.plan.name, m.idle_mm, m.base_mm, m.fields
-    )
+    match p.lowered {
+        Ok(l) if l.on_the_fly() => format!(
+            "{}: {job} · on the fly · idle travel {:.0} mm · stage route {:.0} mm",
+            p.plan.name,
+            m.idle_mm,
+            route_length_mm(&l.route_mm)
+        ),
+        lowered => format!(
+            "{}: {job}{} · idle travel {:.0} mm · stage travel {:.0} mm · {} scan fields",
+            p.plan.name,
+            if lowered.is_ok() {
+                " · step-and-scan"
+            } else {
+                ""
+            },
+            m.idle_mm,
+            m.base_mm,
+            m.fields
+        ),
+    }
+}
+
+/// Length of a polyline, mm.
+fn route_length_mm(pts: &[Pt]) -> f64 {
+    pts.windows(2).map(|w| w[0].dist(w[1])).sum()
 }
 
 fn paint_scale_bar(painter: &Painter, view: &View, rect: Rect) {
