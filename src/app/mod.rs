@@ -27,7 +27,9 @@ pub mod toolpaths;
 
 pub use canvas::{Canvas, CanvasAction, CanvasState, Layers, View};
 
-use crate::document::{Algo, Document, MachineProfile, Plan, ScanField, SolverSettings};
+use crate::document::{
+    Algo, Document, MachineProfile, MotionMode, Plan, ScanField, SolverSettings,
+};
 use commands::{Command, History, Outcome};
 use compare::CompareState;
 use files::{ExportKind, Recent};
@@ -523,13 +525,16 @@ impl App {
                 let job = m.job_time_s.map_or("job time unknown".to_string(), |t| {
                     format!("job time {t:.2} s")
                 });
+                let stage = match (self.doc.settings.motion, m.motion) {
+                    (MotionMode::OnTheFly, Some(f)) => {
+                        format!("on the fly, stage route {:.1} mm", f.stage_route_mm)
+                    }
+                    _ => format!("stage travel {:.1} mm, {} scan fields", m.base_mm, m.fields),
+                };
                 let msg = format!(
-                    "{}: {job}, idle travel {:.1} mm, stage travel {:.1} mm, {} scan fields \
-                     (solved in {:.2} s)",
+                    "{}: {job}, idle travel {:.1} mm, {stage} (solved in {:.2} s)",
                     plan.name,
                     m.idle_mm,
-                    m.base_mm,
-                    m.fields,
                     elapsed.as_secs_f64()
                 );
                 self.doc.plans.push(*plan);

@@ -24,8 +24,8 @@ const OFFSET_X: Color32 = Color32::from_rgb(234, 88, 12);
 const OFFSET_Y: Color32 = Color32::from_rgb(124, 58, 237);
 /// Limits (field reach, axis speed).
 const LIMIT: Color32 = Color32::from_rgb(200, 30, 30);
-/// The playback time.
-const NOW: Color32 = Color32::from_gray(60);
+/// The playback time (legible on the plots' dark and light backgrounds).
+const NOW: Color32 = Color32::from_rgb(234, 179, 8);
 
 /// Sample times over `[0, duration_s]`: every `step_s`, or coarser so that there are at most
 /// `max` of them; the last one is the job's end.
@@ -173,7 +173,7 @@ fn offset_plot(
                 }
             }
             if let Some(t) = t_s {
-                pui.vline(VLine::new("playback t", t).color(NOW));
+                pui.vline(VLine::new("playback t", t).color(NOW).width(2.0));
             }
         });
 }
@@ -214,7 +214,7 @@ fn speed_plot(
                     .style(LineStyle::dashed_loose()),
             );
             if let Some(t) = t_s {
-                pui.vline(VLine::new("playback t", t).color(NOW));
+                pui.vline(VLine::new("playback t", t).color(NOW).width(2.0));
             }
         });
 }
