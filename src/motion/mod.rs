@@ -16,6 +16,7 @@
 //!   speed between the laser-on and laser-off delays.
 
 mod axis;
+mod blend;
 mod lower;
 mod otf;
 mod route;
@@ -23,9 +24,10 @@ pub mod taut;
 mod toolpath;
 
 pub use axis::{AxisMove, StageDynamics, StageMove};
+pub use blend::CornerBlends;
 pub use lower::{lower, LowerError, REACH_TOLERANCE_MM};
 pub use otf::{lower_on_the_fly, OtfError};
-pub use route::{SmoothedAxis, StageRoute};
+pub use route::{AxisRoute, SmoothedAxis, StageRoute};
 pub use toolpath::{
     MachineState, ScanMotion, Segment, SegmentKind, StageMotion, Stroke, Toolpath, TIME_EPS_S,
 };

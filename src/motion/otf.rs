@@ -17,7 +17,7 @@
 //!    offset stays within half the field less the margin. The job starts with the stage at rest:
 //!    the tool waits at its first point for half a window while the stage gets under way.
 
-use super::route::{SmoothedAxis, StageRoute};
+use super::route::{AxisRoute, StageRoute};
 use super::taut::{peak_speed_mm_s, taut_string, TautError, Tube};
 use super::toolpath::{ScanMotion, Segment, SegmentKind, StageMotion, Toolpath};
 use crate::document::{AxisLimits, Geometry, MachineProfile, Plan};
@@ -182,15 +182,14 @@ fn build(
     profile: &MachineProfile,
     clock_s: Option<f64>,
 ) -> Result<(), OtfError> {
-    let axes = [&profile.axis_x, &profile.axis_y];
-    let routes = routes(pieces, path, profile)?;
-    let windows = [0, 1].map(|k| 2.0 * peak_speed_mm_s(&routes[k]) / axes[k].max_accel_mm_s2);
-    let half_window_s = windows[0].max(windows[1]) / 2.0;
-    let pad_s = clock_s.map_or(half_window_s, |p| ceil_to_tick(half_window_s, p));
-    let [rx, ry] = routes;
+    let [rx, ry] = routes(pieces, path, profile)?;
+    let x = AxisRoute::smooth(rx, profile.axis_x.max_accel_mm_s2);
+    let y = AxisRoute::smooth(ry, profile.axis_y.max_accel_mm_s2);
+    let half_reach_s = x.reach_s().max(y.reach_s()) / 2.0;
+    let pad_s = clock_s.map_or(half_reach_s, |p| ceil_to_tick(half_reach_s, p));
     path.route = Some(StageRoute {
-        x: SmoothedAxis::new(rx, windows[0]),
-        y: SmoothedAxis::new(ry, windows[1]),
+        x,
+        y,
         offset_s: pad_s,
     });
     path.segments.clear();
@@ -233,7 +232,7 @@ fn shrink(pieces: &mut [Piece], run: &[Piece], path: &Toolpath, over: &[(f64, f6
     let Some(route) = &path.route else {
         return;
     };
-    let half_window_s = route.x.window_s().max(route.y.window_s()) / 2.0;
+    let half_window_s = route.x.reach_s().max(route.y.reach_s()) / 2.0;
     let mut starts = Vec::with_capacity(run.len());
     let mut t_s = route.offset_s;
     for p in run {

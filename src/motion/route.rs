@@ -8,6 +8,7 @@
 //! `a_max`. The smoothed path departs from `x` by at most the mean of `|x(s) − x(t)|` over the
 //! window, `≤ v · W / 4 = v² / (2 a_max)`, which is the part of the scanner's reach kept for it.
 
+use super::blend::CornerBlends;
 use crate::geom::Pt;
 
 /// One smoothed axis.
@@ -79,14 +80,52 @@ impl SmoothedAxis {
     }
 }
 
+/// One axis of a stage route: corners blended one by one, or (where overlapping blends would
+/// exceed the acceleration) the whole path averaged over one window.
+#[derive(Debug, Clone, PartialEq)]
+pub enum AxisRoute {
+    /// Corner blends ([`CornerBlends`]).
+    Blends(CornerBlends),
+    /// A moving average ([`SmoothedAxis`]).
+    Window(SmoothedAxis),
+}
+
+impl AxisRoute {
+    /// The acceleration-limited route through `vertices` (speed at most their peak).
+    pub fn smooth(vertices: Vec<(f64, f64)>, accel_mm_s2: f64) -> Self {
+        match CornerBlends::new(&vertices, accel_mm_s2) {
+            Some(blends) => AxisRoute::Blends(blends),
+            None => {
+                let window_s = 2.0 * super::taut::peak_speed_mm_s(&vertices) / accel_mm_s2;
+                AxisRoute::Window(SmoothedAxis::new(vertices, window_s))
+            }
+        }
+    }
+    /// Position at `t_s`, mm.
+    pub fn position_mm(&self, t_s: f64) -> f64 {
+        match self {
+            AxisRoute::Blends(b) => b.position_mm(t_s),
+            AxisRoute::Window(w) => w.position_mm(t_s),
+        }
+    }
+    /// How long before or after a vertex the route may depart from the path, s (the longest
+    /// blend, or the window).
+    pub fn reach_s(&self) -> f64 {
+        match self {
+            AxisRoute::Blends(b) => b.longest_s(),
+            AxisRoute::Window(w) => w.window_s(),
+        }
+    }
+}
+
 /// The stage route of an on-the-fly job: two smoothed axes on a time base shifted by
 /// `offset_s` (job time = route time + offset, so the stage can start from rest).
 #[derive(Debug, Clone, PartialEq)]
 pub struct StageRoute {
     /// X axis.
-    pub x: SmoothedAxis,
+    pub x: AxisRoute,
     /// Y axis.
-    pub y: SmoothedAxis,
+    pub y: AxisRoute,
     /// Job time at route time 0, s.
     pub offset_s: f64,
 }
