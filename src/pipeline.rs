@@ -203,7 +203,7 @@ pub fn order_document(doc: &Document, ctx: &JobCtx) -> Result<Plan, PipelineErro
     Ok(plan)
 }
 
-/// The machine motion of one of the document's plans, in the settings' motion mode
+/// The machine motion of one of the document's plans, in the motion mode it was planned for
 /// ([`crate::motion::lower_motion`]).
 pub fn lower_plan(doc: &Document, plan: &Plan) -> Result<Toolpath, PipelineError> {
     lower_plan_on(doc, plan, None)
@@ -215,8 +215,7 @@ pub fn lower_plan_on(
     plan: &Plan,
     clock_s: Option<f64>,
 ) -> Result<Toolpath, PipelineError> {
-    let motion = doc.settings.motion;
-    lower_motion(&doc.geometries, plan, &doc.profile, motion, clock_s).map_err(|source| {
+    lower_motion(&doc.geometries, plan, &doc.profile, clock_s).map_err(|source| {
         PipelineError::Lower {
             file: doc.source.clone().unwrap_or_else(|| "document".into()),
             source,

@@ -525,7 +525,7 @@ impl App {
                 let job = m.job_time_s.map_or("job time unknown".to_string(), |t| {
                     format!("job time {t:.2} s")
                 });
-                let stage = match (self.doc.settings.motion, m.motion) {
+                let stage = match (plan.motion, m.motion) {
                     (MotionMode::OnTheFly, Some(f)) => {
                         format!("on the fly, stage route {:.1} mm", f.stage_route_mm)
                     }

@@ -178,6 +178,7 @@ mod tests {
             }],
             metrics: Metrics::default(),
             history: Vec::new(),
+            motion: MotionMode::Step,
         };
         Document {
             geometries: vec![line],
@@ -202,7 +203,12 @@ mod tests {
         doc.profile.scanner.mark_speed_mm_s *= 2.0;
         assert_eq!(cache.sync(&doc), 1);
         assert!(!cache.get(0).unwrap().unwrap().on_the_fly());
+        // a plan is lowered with the motion it was planned for
         doc.settings.motion = MotionMode::OnTheFly;
+        cache.sync(&doc);
+        assert!(!cache.get(0).unwrap().unwrap().on_the_fly());
+        doc.plans[0].motion = MotionMode::OnTheFly;
+        doc.settings.motion = MotionMode::Step;
         assert_eq!(cache.sync(&doc), 1);
         let l = cache.get(0).unwrap().unwrap();
         assert!(l.on_the_fly() && !l.route_mm.is_empty() && l.motion.is_some());

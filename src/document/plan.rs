@@ -203,4 +203,8 @@ pub struct Plan {
     /// GA convergence history (empty for other algorithms).
     #[serde(default)]
     pub history: Vec<GenerationRecord>,
+    /// The motion it was planned for: it is lowered, shown and exported that way whatever the
+    /// current setting (projects from before on-the-fly marking are step-and-scan).
+    #[serde(default)]
+    pub motion: super::MotionMode,
 }

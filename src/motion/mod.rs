@@ -45,16 +45,15 @@ pub enum MotionError {
     OnTheFly(#[from] OtfError),
 }
 
-/// Lowers a plan in the given motion mode; with `clock_s`, on that controller clock (every
-/// mark starts and ends on a tick: what a trajectory sampled at that period can show).
+/// Lowers a plan in the motion mode it was planned for; with `clock_s`, on that controller clock
+/// (every mark starts and ends on a tick: what a trajectory sampled at that period can show).
 pub fn lower_motion(
     geometries: &[Geometry],
     plan: &Plan,
     profile: &MachineProfile,
-    motion: MotionMode,
     clock_s: Option<f64>,
 ) -> Result<Toolpath, MotionError> {
-    Ok(match motion {
+    Ok(match plan.motion {
         MotionMode::Step => {
             let path = lower(geometries, plan, profile)?;
             match clock_s {

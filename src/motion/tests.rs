@@ -36,6 +36,7 @@ fn plan(fields: Vec<ScanField>, order: Vec<Step>) -> Plan {
         order,
         metrics: Metrics::default(),
         history: vec![],
+        motion: Default::default(),
     }
 }
 

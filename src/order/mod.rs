@@ -95,6 +95,7 @@ pub fn order_plan(
         order: ordering.steps,
         metrics: m,
         history,
+        motion: settings.motion,
     })
 }
 
@@ -176,8 +177,9 @@ fn lower_ordering(
         order: ordering.steps.clone(),
         metrics: Default::default(),
         history: Vec::new(),
+        motion: settings.motion,
     };
-    lower_motion(geometries, &plan, profile, settings.motion, None)
+    lower_motion(geometries, &plan, profile, None)
 }
 
 /// The distance ordering refined for job time ([`time::refine_for_time`]); the refinement is
