@@ -35,7 +35,7 @@ pub fn compute(
     let centers: Vec<Pt> = fields.iter().map(|f| f.center).collect();
     // `+ 0.0` turns the empty sum (−0.0) into 0.0
     let base_mm = centers.windows(2).map(|w| w[0].dist(w[1])).sum::<f64>() + 0.0;
-    let (covered_area_mm2, overlap_pct) = coverage(fields, profile.field_mm);
+    let (covered_area_mm2, overlap_pct) = coverage(fields);
     Metrics {
         idle_mm,
         marked_mm,
@@ -71,11 +71,12 @@ pub fn idle_mm(geometries: &[Geometry], steps: &[Step]) -> f64 {
         + 0.0
 }
 
-/// Area covered by exactly one field and the overlap percentage (seed 000 §5.1).
+/// Area covered by exactly one field and the overlap percentage (seed 000 §5.1), with each
+/// field's own size.
 ///
 /// Exact for axis-aligned fields: a sweep over the x-slabs between field edges, and in each
 /// slab over the y-intervals, counting how many fields cover each piece.
-pub fn coverage(fields: &[ScanField], field_mm: [f64; 2]) -> (f64, f64) {
+pub fn coverage(fields: &[ScanField]) -> (f64, f64) {
     if fields.is_empty() {
         return (0.0, 0.0);
     }
@@ -109,7 +110,8 @@ pub fn coverage(fields: &[ScanField], field_mm: [f64; 2]) -> (f64, f64) {
         }
         once += len_once * (x1 - x0);
     }
-    let full = fields.len() as f64 * field_mm[0] * field_mm[1];
+    // each field's own size: an on-the-fly region around oversize work is larger than a field
+    let full: f64 = fields.iter().map(|f| f.size[0] * f.size[1]).sum();
     let overlap_pct = if full > 0.0 {
         100.0 * (1.0 - once / full)
     } else {
@@ -221,11 +223,11 @@ mod tests {
     #[test]
     fn coverage_of_two_overlapping_fields() {
         let f = [field(0, 35.0, 35.0), field(1, 70.0, 35.0)];
-        let (once, pct) = coverage(&f, [70.0, 70.0]);
+        let (once, pct) = coverage(&f);
         // overlap strip 35 × 70 is covered twice
         assert!((once - (2.0 * 4900.0 - 2.0 * 35.0 * 70.0)).abs() < 1e-9);
         assert!((pct - 50.0).abs() < 1e-9);
-        let (once, pct) = coverage(&f[..1], [70.0, 70.0]);
+        let (once, pct) = coverage(&f[..1]);
         assert!((once - 4900.0).abs() < 1e-9 && pct.abs() < 1e-12);
     }
 
