@@ -215,7 +215,9 @@ pub fn lower_plan_on(
     plan: &Plan,
     clock_s: Option<f64>,
 ) -> Result<Toolpath, PipelineError> {
-    lower_motion(&doc.geometries, plan, &doc.profile, clock_s).map_err(|source| {
+    // exports and the GUI's display run to the end: no cancel
+    let ctx = JobCtx::default();
+    lower_motion(&doc.geometries, plan, &doc.profile, clock_s, &ctx).map_err(|source| {
         PipelineError::Lower {
             file: doc.source.clone().unwrap_or_else(|| "document".into()),
             source,

@@ -389,3 +389,24 @@ fn on_the_fly_margin_must_leave_reach() {
         "{e}"
     );
 }
+
+#[test]
+fn on_the_fly_lowering_stops_on_a_cancel() {
+    use galvoplan::job::{CancelToken, NoProgress};
+    use galvoplan::motion::{lower_on_the_fly, OtfError};
+    let mut doc = serpentine_document();
+    let plan = plan_document(&mut doc, &JobCtx::default()).unwrap();
+    let token = CancelToken::new();
+    token.cancel();
+    let ctx = JobCtx::new(token, std::sync::Arc::new(NoProgress));
+    let e = lower_on_the_fly(&doc.geometries, &plan, &doc.profile, None, &ctx).unwrap_err();
+    assert!(matches!(e, OtfError::Cancelled(_)), "{e}");
+    assert!(lower_on_the_fly(
+        &doc.geometries,
+        &plan,
+        &doc.profile,
+        None,
+        &JobCtx::default()
+    )
+    .is_ok());
+}

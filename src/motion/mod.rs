@@ -33,6 +33,7 @@ pub use toolpath::{
 };
 
 use crate::document::{Geometry, MachineProfile, MotionMode, Plan};
+use crate::job::JobCtx;
 
 /// Why a plan cannot be turned into motion, in either mode.
 #[derive(Debug, thiserror::Error, PartialEq)]
@@ -52,6 +53,7 @@ pub fn lower_motion(
     plan: &Plan,
     profile: &MachineProfile,
     clock_s: Option<f64>,
+    ctx: &JobCtx,
 ) -> Result<Toolpath, MotionError> {
     Ok(match plan.motion {
         MotionMode::Step => {
@@ -61,7 +63,7 @@ pub fn lower_motion(
                 None => path,
             }
         }
-        MotionMode::OnTheFly => lower_on_the_fly(geometries, plan, profile, clock_s)?,
+        MotionMode::OnTheFly => lower_on_the_fly(geometries, plan, profile, clock_s, ctx)?,
     })
 }
 

@@ -22,6 +22,7 @@ use super::taut::{peak_speed_mm_s, taut_string, TautError, Tube};
 use super::toolpath::{ScanMotion, Segment, SegmentKind, StageMotion, Toolpath};
 use crate::document::{AxisLimits, Geometry, MachineProfile, Plan};
 use crate::geom::Pt;
+use crate::job::{Cancelled, JobCtx};
 use thiserror::Error;
 
 /// Share of the scanner's reach kept for smoothing the route by the guaranteed fallback.
@@ -94,6 +95,9 @@ pub enum OtfError {
     /// The route could not be computed.
     #[error("stage route: {0}")]
     Route(#[from] TautError),
+    /// The operator cancelled.
+    #[error("cancelled")]
+    Cancelled(#[from] Cancelled),
 }
 
 /// What the tool-centre point does during a piece.
@@ -119,12 +123,14 @@ struct Piece {
 
 /// Lowers a plan for on-the-fly marking (see the module documentation). With `clock_s`, every
 /// mark starts and ends on a tick of that controller clock (as [`Toolpath::on_clock`] does for
-/// step-and-scan), with one laser-off tick between marks.
+/// step-and-scan), with one laser-off tick between marks. `ctx` is checked for a cancel between
+/// rounds.
 pub fn lower_on_the_fly(
     geometries: &[Geometry],
     plan: &Plan,
     profile: &MachineProfile,
     clock_s: Option<f64>,
+    ctx: &JobCtx,
 ) -> Result<Toolpath, OtfError> {
     let reach_mm = reach_mm(profile)?;
     let mut path = Toolpath::default();
@@ -136,6 +142,7 @@ pub fn lower_on_the_fly(
     ];
     let (mut best_excess_mm, mut stalled) = (f64::INFINITY, 0);
     for _ in 0..SHRINK_ROUNDS {
+        ctx.check()?;
         retime(&mut pieces, &path, profile, full_speed)?;
         let run = clocked(&pieces, &path, clock_s);
         build(&mut path, &run, profile, clock_s)?;

@@ -18,7 +18,7 @@ use crate::document::{
     SolverSettings, Step,
 };
 use crate::job::{Cancelled, JobCtx};
-use crate::motion::{lower_motion, MotionError, Toolpath};
+use crate::motion::{lower_motion, MotionError, OtfError, Toolpath};
 use thiserror::Error;
 
 /// Why ordering failed.
@@ -74,7 +74,7 @@ pub fn order_plan(
         detail.push(("time".into(), t.elapsed().as_secs_f64()));
         best
     } else {
-        let toolpath = lower_ordering(geometries, fields, profile, settings, &ordering)?;
+        let toolpath = lower_ordering(geometries, fields, profile, settings, &ordering, ctx)?;
         (ordering, toolpath)
     };
     let order_s = t0.elapsed().as_secs_f64();
@@ -169,7 +169,8 @@ fn lower_ordering(
     profile: &MachineProfile,
     settings: &SolverSettings,
     ordering: &Ordering,
-) -> Result<Toolpath, MotionError> {
+    ctx: &JobCtx,
+) -> Result<Toolpath, OrderError> {
     let plan = Plan {
         name: String::new(),
         algo: Algo::default(),
@@ -179,7 +180,14 @@ fn lower_ordering(
         history: Vec::new(),
         motion: settings.motion,
     };
-    lower_motion(geometries, &plan, profile, None)
+    // a search cancelled with a result (HGA's best so far) still gets its toolpath; a cancel
+    // during the lowering itself (on the fly, seconds on large jobs) stops it
+    let finish = JobCtx::default();
+    let ctx = if ctx.is_cancelled() { &finish } else { ctx };
+    match lower_motion(geometries, &plan, profile, None, ctx) {
+        Err(MotionError::OnTheFly(OtfError::Cancelled(c))) => Err(OrderError::Cancelled(c)),
+        other => Ok(other?),
+    }
 }
 
 /// The distance ordering refined for job time ([`time::refine_for_time`]); the refinement is
@@ -193,13 +201,13 @@ fn time_ordering(
     ordering: Ordering,
     ctx: &JobCtx,
 ) -> Result<(Ordering, Toolpath), OrderError> {
-    let by_distance = lower_ordering(geometries, fields, profile, settings, &ordering)?;
+    let by_distance = lower_ordering(geometries, fields, profile, settings, &ordering, ctx)?;
     let refined =
         match time::refine_for_time(geometries, fields, &ordering, profile, settings.seed, ctx) {
             Ok(refined) => refined,
             Err(Cancelled) => return Ok((ordering, by_distance)),
         };
-    let by_time = lower_ordering(geometries, fields, profile, settings, &refined)?;
+    let by_time = lower_ordering(geometries, fields, profile, settings, &refined, ctx)?;
     Ok(if by_time.duration_s() <= by_distance.duration_s() {
         (refined, by_time)
     } else {
