@@ -39,7 +39,7 @@ pub fn trajectory_period_s(period_ms: f64) -> Result<f64, PeriodError> {
 /// sample.
 pub fn trajectory_csv(toolpath: &Toolpath, period_s: f64) -> String {
     let end_s = toolpath.duration_s();
-    let samples = (end_s / period_s - 1e-9).ceil().max(0.0) as usize + 1;
+    let samples = crate::motion::ticks_covering(end_s, period_s) + 1;
     let mut out = String::with_capacity(samples * 64);
     out.push_str(TRAJECTORY_HEADER);
     out.push('\n');

@@ -186,25 +186,31 @@ impl MaxTree {
     }
 }
 
-/// The point lying in the most rectangles of `active` (indices into `rects`): (x, y, count).
-///
-/// Among the deepest points it is the one with the smallest x, then the smallest y (both are
-/// sides of rectangles holding it). The reference for [`deepest_point_in_cell`].
-fn deepest_point(rects: &[FRect], active: &[usize]) -> (f64, f64, usize) {
+/// The sweep over `rects[active]`: the sorted distinct y edges, and the x events
+/// `(x, 0 = add | 1 = remove, rect)` sorted by x, adds before removes, then by rectangle.
+fn sweep_setup(rects: &[FRect], active: &[usize]) -> (Vec<f64>, Vec<(f64, u8, usize)>) {
     let mut ys: Vec<f64> = active
         .iter()
         .flat_map(|&i| [rects[i].y.lo, rects[i].y.hi])
         .collect();
     ys.sort_by(f64::total_cmp);
     ys.dedup();
-    let yi = |v: f64| ys.partition_point(|&q| q < v);
-    // events: (x, kind 0 = add / 1 = remove, rect)
     let mut ev: Vec<(f64, u8, usize)> = Vec::with_capacity(active.len() * 2);
     for &i in active {
         ev.push((rects[i].x.lo, 0, i));
         ev.push((rects[i].x.hi, 1, i));
     }
     ev.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)).then(a.2.cmp(&b.2)));
+    (ys, ev)
+}
+
+/// The point lying in the most rectangles of `active` (indices into `rects`): (x, y, count).
+///
+/// Among the deepest points it is the one with the smallest x, then the smallest y (both are
+/// sides of rectangles holding it). The reference for [`deepest_point_in_cell`].
+fn deepest_point(rects: &[FRect], active: &[usize]) -> (f64, f64, usize) {
+    let (ys, ev) = sweep_setup(rects, active);
+    let yi = |v: f64| ys.partition_point(|&q| q < v);
     let mut tree = MaxTree::new(ys.len());
     let mut best = (0i32, 0.0, 0.0);
     let mut k = 0;
@@ -247,12 +253,7 @@ fn deepest_point_in_cell(
     col: usize,
     row: usize,
 ) -> Option<(i32, f64, f64)> {
-    let mut ys: Vec<f64> = active
-        .iter()
-        .flat_map(|&i| [rects[i].y.lo, rects[i].y.hi])
-        .collect();
-    ys.sort_by(f64::total_cmp);
-    ys.dedup();
+    let (ys, ev) = sweep_setup(rects, active);
     // the leaves whose y lies in this row (contiguous: the row is monotone in y)
     let first_leaf = ys.partition_point(|&v| grid.row(v) < row);
     let end_leaf = ys.partition_point(|&v| grid.row(v) <= row);
@@ -260,13 +261,6 @@ fn deepest_point_in_cell(
         return None;
     }
     let yi = |v: f64| ys.partition_point(|&q| q < v);
-    // events: (x, kind 0 = add / 1 = remove, rect)
-    let mut ev: Vec<(f64, u8, usize)> = Vec::with_capacity(active.len() * 2);
-    for &i in active {
-        ev.push((rects[i].x.lo, 0, i));
-        ev.push((rects[i].x.hi, 1, i));
-    }
-    ev.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)).then(a.2.cmp(&b.2)));
     let mut tree = MaxTree::new(ys.len());
     let mut best = (0i32, 0.0, 0.0);
     let mut k = 0;

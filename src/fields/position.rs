@@ -28,6 +28,41 @@ pub fn total_overlap(centers: &[Pt], f: [f64; 2]) -> f64 {
     s
 }
 
+/// The best position for field `i` in its rectangle `r` against its neighbours `near` held
+/// still: least overlap (within 10⁻⁶ mm²), then nearest to `target`; the current position when
+/// nothing is strictly better. The candidates are the grid of overlap breaks (see the module).
+fn best_spot(i: usize, c: &[Pt], near: &[usize], r: &FRect, target: Pt, field: [f64; 2]) -> Pt {
+    let mut xs = vec![r.x.lo, r.x.hi, target.x];
+    let mut ys = vec![r.y.lo, r.y.hi, target.y];
+    for &j in near {
+        xs.extend([c[j].x - field[0], c[j].x, c[j].x + field[0]]);
+        ys.extend([c[j].y - field[1], c[j].y, c[j].y + field[1]]);
+    }
+    let mut xs: Vec<f64> = xs.into_iter().map(|v| r.x.clamp(v)).collect();
+    let mut ys: Vec<f64> = ys.into_iter().map(|v| r.y.clamp(v)).collect();
+    xs.sort_by(f64::total_cmp);
+    xs.dedup();
+    ys.sort_by(f64::total_cmp);
+    ys.dedup();
+    let score = |p: Pt| -> (f64, f64) {
+        let ov: f64 = near.iter().map(|&j| pair_overlap(p, c[j], field)).sum();
+        (ov, p.dist2(target))
+    };
+    let better =
+        |a: (f64, f64), b: (f64, f64)| a.0 < b.0 - 1e-6 || (a.0 <= b.0 + 1e-6 && a.1 < b.1 - 1e-9);
+    let mut best = (score(c[i]), c[i]);
+    for &x in &xs {
+        for &y in &ys {
+            let p = Pt::new(x, y);
+            let s = score(p);
+            if better(s, best.0) {
+                best = (s, p);
+            }
+        }
+    }
+    best.1
+}
+
 /// Relative slack of the grid look-up window, so that rounding never hides a neighbour.
 const WINDOW_SLACK: f64 = 1e-9;
 /// Absolute slack of the grid look-up window, mm.
@@ -98,41 +133,13 @@ pub fn place(
                         && (c[j].y - c[i].y).abs() < reach[1]
                 })
                 .collect();
-            let mut xs = vec![r.x.lo, r.x.hi, targets[i].x];
-            let mut ys = vec![r.y.lo, r.y.hi, targets[i].y];
-            for &j in &near {
-                xs.extend([c[j].x - field[0], c[j].x, c[j].x + field[0]]);
-                ys.extend([c[j].y - field[1], c[j].y, c[j].y + field[1]]);
-            }
-            let mut xs: Vec<f64> = xs.into_iter().map(|v| r.x.clamp(v)).collect();
-            let mut ys: Vec<f64> = ys.into_iter().map(|v| r.y.clamp(v)).collect();
-            xs.sort_by(f64::total_cmp);
-            xs.dedup();
-            ys.sort_by(f64::total_cmp);
-            ys.dedup();
-            let score = |p: Pt| -> (f64, f64) {
-                let ov: f64 = near.iter().map(|&j| pair_overlap(p, c[j], field)).sum();
-                (ov, p.dist2(targets[i]))
-            };
-            let better = |a: (f64, f64), b: (f64, f64)| {
-                a.0 < b.0 - 1e-6 || (a.0 <= b.0 + 1e-6 && a.1 < b.1 - 1e-9)
-            };
-            let mut best = (score(c[i]), c[i]);
-            for &x in &xs {
-                for &y in &ys {
-                    let p = Pt::new(x, y);
-                    let s = score(p);
-                    if better(s, best.0) {
-                        best = (s, p);
-                    }
-                }
-            }
-            if best.1 != c[i] {
+            let best = best_spot(i, &c, &near, r, targets[i], field);
+            if best != c[i] {
                 if let Some(grid) = &mut grid {
                     grid.remove(i, (c[i].x, c[i].x), (c[i].y, c[i].y));
-                    grid.insert(i, (best.1.x, best.1.x), (best.1.y, best.1.y));
+                    grid.insert(i, (best.x, best.x), (best.y, best.y));
                 }
-                c[i] = best.1;
+                c[i] = best;
                 moved = true;
             }
         }
@@ -179,37 +186,9 @@ mod tests {
                             && (c[j].y - c[i].y).abs() < 2.0 * field[1] + (r.y.hi - r.y.lo)
                     })
                     .collect();
-                let mut xs = vec![r.x.lo, r.x.hi, targets[i].x];
-                let mut ys = vec![r.y.lo, r.y.hi, targets[i].y];
-                for &j in &near {
-                    xs.extend([c[j].x - field[0], c[j].x, c[j].x + field[0]]);
-                    ys.extend([c[j].y - field[1], c[j].y, c[j].y + field[1]]);
-                }
-                let mut xs: Vec<f64> = xs.into_iter().map(|v| r.x.clamp(v)).collect();
-                let mut ys: Vec<f64> = ys.into_iter().map(|v| r.y.clamp(v)).collect();
-                xs.sort_by(f64::total_cmp);
-                xs.dedup();
-                ys.sort_by(f64::total_cmp);
-                ys.dedup();
-                let score = |p: Pt| -> (f64, f64) {
-                    let ov: f64 = near.iter().map(|&j| pair_overlap(p, c[j], field)).sum();
-                    (ov, p.dist2(targets[i]))
-                };
-                let better = |a: (f64, f64), b: (f64, f64)| {
-                    a.0 < b.0 - 1e-6 || (a.0 <= b.0 + 1e-6 && a.1 < b.1 - 1e-9)
-                };
-                let mut best = (score(c[i]), c[i]);
-                for &x in &xs {
-                    for &y in &ys {
-                        let p = Pt::new(x, y);
-                        let s = score(p);
-                        if better(s, best.0) {
-                            best = (s, p);
-                        }
-                    }
-                }
-                if best.1 != c[i] {
-                    c[i] = best.1;
+                let best = best_spot(i, &c, &near, r, targets[i], field);
+                if best != c[i] {
+                    c[i] = best;
                     moved = true;
                 }
             }

@@ -17,6 +17,7 @@
 
 mod axis;
 mod blend;
+mod clock;
 mod lower;
 mod otf;
 mod route;
@@ -25,6 +26,7 @@ mod toolpath;
 
 pub use axis::{AxisMove, StageDynamics, StageMove};
 pub use blend::CornerBlends;
+pub use clock::ticks_covering;
 pub use lower::{lower, LowerError, REACH_TOLERANCE_MM};
 pub use otf::{lower_on_the_fly, OtfError};
 pub use route::{AxisRoute, SmoothedAxis, StageRoute};

@@ -17,6 +17,7 @@
 //!    offset stays within half the field less the margin. The job starts with the stage at rest:
 //!    the tool waits at its first point for half a window while the stage gets under way.
 
+use super::clock::{ceil_to_tick, MarkClock};
 use super::route::{AxisRoute, StageRoute};
 use super::taut::{peak_speed_mm_s, taut_string, TautError, Tube};
 use super::toolpath::{ScanMotion, Segment, SegmentKind, StageMotion, Toolpath};
@@ -529,23 +530,18 @@ fn stretch_factors(
     factors
 }
 
-/// `t_s` rounded up to whole ticks of `period_s` (within a millionth of a tick: float sums).
-fn ceil_to_tick(t_s: f64, period_s: f64) -> f64 {
-    ((t_s / period_s - 1e-6).ceil()).max(0.0) * period_s
-}
-
 /// The pieces on a controller clock: marks start and end on ticks (a wait at the mark's start
 /// before it, the mark slower to fill whole ticks), one laser-off tick between marks.
 fn on_clock(pieces: &[Piece], path: &Toolpath, period_s: f64) -> Vec<Piece> {
     let mut out = Vec::with_capacity(pieces.len() * 2);
-    let (mut t_s, mut last_mark_end_s) = (0.0, f64::NEG_INFINITY);
+    let (mut t_s, mut clock) = (0.0, MarkClock::new(period_s));
     for piece in pieces {
         let Tool::Stroke(s) = piece.tool else {
             out.push(*piece);
             t_s += piece.duration_s;
             continue;
         };
-        let start_s = ceil_to_tick(t_s, period_s).max(last_mark_end_s + 2.0 * period_s);
+        let (start_s, duration_s) = clock.place(t_s, piece.duration_s);
         if start_s > t_s {
             let at = path.stroke_points(s).first().copied().unwrap_or_default();
             out.push(Piece {
@@ -555,13 +551,11 @@ fn on_clock(pieces: &[Piece], path: &Toolpath, period_s: f64) -> Vec<Piece> {
                 ..*piece
             });
         }
-        let duration_s = ceil_to_tick(piece.duration_s, period_s);
         out.push(Piece {
             duration_s,
             ..*piece
         });
         t_s = start_s + duration_s;
-        last_mark_end_s = t_s;
     }
     out
 }

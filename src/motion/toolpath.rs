@@ -2,6 +2,7 @@
 //! laser state known at any instant.
 
 use super::axis::StageMove;
+use super::clock::MarkClock;
 use super::route::StageRoute;
 use crate::document::{MotionFigures, TimeBreakdown};
 use crate::geom::Pt;
@@ -147,15 +148,6 @@ pub struct Toolpath {
     arc_mm: Vec<f64>,
 }
 
-/// Ticks closer to a whole number than this are that whole number: segment durations are float
-/// sums, and a mark that fills exactly two ticks must not become three.
-const TICK_EPS: f64 = 1e-6;
-
-/// `t_s` rounded up to whole ticks of `period_s`.
-fn ceil_to_tick(t_s: f64, period_s: f64) -> f64 {
-    ((t_s / period_s - TICK_EPS).ceil()).max(0.0) * period_s
-}
-
 impl Toolpath {
     /// Adds a stroke's points; returns its index.
     pub(crate) fn push_stroke(
@@ -205,7 +197,7 @@ impl Toolpath {
             arc_mm: self.arc_mm.clone(),
         };
         let mut t_s = 0.0;
-        let mut last_mark_end_s = f64::NEG_INFINITY;
+        let mut clock = MarkClock::new(period_s);
         for seg in &self.segments {
             if seg.kind != SegmentKind::Mark {
                 out.segments.push(Segment {
@@ -215,8 +207,7 @@ impl Toolpath {
                 t_s += seg.duration_s;
                 continue;
             }
-            // one laser-off tick between two marks: the sample after a mark's end is off
-            let start_s = ceil_to_tick(t_s, period_s).max(last_mark_end_s + 2.0 * period_s);
+            let (start_s, duration_s) = clock.place(t_s, seg.duration_s);
             if start_s > t_s {
                 let at_start = self.state_in(seg, seg.start_s);
                 out.segments.push(Segment {
@@ -227,14 +218,12 @@ impl Toolpath {
                     scan: ScanMotion::Hold(at_start.scan),
                 });
             }
-            let duration_s = ceil_to_tick(seg.duration_s, period_s);
             out.segments.push(Segment {
                 start_s,
                 duration_s,
                 ..*seg
             });
             t_s = start_s + duration_s;
-            last_mark_end_s = t_s;
         }
         out
     }

@@ -156,9 +156,11 @@ fn run_hga(
 
 /// The fields of `order` (ids) in that order.
 fn fields_in_order(fields: &[ScanField], order: &[usize]) -> Vec<ScanField> {
+    let by_id: std::collections::HashMap<usize, &ScanField> =
+        fields.iter().map(|f| (f.id, f)).collect();
     order
         .iter()
-        .filter_map(|&id| fields.iter().find(|f| f.id == id).cloned())
+        .filter_map(|id| by_id.get(id).map(|&f| f.clone()))
         .collect()
 }
 
