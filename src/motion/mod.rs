@@ -17,6 +17,7 @@
 
 mod axis;
 mod blend;
+pub mod cetsp;
 mod clock;
 mod lower;
 mod otf;
