@@ -276,3 +276,87 @@ proptest! {
         prop_assert_eq!(route.points.last(), pat.last().map(|q| &q.at));
     }
 }
+
+/// Knots of an imported job's strokes in document order at seed 000's mark speed, jumping
+/// between strokes at its jump speed.
+fn svg_tool(path: &str) -> Vec<ToolKnot> {
+    const MARK_MM_S: f64 = 1000.0;
+    const JUMP_MM_S: f64 = 3000.0;
+    let imported =
+        crate::import::import_svg_file(std::path::Path::new(path), &Default::default()).unwrap();
+    let mut knots: Vec<ToolKnot> = Vec::new();
+    for g in &imported.geometries {
+        let mut points = g.points.clone();
+        if g.closed {
+            points.push(points[0]);
+        }
+        let start_s = match knots.last_mut() {
+            Some(k) => {
+                k.marking = false;
+                k.t_s + k.at.dist(points[0]) / JUMP_MM_S
+            }
+            None => 0.0,
+        };
+        knots.extend(walk(&points, MARK_MM_S).into_iter().map(|k| ToolKnot {
+            t_s: k.t_s + start_s,
+            ..k
+        }));
+    }
+    knots
+}
+
+/// The measurement of the report: `cargo test --release --no-default-features --lib
+/// motion::cetsp::tests::measure_otf_benchmarks -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn measure_otf_benchmarks() {
+    const RADIUS_MM: f64 = 35.0;
+    println!("pattern | pattern mm | LSA pts | lsa mm | lsa cov | lsa inR | ga mm | ga/lsa | ga cov | ga inR | ga s");
+    for name in ["lissajous", "tree", "spiral"] {
+        let tool = svg_tool(&format!("/work/shared/bench/otf/{name}.svg"));
+        let pat = pattern(&tool, PATTERN_STEP_MM);
+        let pattern_mm: f64 = pat.windows(2).map(|w| w[0].at.dist(w[1].at)).sum();
+        let t0 = std::time::Instant::now();
+        let lsa = lsa_route(&tool, &LsaParams::paper(RADIUS_MM));
+        let lsa_s = t0.elapsed().as_secs_f64();
+        let check = Coverage::new(&tool, RADIUS_MM);
+        let t0 = std::time::Instant::now();
+        let res = cetsp_ga(
+            &tool,
+            &lsa,
+            RADIUS_MM,
+            &GaParams::default(),
+            &JobCtx::default(),
+        );
+        let ga_s = t0.elapsed().as_secs_f64();
+        let res = res.unwrap();
+        println!(
+            "{name} | {pattern_mm:.0} | {} | {:.0} | {:.4} | {:.4} | {:.0} | {:.3} | {:.4} | {:.4} | {ga_s:.2} (lsa {lsa_s:.3} s)",
+            lsa.points.len(),
+            lsa.length_mm(),
+            check.coverage(&lsa),
+            check.within_radius(&lsa),
+            res.route.length_mm(),
+            res.route.length_mm() / lsa.length_mm(),
+            res.coverage,
+            res.within_radius,
+        );
+    }
+    let tool = svg_tool("/work/shared/bench/otf/spiral.svg");
+    let lsa = lsa_route(&tool, &LsaParams::paper(RADIUS_MM));
+    let token = CancelToken::new();
+    let ctx = JobCtx::new(token.clone(), Arc::new(NoProgress));
+    let canceller = std::thread::spawn(move || {
+        std::thread::sleep(std::time::Duration::from_millis(700));
+        token.cancel();
+        std::time::Instant::now()
+    });
+    let res = cetsp_ga(&tool, &lsa, RADIUS_MM, &GaParams::default(), &ctx);
+    let returned = std::time::Instant::now();
+    let at = canceller.join().unwrap();
+    assert_eq!(res, Err(Cancelled));
+    println!(
+        "spiral cancel latency: {:.1} ms",
+        returned.duration_since(at).as_secs_f64() * 1e3
+    );
+}
