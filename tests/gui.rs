@@ -760,3 +760,18 @@ fn motion_plots_show_an_on_the_fly_plan() {
     assert!(h.query_by_label_contains("Scanner offset").is_none());
     assert!(h.query_by_label_contains("Motion plots").is_none());
 }
+
+#[test]
+fn the_stage_route_switch_plans_seed001_routes() {
+    use galvoplan::document::StageRouteKind;
+    let mut h = opened(&demo());
+    set_motion(&mut h, "On the fly (stage moves while marking)");
+    h.get_by_label("Stage route").click();
+    h.run();
+    h.get_by_label("Simplified pattern (seed 001 LSA)").click();
+    h.run();
+    assert_eq!(h.state().doc.settings.stage_route, StageRouteKind::Lsa);
+    let plan = solve(&mut h, "Run HHA");
+    assert!(plan.stage_route.is_some());
+    assert!(h.state().toolpath(0).unwrap().unwrap().on_the_fly());
+}

@@ -308,35 +308,7 @@ fn on_the_fly_keeps_the_scanner_in_reach_and_the_stage_within_its_limits() {
         .collect();
     // the stage starts at rest
     assert_eq!(states[0].stage, states[1].stage);
-    let axis = |q: Pt, k: usize| if k == 0 { q.x } else { q.y };
-    let limits = [&p.axis_x, &p.axis_y];
-    let mut moved_mm = 0.0;
-    for (j, w) in states.windows(3).enumerate() {
-        let o = w[0].scan;
-        assert!(
-            o.x.abs() <= reach_mm + 1e-6 && o.y.abs() <= reach_mm + 1e-6,
-            "{o:?} at {j}"
-        );
-        for (k, lim) in limits.iter().enumerate() {
-            let s = w.iter().map(|m| axis(m.stage, k)).collect::<Vec<_>>();
-            assert!((0.0..=p.stroke_mm[k]).contains(&s[0]));
-            let v = (s[1] - s[0]) / period_s;
-            let a = (s[2] - 2.0 * s[1] + s[0]) / (period_s * period_s);
-            assert!(
-                v.abs() <= lim.max_velocity_mm_s * (1.0 + 1e-6),
-                "speed {v} at {j}"
-            );
-            assert!(
-                a.abs() <= lim.max_accel_mm_s2 * 1.001,
-                "acceleration {a} at {j} of {n}"
-            );
-        }
-        if w[0].laser && w[1].laser {
-            let speed = w[1].tcp().dist(w[0].tcp()) / period_s;
-            assert!(speed <= p.scanner.mark_speed_mm_s * (1.0 + 1e-6), "{speed}");
-        }
-        moved_mm += w[1].stage.dist(w[0].stage);
-    }
+    let moved_mm = assert_on_the_fly_feasible(&doc, &path);
     // the stage really follows the work: the serpentine spans 260 mm in x
     assert!(moved_mm > 500.0, "{moved_mm}");
     // the plan's motion figures describe the same route
@@ -409,4 +381,104 @@ fn on_the_fly_lowering_stops_on_a_cancel() {
         &JobCtx::default()
     )
     .is_ok());
+}
+
+/// Samples `path` every millisecond and checks the on-the-fly invariants: scanner offset in
+/// reach, stage in its stroke within its speed and acceleration limits, marks no faster than
+/// the mark speed. Returns the stage's route length, mm (the last sample's step excluded).
+fn assert_on_the_fly_feasible(doc: &Document, path: &galvoplan::motion::Toolpath) -> f64 {
+    let period_s = 1e-3;
+    let p = &doc.profile;
+    let reach_mm = p.field_mm[0] / 2.0 - p.otf_margin_mm;
+    let n = (path.duration_s() / period_s).ceil() as usize;
+    let states: Vec<_> = (0..=n)
+        .map(|k| path.state_at(k as f64 * period_s))
+        .collect();
+    let axis = |q: Pt, k: usize| if k == 0 { q.x } else { q.y };
+    let limits = [&p.axis_x, &p.axis_y];
+    let mut route_mm = 0.0;
+    for (j, w) in states.windows(3).enumerate() {
+        let o = w[0].scan;
+        assert!(
+            o.x.abs() <= reach_mm + 1e-6 && o.y.abs() <= reach_mm + 1e-6,
+            "{o:?} at {j}"
+        );
+        for (k, lim) in limits.iter().enumerate() {
+            let s = w.iter().map(|m| axis(m.stage, k)).collect::<Vec<_>>();
+            assert!((0.0..=p.stroke_mm[k]).contains(&s[0]));
+            let v = (s[1] - s[0]) / period_s;
+            let a = (s[2] - 2.0 * s[1] + s[0]) / (period_s * period_s);
+            assert!(
+                v.abs() <= lim.max_velocity_mm_s * (1.0 + 1e-6),
+                "{v} at {j}"
+            );
+            assert!(a.abs() <= lim.max_accel_mm_s2 * 1.001, "{a} at {j}");
+        }
+        if w[0].laser && w[1].laser {
+            let speed = w[1].tcp().dist(w[0].tcp()) / period_s;
+            assert!(speed <= p.scanner.mark_speed_mm_s * (1.0 + 1e-6), "{speed}");
+        }
+        route_mm += w[1].stage.dist(w[0].stage);
+    }
+    route_mm
+}
+
+/// The serpentine planned on the fly with stage route `kind` (a small GA for `cetsp-ga`).
+fn plan_with_route(kind: galvoplan::document::StageRouteKind) -> (Document, Plan) {
+    let mut doc = serpentine_document();
+    doc.settings.stage_route = kind;
+    doc.settings.route_ga.population = 12;
+    doc.settings.route_ga.generations = 15;
+    let plan = plan_document(&mut doc, &JobCtx::default()).unwrap();
+    (doc, plan)
+}
+
+#[test]
+fn seed001_routes_are_followed_and_the_taut_string_is_never_longer() {
+    use galvoplan::document::StageRouteKind;
+    let mut lengths = Vec::new();
+    for kind in [
+        StageRouteKind::Taut,
+        StageRouteKind::Lsa,
+        StageRouteKind::CetspGa,
+    ] {
+        let (doc, plan) = plan_with_route(kind);
+        assert_eq!(plan.stage_route.is_some(), kind != StageRouteKind::Taut);
+        let path = galvoplan::pipeline::lower_plan(&doc, &plan).unwrap();
+        let route_mm = assert_on_the_fly_feasible(&doc, &path);
+        if let Some(route) = &plan.stage_route {
+            // the stage follows the paper's route: its length is about the polyline's
+            let polyline_mm = route.length_mm();
+            assert!(
+                (route_mm - polyline_mm).abs() <= 0.15 * polyline_mm,
+                "{kind:?}: {route_mm} vs {polyline_mm}"
+            );
+        }
+        lengths.push(route_mm);
+    }
+    assert!(lengths[0] <= lengths[1], "taut {lengths:?}");
+    assert!(lengths[0] <= lengths[2], "taut {lengths:?}");
+}
+
+#[test]
+fn the_route_ga_is_deterministic_and_its_settings_are_checked() {
+    use galvoplan::document::StageRouteKind;
+    let (_, a) = plan_with_route(StageRouteKind::CetspGa);
+    let (_, b) = plan_with_route(StageRouteKind::CetspGa);
+    assert_eq!(a.stage_route, b.stage_route);
+    let mut doc = serpentine_document();
+    doc.settings.stage_route = StageRouteKind::CetspGa;
+    doc.settings.route_ga.mutation_rate = 1.5;
+    let e = plan_document(&mut doc, &JobCtx::default())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("mutation"), "{e}");
+    // a different seed, another route (the GA is random but seeded)
+    let mut doc = serpentine_document();
+    doc.settings.stage_route = StageRouteKind::CetspGa;
+    doc.settings.route_ga.population = 12;
+    doc.settings.route_ga.generations = 15;
+    doc.settings.seed = 7;
+    let c = plan_document(&mut doc, &JobCtx::default()).unwrap();
+    assert!(c.stage_route.is_some());
 }

@@ -7,7 +7,8 @@
 
 use super::commands::Command;
 use crate::document::{
-    CostModel, FieldsMode, MachineProfile, MotionMode, SolverSettings, VertexMode, BUILTIN,
+    CostModel, FieldsMode, MachineProfile, MotionMode, SolverSettings, StageRouteKind, VertexMode,
+    BUILTIN,
 };
 use egui::{Color32, RichText};
 
@@ -484,9 +485,7 @@ impl Editors {
         .on_hover_text(COST_MODEL_HELP);
         combo(ui, "Motion", &mut s.motion, MOTION_MODES).on_hover_text(MOTION_HELP);
         ui.add_enabled_ui(s.motion == MotionMode::OnTheFly, |ui| {
-            // the library has one stage route; the choice shows which one is used
-            let mut route = ();
-            combo(ui, "Stage route", &mut route, &[((), "Taut string")])
+            combo(ui, "Stage route", &mut s.stage_route, STAGE_ROUTES)
                 .on_hover_text(STAGE_ROUTE_HELP)
                 .on_disabled_hover_text("Only used on the fly: step-and-scan has no route.");
         });
@@ -537,11 +536,26 @@ const MOTION_HELP: &str = "How the machine moves while it marks.\n\
     Used by the next solve; the plans' toolpaths on the canvas, the playback and the motion \
     plots are re-computed at once with this setting.";
 
-/// What the stage route means for the operator.
+/// The stage routes offered, in words.
+pub const STAGE_ROUTES: &[(StageRouteKind, &str)] = &[
+    (StageRouteKind::Taut, "Taut string (shortest)"),
+    (StageRouteKind::Lsa, "Simplified pattern (seed 001 LSA)"),
+    (
+        StageRouteKind::CetspGa,
+        "Genetic algorithm (seed 001 CETSP)",
+    ),
+];
+
+/// What the stage routes mean for the operator.
 const STAGE_ROUTE_HELP: &str = "How the stage's route is computed on the fly.\n\
     Taut string: per axis, the shortest route that keeps the laser point within the \
-    scanner's reach, then smoothed to the axes' speed and acceleration limits (the only \
-    route available for now).";
+    scanner's reach, smoothed to the axes' speed and acceleration limits; the marking slows \
+    where the stage cannot follow.\n\
+    Simplified pattern: seed 001's benchmark, the stage follows the pattern simplified by \
+    RDP and VW.\n\
+    Genetic algorithm: seed 001's close-enough TSP route (slow to plan: 500 generations; \
+    progress and Cancel as for the solves).\n\
+    Used by the next solve.";
 
 /// A labelled combo box; returns the combo's response.
 fn combo<T: PartialEq + Copy>(

@@ -27,9 +27,10 @@ impl Lowered {
     pub fn new(toolpath: Toolpath) -> Self {
         let mut mark_s = vec![(f64::INFINITY, f64::INFINITY); toolpath.strokes.len()];
         for seg in &toolpath.segments {
-            if let ScanMotion::Mark { stroke } = seg.scan {
+            if let ScanMotion::Mark { stroke, .. } = seg.scan {
                 if let Some(m) = mark_s.get_mut(stroke) {
-                    *m = (seg.start_s, seg.end_s());
+                    // a stroke marked in parts (on the fly): from its first to its last
+                    *m = (m.0.min(seg.start_s), seg.end_s());
                 }
             }
         }
@@ -179,6 +180,7 @@ mod tests {
             metrics: Metrics::default(),
             history: Vec::new(),
             motion: MotionMode::Step,
+            stage_route: None,
         };
         Document {
             geometries: vec![line],

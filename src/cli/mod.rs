@@ -8,7 +8,8 @@ mod progress;
 use anyhow::Result;
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use galvoplan::document::{
-    Algo, CostModel, FieldsMode, MachineProfile, MotionMode, SolverSettings, VertexMode,
+    Algo, CostModel, FieldsMode, MachineProfile, MotionMode, RouteGaSettings, SolverSettings,
+    StageRouteKind, VertexMode,
 };
 use galvoplan::hatch::{HatchSettings, OutlineMode};
 use galvoplan::import::ImportOptions;
@@ -72,6 +73,10 @@ enum MotionArg {
 enum StageRouteArg {
     /// Per-axis taut string through the scanner's reach, retimed and smoothed to the axis limits.
     Taut,
+    /// Seed 001's benchmark: the polyline through the line-simplified pattern points.
+    Lsa,
+    /// Seed 001's genetic algorithm (close-enough TSP on the LSA points).
+    CetspGa,
 }
 
 /// What the ordering minimises, as on the command line.
@@ -113,6 +118,21 @@ struct JobOpts {
     /// The stage route on the fly.
     #[arg(long, value_enum, default_value = "taut")]
     stage_route: StageRouteArg,
+    /// cetsp-ga: population size (seed 001: 50).
+    #[arg(long, default_value_t = 50)]
+    route_population: usize,
+    /// cetsp-ga: generations (seed 001: 500).
+    #[arg(long, default_value_t = 500)]
+    route_generations: usize,
+    /// cetsp-ga: crossover rate p_c (seed 001: 1.0).
+    #[arg(long, default_value_t = 1.0)]
+    route_crossover: f64,
+    /// cetsp-ga: mutation rate p_m (seed 001: 0.5).
+    #[arg(long, default_value_t = 0.5)]
+    route_mutation: f64,
+    /// lsa and cetsp-ga: padding radius in mm (default: half the field, its inscribed circle).
+    #[arg(long)]
+    padding_radius_mm: Option<f64>,
     /// Start vertices: exact (layered-graph DP after VEA) or vea (seed 000 only).
     #[arg(long, value_enum, default_value = "exact")]
     vertex: VertexArg,
@@ -193,9 +213,21 @@ impl JobOpts {
                 AlgoArg::Baseline => Algo::Baseline,
                 AlgoArg::AsIs => Algo::AsIs,
             },
-            motion: match (self.motion, self.stage_route) {
-                (MotionArg::Step, _) => MotionMode::Step,
-                (MotionArg::OnTheFly, StageRouteArg::Taut) => MotionMode::OnTheFly,
+            motion: match self.motion {
+                MotionArg::Step => MotionMode::Step,
+                MotionArg::OnTheFly => MotionMode::OnTheFly,
+            },
+            stage_route: match self.stage_route {
+                StageRouteArg::Taut => StageRouteKind::Taut,
+                StageRouteArg::Lsa => StageRouteKind::Lsa,
+                StageRouteArg::CetspGa => StageRouteKind::CetspGa,
+            },
+            route_ga: RouteGaSettings {
+                population: self.route_population,
+                generations: self.route_generations,
+                crossover_rate: self.route_crossover,
+                mutation_rate: self.route_mutation,
+                padding_radius_mm: self.padding_radius_mm,
             },
             cost_model: match self.cost {
                 CostArg::Time => CostModel::Time,

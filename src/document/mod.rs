@@ -15,7 +15,10 @@ pub use profile::{
     BUILTIN, PROFILE_VERSION,
 };
 pub use project::{load_project, save_project, write_atomic, ProjectError, PROJECT_VERSION};
-pub use settings::{Algo, CostModel, FieldsMode, GaParams, MotionMode, SolverSettings, VertexMode};
+pub use settings::{
+    Algo, CostModel, FieldsMode, GaParams, MotionMode, RouteGaSettings, SolverSettings,
+    StageRouteKind, VertexMode,
+};
 
 use crate::import::Warning;
 use serde::{Deserialize, Serialize};

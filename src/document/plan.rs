@@ -207,4 +207,8 @@ pub struct Plan {
     /// current setting (projects from before on-the-fly marking are step-and-scan).
     #[serde(default)]
     pub motion: super::MotionMode,
+    /// On the fly with seed 001's routes (`lsa`, `cetsp-ga`): the stage route the lowering
+    /// follows (none: the taut string, computed by the lowering itself).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stage_route: Option<crate::motion::cetsp::TimedRoute>,
 }

@@ -77,6 +77,51 @@ pub enum MotionMode {
     OnTheFly,
 }
 
+/// The stage route of on-the-fly marking.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+pub enum StageRouteKind {
+    /// Per-axis taut string through the scanner's reach, retimed and smoothed to the axis
+    /// limits (the shortest route; galvoplan's own).
+    #[default]
+    #[serde(rename = "taut")]
+    Taut,
+    /// Seed 001's benchmark: the polyline through the line-simplified pattern points.
+    #[serde(rename = "lsa")]
+    Lsa,
+    /// Seed 001's genetic algorithm on the close-enough TSP of those points.
+    #[serde(rename = "cetsp-ga")]
+    CetspGa,
+}
+
+/// Settings of seed 001's route GA and of its padding radius (the paper's defaults).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct RouteGaSettings {
+    /// Population size (paper: 50).
+    pub population: usize,
+    /// Generations (paper: 500).
+    pub generations: usize,
+    /// Crossover rate p_c (paper: 1.0).
+    pub crossover_rate: f64,
+    /// Mutation rate p_m (paper: 0.5).
+    pub mutation_rate: f64,
+    /// Padding radius, mm (none: half the field's smaller side, the circle inscribed in it).
+    pub padding_radius_mm: Option<f64>,
+}
+
+impl Default for RouteGaSettings {
+    fn default() -> Self {
+        let paper = crate::motion::cetsp::GaParams::default();
+        Self {
+            population: paper.population,
+            generations: paper.generations,
+            crossover_rate: paper.crossover_rate,
+            mutation_rate: paper.mutation_rate,
+            padding_radius_mm: None,
+        }
+    }
+}
+
 /// Parameters of the hybrid genetic algorithm (seed 000 §3.3.6 defaults).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
@@ -134,6 +179,10 @@ pub struct SolverSettings {
     pub cost_model: CostModel,
     /// Step-and-scan or on the fly.
     pub motion: MotionMode,
+    /// The stage route on the fly.
+    pub stage_route: StageRouteKind,
+    /// Seed 001's route GA (`cetsp-ga`) and padding radius (`lsa`, `cetsp-ga`).
+    pub route_ga: RouteGaSettings,
     /// Cut geometries larger than a field at field borders instead of failing.
     pub split_oversize: bool,
     /// GA parameters.
@@ -155,6 +204,8 @@ impl Default for SolverSettings {
             hha_improve: true,
             cost_model: CostModel::default(),
             motion: MotionMode::default(),
+            stage_route: StageRouteKind::default(),
+            route_ga: RouteGaSettings::default(),
             split_oversize: false,
             ga: GaParams::default(),
             hatch: None,

@@ -7,8 +7,10 @@
 //! the same sign that overlap are merged into one ramp of their summed `Δv`, centred at their
 //! `Δv`-weighted mean time (which again leaves the position after it unchanged); ramps of
 //! opposite signs may overlap (their accelerations cancel there). The result is checked: where
-//! three or more ramps would still add up beyond `a`, [`CornerBlends::new`] returns `None` and
-//! the caller smooths another way.
+//! three or more ramps would still add up beyond `a`, [`CornerBlends::new`] returns the
+//! [`Overload`] spans and the caller slows the path there (slowing a stretch by `f` divides its
+//! `Δv`, hence its ramp widths, by `f` and multiplies the time between its vertices by `f`: the
+//! overlaps go away).
 
 /// One ramp of the blended speed.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -54,11 +56,21 @@ pub struct CornerBlends {
     longest_s: f64,
 }
 
+/// Where overlapping ramps would accelerate beyond the limit: the time spans (s) of the ramps
+/// that overlap there.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Overload {
+    /// `(start_s, end_s)` spans, in time order.
+    pub spans: Vec<(f64, f64)>,
+}
+
 impl CornerBlends {
-    /// Blends the corners of `vertices` (times strictly increasing) at acceleration `accel_mm_s2`;
-    /// `None` when overlapping ramps would exceed it.
-    pub fn new(vertices: &[(f64, f64)], accel_mm_s2: f64) -> Option<Self> {
-        let &(_, start_mm) = vertices.first()?;
+    /// Blends the corners of `vertices` (non-empty, times strictly increasing) at acceleration
+    /// `accel_mm_s2`; the [`Overload`] spans where overlapping ramps would exceed it.
+    pub fn new(vertices: &[(f64, f64)], accel_mm_s2: f64) -> Result<Self, Overload> {
+        let Some(&(_, start_mm)) = vertices.first() else {
+            return Err(Overload { spans: Vec::new() });
+        };
         let mut ramps: Vec<Ramp> = Vec::with_capacity(vertices.len());
         let mut v_before = 0.0;
         for (k, &(t, x)) in vertices.iter().enumerate() {
@@ -106,12 +118,21 @@ impl CornerBlends {
             ramps,
             prefix,
         };
-        blends.acceleration_within(accel_mm_s2).then_some(blends)
+        let spans: Vec<(f64, f64)> = blends
+            .overloaded_at(accel_mm_s2)
+            .into_iter()
+            .filter_map(|t| blends.active_span(t))
+            .collect();
+        if spans.is_empty() {
+            Ok(blends)
+        } else {
+            Err(Overload { spans })
+        }
     }
 
-    /// True when the summed ramps never accelerate faster than `accel_mm_s2` (sweep over the
-    /// ramps' start and end events).
-    fn acceleration_within(&self, accel_mm_s2: f64) -> bool {
+    /// The instants where the summed ramps accelerate faster than `accel_mm_s2` (sweep over
+    /// the ramps' start and end events; the middle of each overloaded stretch).
+    fn overloaded_at(&self, accel_mm_s2: f64) -> Vec<f64> {
         let mut events: Vec<(f64, f64)> = Vec::with_capacity(2 * self.ramps.len());
         for r in &self.ramps {
             let a = r.dv_mm_s / r.width_s;
@@ -121,6 +142,7 @@ impl CornerBlends {
         events.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
         let mut sum = 0.0;
         let mut k = 0;
+        let mut out = Vec::new();
         while k < events.len() {
             // apply every event at this instant before judging
             let t = events[k].0;
@@ -129,10 +151,28 @@ impl CornerBlends {
                 k += 1;
             }
             if sum.abs() > accel_mm_s2 * (1.0 + 1e-9) {
-                return false;
+                let next = events.get(k).map_or(t, |e| e.0);
+                out.push(0.5 * (t + next));
             }
         }
-        true
+        out
+    }
+
+    /// The span of the ramps running at `t_s` (their union), if any: the part of the path
+    /// whose corners move the blended position at that instant (a centred ramp changes the
+    /// position only while it runs).
+    pub fn active_span(&self, t_s: f64) -> Option<(f64, f64)> {
+        let first = self
+            .ramps
+            .partition_point(|r| r.start_s() < t_s - self.longest_s);
+        let last = self.ramps.partition_point(|r| r.start_s() <= t_s);
+        self.ramps[first..last]
+            .iter()
+            .filter(|r| r.end_s() >= t_s)
+            .fold(None, |span, r| match span {
+                None => Some((r.start_s(), r.end_s())),
+                Some((a, b)) => Some((f64::min(a, r.start_s()), f64::max(b, r.end_s()))),
+            })
     }
 
     /// The longest ramp, s: how far from a vertex the path may differ from it.
@@ -182,6 +222,9 @@ mod tests {
         ];
         let a = 1000.0;
         let b = CornerBlends::new(&verts, a).unwrap();
+        assert_eq!(b.active_span(2.5), None);
+        let (s0, s1) = b.active_span(3.0).unwrap();
+        assert!(s0 < 3.0 && s1 > 3.0);
         let dt = 1e-3;
         let p: Vec<f64> = (0..6000)
             .map(|k| b.position_mm(k as f64 * dt - 1.0))

@@ -221,7 +221,11 @@ impl<'a> Builder<'a> {
             SegmentKind::Mark,
             duration_s,
             stage,
-            ScanMotion::Mark { stroke },
+            ScanMotion::Mark {
+                stroke,
+                start_frac: 0.0,
+                end_frac: 1.0,
+            },
         );
         if let Some(&end) = self.path.stroke_points(stroke).last() {
             self.scan_at = end.minus(self.stage_at);

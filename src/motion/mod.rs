@@ -22,6 +22,7 @@ mod clock;
 mod lower;
 mod otf;
 mod route;
+mod seed_routes;
 pub mod taut;
 mod toolpath;
 
@@ -31,6 +32,7 @@ pub use clock::ticks_covering;
 pub use lower::{lower, LowerError, REACH_TOLERANCE_MM};
 pub use otf::{lower_on_the_fly, OtfError};
 pub use route::{AxisRoute, SmoothedAxis, StageRoute};
+pub use seed_routes::plan_stage_route;
 pub use toolpath::{
     MachineState, ScanMotion, Segment, SegmentKind, StageMotion, Stroke, Toolpath, TIME_EPS_S,
 };

@@ -1,22 +1,36 @@
 //! On-the-fly lowering: the stage moves on a continuous route while the scanner marks.
 //!
 //! 1. The tool-centre point's time law comes from the plan's stroke order as in step-and-scan
-//!    (marks at mark speed, jumps at jump speed, the laser and jump delays), as *pieces*.
+//!    (marks at mark speed, jumps at jump speed, the laser and jump delays), as *pieces*; a
+//!    long stroke is cut into parts of at least [`PART_MM`] so that it can be slowed locally.
 //! 2. Per axis the stage must keep `|tcp − stage| ≤ h` with `h` = half the field less the
-//!    profile's `otf_margin_mm` less a smoothing allowance `δ` ([`SMOOTHING_SHARE`] of the
-//!    reach), and stay inside its stroke. Through that tube the **taut string** is the shortest
-//!    route and has the least peak speed of any route ([`super::taut`]).
-//! 3. Where its speed exceeds the axis cap `v = min(v_max, √(2 a_max δ))`, the pieces under that
-//!    stretch of the route are slowed (the scanner waits, marks run slower) by the excess, and
-//!    the route is computed again; rounds repeat until no stretch is too fast (after
-//!    [`RETIME_ROUNDS`] the whole job is slowed by what is left). Slowing any piece never raises
-//!    the taut string's peak speed (the old route, reparametrised, stays feasible), so the rounds
-//!    and the controller clock alignment keep the cap.
-//! 4. The route is smoothed by a moving average of window `2 v / a_max` ([`super::route`]):
-//!    speed ≤ `v`, acceleration ≤ `a_max`, departure ≤ `v² / (2 a_max)` ≤ `δ`: the scanner
-//!    offset stays within half the field less the margin. The job starts with the stage at rest:
-//!    the tool waits at its first point for half a window while the stage gets under way.
+//!    profile's `otf_margin_mm`, and stay inside its stroke. Through that tube the **taut
+//!    string** is the shortest route and has the least peak speed of any route
+//!    ([`super::taut`]). With a seed 001 route (`lsa`, `cetsp-ga`) each knot's interval is
+//!    narrowed to [`FOLLOW_MM`] around the route's position at that knot's nominal time.
+//! 3. Retiming: where the string is faster than the axis limit, or where one of its corners
+//!    would depart from it by more than [`CORNER_SHARE`] of the reach once blended at the axis
+//!    acceleration (`Δv² / (8 a)`), the pieces under that stretch are slowed (the scanner
+//!    waits, marks run slower), and the string is computed again, until none is.
+//! 4. Every corner is blended at the axis acceleration ([`super::blend`]): the speed stays
+//!    within the string's, the acceleration within the limit. A blend departs from the
+//!    string's corner *outwards* (it cuts the corner the tube pushed the string round), so the
+//!    blended route is checked on a 1 ms grid and at every knot; where it leaves the reach or
+//!    the stroke, the tube there is narrowed by the excess (the string then bends that much
+//!    further inside and its blend comes back to the edge), or where that would leave less
+//!    than [`MIN_TUBE_SHARE`] of the reach, and where overlapping blends exceed the
+//!    acceleration, the pieces there are slowed by [`SLOW_FACTOR`] (a slowdown by `f` divides
+//!    a corner's departure by `f²`). Rounds repeat until the route is clean; after
+//!    [`SLOW_ROUNDS`] the guaranteed route takes over (half the reach kept for a moving-average
+//!    smoothing and the speed capped so that it stays inside; it has never been needed on the
+//!    benchmarks).
+//!
+//! The trade-off is [`CORNER_SHARE`]: a corner slowed rather than rounded costs time, a corner
+//! rounded costs route length (see docs/BENCHMARKS.md for the measurements that set it). The
+//! job starts with the stage at rest; it waits half the longest blend at the first point.
 
+use super::blend::CornerBlends;
+use super::cetsp::{TimedRoute, ToolKnot};
 use super::clock::{ceil_to_tick, MarkClock};
 use super::route::{AxisRoute, StageRoute};
 use super::taut::{peak_speed_mm_s, taut_string, TautError, Tube};
@@ -29,11 +43,33 @@ use thiserror::Error;
 /// Share of the scanner's reach kept for smoothing the route by the guaranteed fallback.
 pub const SMOOTHING_SHARE: f64 = 0.5;
 
-/// Share of the reach the first tube leaves free (the smoothing cuts corners inwards and out).
-pub const TIGHT_SHARE: f64 = 0.02;
+/// Share of the reach the tube leaves free: the check allows [`CHECK_SLACK`], the string
+/// touches the tube at its contacts, and the blends cut corners inwards.
+const TUBE_SLACK: f64 = 2.0 * CHECK_SLACK;
 
-/// Rounds of narrowing the tube where the smoothed route overshoots, before the fallback.
-pub const SHRINK_ROUNDS: usize = 24;
+/// How closely the stage follows a seed 001 route (`lsa`, `cetsp-ga`), per axis, mm: the
+/// route's polyline is the paper's; the band lets the blends round its corners.
+const FOLLOW_MM: f64 = 1.0;
+
+/// A long stroke is retimed in parts of at least this length, mm (cut at its vertices).
+const PART_MM: f64 = 2.0;
+
+/// Share of the reach kept for the blends' departure from the string's corners: corners that
+/// would depart further are slowed until they do not.
+const CORNER_SHARE: f64 = 0.1;
+
+/// Rounds of slowing the tool where the blended route overshoots or over-accelerates, before
+/// the guaranteed fallback (each round divides the departures there by [`SLOW_FACTOR`]²).
+pub const SLOW_ROUNDS: usize = 48;
+
+/// How much one round slows the pieces under a trouble spot.
+const SLOW_FACTOR: f64 = 1.25;
+
+/// The narrowest tube a repair makes before it slows the tool instead (share of the reach).
+const MIN_TUBE_SHARE: f64 = 0.9;
+
+/// The least a repair narrows the tube by, mm (so that rounds make progress).
+const MIN_NARROWING_MM: f64 = 0.01;
 
 /// Grid on which the scanner offset is checked (besides every knot), s. Between two checked
 /// instants the tool moves straight and the stage's acceleration is at most `a_max`, so the
@@ -44,15 +80,9 @@ pub const CHECK_PERIOD_S: f64 = 1e-3;
 /// Share of the reach kept as slack by the check (3.5 µm of a 35 mm reach).
 const CHECK_SLACK: f64 = 1e-4;
 
-/// How much of an overshoot a round takes off the tube near it.
-const SHRINK_GAIN: f64 = 0.5;
-
 /// Each retiming round slows a bit more than the excess it sees, so that the rounds settle
 /// quickly (the route changes as the tool slows).
 const RETIME_OVERSHOOT: f64 = 0.02;
-
-/// Narrowing rounds without a smaller worst overshoot before the fallback takes over.
-const STALLED_ROUNDS: usize = 3;
 
 /// Retiming rounds before the whole job is slowed uniformly.
 pub const RETIME_ROUNDS: usize = 32;
@@ -96,6 +126,9 @@ pub enum OtfError {
     /// The route could not be computed.
     #[error("stage route: {0}")]
     Route(#[from] TautError),
+    /// Seed 001's route settings are not usable.
+    #[error("stage route settings: {0}")]
+    RouteSettings(#[from] super::cetsp::CetspError),
     /// The operator cancelled.
     #[error("cancelled")]
     Cancelled(#[from] Cancelled),
@@ -106,7 +139,12 @@ pub enum OtfError {
 enum Tool {
     Hold(Pt),
     Line(Pt, Pt),
-    Stroke(usize),
+    /// Part `[start_frac, end_frac]` of a stroke (fractions of its length).
+    Stroke {
+        stroke: usize,
+        start_frac: f64,
+        end_frac: f64,
+    },
 }
 
 /// A piece of the tool's time law.
@@ -120,6 +158,10 @@ struct Piece {
     tube_mm: f64,
     /// Index of the piece it comes from before the clock alignment.
     origin: usize,
+    /// Start in the tool's nominal time law (before any retiming), s.
+    nominal_start_s: f64,
+    /// Duration in the nominal time law, s (0 for waits the clock adds).
+    nominal_s: f64,
 }
 
 /// Lowers a plan for on-the-fly marking (see the module documentation). With `clock_s`, every
@@ -135,43 +177,57 @@ pub fn lower_on_the_fly(
 ) -> Result<Toolpath, OtfError> {
     let reach_mm = reach_mm(profile)?;
     let mut path = Toolpath::default();
-    let tube_mm = reach_mm * (1.0 - TIGHT_SHARE);
+    let corner_mm = CORNER_SHARE * reach_mm;
+    let tube_mm = reach_mm * (1.0 - TUBE_SLACK);
     let mut pieces = tool_pieces(geometries, plan, profile, tube_mm, &mut path)?;
+    let follow = plan.stage_route.as_ref();
     let full_speed = [
         profile.axis_x.max_velocity_mm_s,
         profile.axis_y.max_velocity_mm_s,
     ];
-    let (mut best_excess_mm, mut stalled) = (f64::INFINITY, 0);
-    for _ in 0..SHRINK_ROUNDS {
+    for _ in 0..SLOW_ROUNDS {
         ctx.check()?;
-        retime(&mut pieces, &path, profile, full_speed)?;
+        retime(
+            &mut pieces,
+            &path,
+            profile,
+            full_speed,
+            Some(corner_mm),
+            follow,
+        )?;
         let run = clocked(&pieces, &path, clock_s);
-        build(&mut path, &run, profile, clock_s)?;
-        let over = overshoots(&path, reach_mm);
-        if over.is_empty() {
-            return Ok(path);
-        }
-        let worst_mm = over.iter().map(|o| o.1).fold(0.0, f64::max);
-        if worst_mm < best_excess_mm {
-            (best_excess_mm, stalled) = (worst_mm, 0);
-        } else {
-            stalled += 1;
-            if stalled >= STALLED_ROUNDS {
-                break;
+        let trouble = match blended_routes(&run, &path, profile, follow)? {
+            Err(spans) => spans
+                .into_iter()
+                .map(|span| Trouble {
+                    span,
+                    excess_mm: None,
+                })
+                .collect(),
+            Ok([x, y]) => {
+                install(&mut path, &run, x, y, clock_s);
+                let trouble = overshoot_spans(&path, reach_mm, profile);
+                if trouble.is_empty() {
+                    return Ok(path);
+                }
+                trouble
             }
-        }
-        shrink(&mut pieces, &run, &path, &over);
+        };
+        repair(&mut pieces, &run, &trouble, reach_mm);
     }
-    // the tube never settled: the guaranteed route (a share of the reach for the smoothing, the
-    // speed capped so that the smoothing stays inside it)
+    // the blends never settled: the guaranteed route (a share of the reach for the smoothing,
+    // the speed capped so that the smoothing stays inside it)
     let allowance_mm = SMOOTHING_SHARE * reach_mm;
     let cap = [&profile.axis_x, &profile.axis_y].map(|a| speed_cap_mm_s(a, allowance_mm));
     for piece in &mut pieces {
         piece.tube_mm = reach_mm - allowance_mm;
     }
-    retime(&mut pieces, &path, profile, cap)?;
+    retime(&mut pieces, &path, profile, cap, None, follow)?;
     let run = clocked(&pieces, &path, clock_s);
-    build(&mut path, &run, profile, clock_s)?;
+    let [rx, ry] = routes(&run, &path, profile, follow)?;
+    let x = AxisRoute::smooth(rx, profile.axis_x.max_accel_mm_s2);
+    let y = AxisRoute::smooth(ry, profile.axis_y.max_accel_mm_s2);
+    install(&mut path, &run, x, y, clock_s);
     Ok(path)
 }
 
@@ -183,16 +239,40 @@ fn clocked(pieces: &[Piece], path: &Toolpath, clock_s: Option<f64>) -> Vec<Piece
     }
 }
 
-/// Routes, smoothing and segments of `pieces` into `path` (replacing earlier ones).
-fn build(
+/// Both axes blended, or the spans (route time) where overlapping blends exceed the
+/// acceleration.
+type Blended = Result<[AxisRoute; 2], Vec<(f64, f64)>>;
+
+/// The taut strings of `pieces` with their corners blended at each axis' acceleration; where
+/// blends overlap beyond it, the spans (route time) to slow down.
+fn blended_routes(
+    pieces: &[Piece],
+    path: &Toolpath,
+    profile: &MachineProfile,
+    follow: Option<&TimedRoute>,
+) -> Result<Blended, OtfError> {
+    let [rx, ry] = routes(pieces, path, profile, follow)?;
+    let x = CornerBlends::new(&rx, profile.axis_x.max_accel_mm_s2);
+    let y = CornerBlends::new(&ry, profile.axis_y.max_accel_mm_s2);
+    Ok(match (x, y) {
+        (Ok(x), Ok(y)) => Ok([AxisRoute::Blends(x), AxisRoute::Blends(y)]),
+        (x, y) => Err([x.err(), y.err()]
+            .into_iter()
+            .flatten()
+            .flat_map(|o| o.spans)
+            .collect()),
+    })
+}
+
+/// Installs the route `x`, `y` of `pieces` in `path` and lays out its segments: the stage
+/// starts at rest, half the longest blend before the route's time 0 (on a tick with a clock).
+fn install(
     path: &mut Toolpath,
     pieces: &[Piece],
-    profile: &MachineProfile,
+    x: AxisRoute,
+    y: AxisRoute,
     clock_s: Option<f64>,
-) -> Result<(), OtfError> {
-    let [rx, ry] = routes(pieces, path, profile)?;
-    let x = AxisRoute::smooth(rx, profile.axis_x.max_accel_mm_s2);
-    let y = AxisRoute::smooth(ry, profile.axis_y.max_accel_mm_s2);
+) {
     let half_reach_s = x.reach_s().max(y.reach_s()) / 2.0;
     let pad_s = clock_s.map_or(half_reach_s, |p| ceil_to_tick(half_reach_s, p));
     path.route = Some(StageRoute {
@@ -202,20 +282,34 @@ fn build(
     });
     path.segments.clear();
     push_segments(path, pieces, pad_s);
-    Ok(())
 }
 
-/// Instants (job time) where the scanner offset exceeds `reach_mm` on an axis, with the excess:
-/// checked every [`CHECK_PERIOD_S`] and at every knot of the tool (segment ends and stroke
-/// vertices). Between two such instants the offset can grow by at most `a_max · Δt² / 8` (the
-/// stage's curvature; the tool moves straight between knots): below a micrometre.
-fn overshoots(path: &Toolpath, reach_mm: f64) -> Vec<(f64, f64)> {
+/// A stretch of the route (route time, s) to repair: where the blended stage overshoots the
+/// scanner's reach or the stroke (by `excess_mm`), or where blends overlap beyond the
+/// acceleration (`None`).
+#[derive(Debug, Clone, Copy)]
+struct Trouble {
+    span: (f64, f64),
+    excess_mm: Option<f64>,
+}
+
+/// Instants (job time) where the scanner offset exceeds `reach_mm` on an axis or the stage
+/// leaves its stroke, with the excess (mm): checked every [`CHECK_PERIOD_S`] and at every knot
+/// of the tool (segment ends and stroke vertices). Between two such instants the offset can
+/// grow by at most `a_max · Δt² / 8` (the stage's curvature; the tool moves straight between
+/// knots): below a micrometre.
+fn overshoots(path: &Toolpath, reach_mm: f64, stroke_mm: [f64; 2]) -> Vec<(f64, f64)> {
     let mut times: Vec<f64> = Vec::new();
     for seg in &path.segments {
         times.push(seg.start_s);
-        if let ScanMotion::Mark { stroke } = seg.scan {
+        if let ScanMotion::Mark {
+            stroke,
+            start_frac,
+            end_frac,
+        } = seg.scan
+        {
             times.extend(
-                stroke_knots(path, stroke)
+                part_knots(path, stroke, start_frac, end_frac)
                     .iter()
                     .map(|(u, _)| seg.start_s + u * seg.duration_s),
             );
@@ -224,44 +318,88 @@ fn overshoots(path: &Toolpath, reach_mm: f64) -> Vec<(f64, f64)> {
     let end_s = path.duration_s();
     let grid = (end_s / CHECK_PERIOD_S).ceil() as usize;
     times.extend((0..=grid).map(|k| (k as f64 * CHECK_PERIOD_S).min(end_s)));
+    let limit_mm = reach_mm * (1.0 - CHECK_SLACK);
     times
         .into_iter()
         .filter_map(|t| {
-            let o = path.state_at(t).scan;
-            let excess = o.x.abs().max(o.y.abs()) - reach_mm * (1.0 - CHECK_SLACK);
-            (excess > 0.0).then_some((t, excess))
+            let state = path.state_at(t);
+            let (offset, stage) = (state.scan, state.stage);
+            let excess_mm = [
+                offset.x.abs().max(offset.y.abs()) - limit_mm,
+                -stage.x,
+                -stage.y,
+                stage.x - stroke_mm[0],
+                stage.y - stroke_mm[1],
+            ]
+            .into_iter()
+            .fold(0.0, f64::max);
+            (excess_mm > 0.0).then_some((t, excess_mm))
         })
         .collect()
 }
 
-/// Narrows the tube of every piece within half a smoothing window of an overshoot by 1.5 × the
-/// largest excess near it (at least a hundredth of a millimetre).
-fn shrink(pieces: &mut [Piece], run: &[Piece], path: &Toolpath, over: &[(f64, f64)]) {
+/// The overshoots as stretches of the route: the ramps running at each (a centred ramp moves
+/// the position only while it runs; a tiny span around it when none runs).
+fn overshoot_spans(path: &Toolpath, reach_mm: f64, profile: &MachineProfile) -> Vec<Trouble> {
     let Some(route) = &path.route else {
-        return;
+        return Vec::new();
     };
-    let half_window_s = route.x.reach_s().max(route.y.reach_s()) / 2.0;
+    overshoots(path, reach_mm, profile.stroke_mm)
+        .into_iter()
+        .map(|(t, excess_mm)| {
+            let tau = t - route.offset_s;
+            let spans = [route.x.active_span(tau), route.y.active_span(tau)];
+            let span = spans
+                .into_iter()
+                .flatten()
+                .reduce(|a, b| (a.0.min(b.0), a.1.max(b.1)))
+                .unwrap_or((tau - CHECK_PERIOD_S, tau + CHECK_PERIOD_S));
+            Trouble {
+                span,
+                excess_mm: Some(excess_mm),
+            }
+        })
+        .collect()
+}
+
+/// Repairs the pieces under each trouble (run `run`, route time): an overshoot narrows their
+/// tube by the excess (a blend departs from the string's corner outwards, by `Δv² / (8 a)`,
+/// so a string kept that much inside is followed within reach), unless the tube would drop
+/// below [`MIN_TUBE_SHARE`] of the reach; then, and where blends overlap, the pieces are slowed
+/// by [`SLOW_FACTOR`] (their corners' speed changes, hence blend widths and departures, shrink
+/// while the time between corners grows).
+fn repair(pieces: &mut [Piece], run: &[Piece], trouble: &[Trouble], reach_mm: f64) {
     let mut starts = Vec::with_capacity(run.len());
-    let mut t_s = route.offset_s;
+    let mut t_s = 0.0;
     for p in run {
         starts.push(t_s);
         t_s += p.duration_s;
     }
-    let mut worst = vec![0.0f64; pieces.len()];
-    for &(t, excess) in over {
-        let (lo, hi) = (t - half_window_s, t + half_window_s);
+    let mut narrow_mm = vec![0.0f64; pieces.len()];
+    let mut slow = vec![false; pieces.len()];
+    for t in trouble {
+        let (lo, hi) = t.span;
         let first = starts.partition_point(|&s| s <= lo).saturating_sub(1);
         for j in first..run.len() {
             if starts[j] > hi {
                 break;
             }
-            let w = &mut worst[run[j].origin];
-            *w = w.max(excess);
+            let k = run[j].origin;
+            match t.excess_mm {
+                Some(e)
+                    if pieces[k].tube_mm - e.max(MIN_NARROWING_MM) >= MIN_TUBE_SHARE * reach_mm =>
+                {
+                    narrow_mm[k] = narrow_mm[k].max(e.max(MIN_NARROWING_MM));
+                }
+                _ => slow[k] = true,
+            }
         }
     }
-    for (piece, excess) in pieces.iter_mut().zip(worst) {
-        if excess > 0.0 {
-            piece.tube_mm = (piece.tube_mm - (SHRINK_GAIN * excess).max(0.01)).max(0.0);
+    for (k, piece) in pieces.iter_mut().enumerate() {
+        if slow[k] {
+            piece.duration_s *= SLOW_FACTOR;
+        } else {
+            piece.tube_mm -= narrow_mm[k];
         }
     }
 }
@@ -310,6 +448,9 @@ fn tool_pieces(
         let stroke = path.push_stroke(k, geometry, step.field, Pt::default(), &points);
         let mut piece = |kind, duration_s: f64, tool| {
             if duration_s > 0.0 {
+                let nominal_start_s = pieces
+                    .last()
+                    .map_or(0.0, |p: &Piece| p.nominal_start_s + p.nominal_s);
                 pieces.push(Piece {
                     kind,
                     duration_s,
@@ -317,6 +458,8 @@ fn tool_pieces(
                     geometry,
                     tube_mm,
                     origin: pieces.len(),
+                    nominal_start_s,
+                    nominal_s: duration_s,
                 });
             }
         };
@@ -334,8 +477,15 @@ fn tool_pieces(
             laser.on_delay_s,
             Tool::Hold(start),
         );
-        let mark_s = path.strokes[stroke].length_mm / scanner.mark_speed_mm_s;
-        piece(SegmentKind::Mark, mark_s, Tool::Stroke(stroke));
+        for (start_frac, end_frac) in stroke_parts(path, stroke) {
+            let part_mm = (end_frac - start_frac) * path.strokes[stroke].length_mm;
+            let tool = Tool::Stroke {
+                stroke,
+                start_frac,
+                end_frac,
+            };
+            piece(SegmentKind::Mark, part_mm / scanner.mark_speed_mm_s, tool);
+        }
         piece(
             SegmentKind::LaserOffDelay,
             laser.off_delay_s,
@@ -350,13 +500,15 @@ fn tool_pieces(
 /// half-width (the narrowest of the pieces meeting there).
 struct Knots {
     times: Vec<f64>,
+    /// The same instants in the tool's nominal time law, s.
+    nominal_s: Vec<f64>,
     points: Vec<Pt>,
     owners: Vec<usize>,
     tube_mm: Vec<f64>,
 }
 
 impl Knots {
-    fn push(&mut self, t_s: f64, p: Pt, owner: usize, tube_mm: f64) {
+    fn push(&mut self, (t_s, nominal_s): (f64, f64), p: Pt, owner: usize, tube_mm: f64) {
         let mut tube_mm = tube_mm;
         if self
             .times
@@ -364,11 +516,13 @@ impl Knots {
             .is_some_and(|&last| t_s - last <= KNOT_EPS_S)
         {
             self.times.pop();
+            self.nominal_s.pop();
             self.points.pop();
             self.owners.pop();
             tube_mm = tube_mm.min(self.tube_mm.pop().unwrap_or(tube_mm));
         }
         self.times.push(t_s);
+        self.nominal_s.push(nominal_s);
         self.points.push(p);
         self.owners.push(owner);
         self.tube_mm.push(tube_mm);
@@ -378,6 +532,7 @@ impl Knots {
 fn knots(pieces: &[Piece], path: &Toolpath) -> Knots {
     let mut k = Knots {
         times: Vec::new(),
+        nominal_s: Vec::new(),
         points: Vec::new(),
         owners: Vec::new(),
         tube_mm: Vec::new(),
@@ -385,24 +540,98 @@ fn knots(pieces: &[Piece], path: &Toolpath) -> Knots {
     let mut t_s = 0.0;
     for piece in pieces {
         let (g, w) = (piece.geometry, piece.tube_mm);
-        match piece.tool {
-            Tool::Hold(p) => {
-                k.push(t_s, p, g, w);
-                k.push(t_s + piece.duration_s, p, g, w);
-            }
-            Tool::Line(a, b) => {
-                k.push(t_s, a, g, w);
-                k.push(t_s + piece.duration_s, b, g, w);
-            }
-            Tool::Stroke(s) => {
-                for (u, p) in stroke_knots(path, s) {
-                    k.push(t_s + u * piece.duration_s, p, g, w);
-                }
-            }
+        let at = |u: f64| {
+            (
+                t_s + u * piece.duration_s,
+                piece.nominal_start_s + u * piece.nominal_s,
+            )
+        };
+        for (u, p) in piece_knots(piece, path) {
+            k.push(at(u), p, g, w);
         }
         t_s += piece.duration_s;
     }
     k
+}
+
+/// The knots of one piece: fractions of its duration and the tool's point there.
+fn piece_knots(piece: &Piece, path: &Toolpath) -> Vec<(f64, Pt)> {
+    match piece.tool {
+        Tool::Hold(p) => vec![(0.0, p), (1.0, p)],
+        Tool::Line(a, b) => vec![(0.0, a), (1.0, b)],
+        Tool::Stroke {
+            stroke,
+            start_frac,
+            end_frac,
+        } => part_knots(path, stroke, start_frac, end_frac),
+    }
+}
+
+/// The tool's nominal time law of a plan on the fly (marks at mark speed, jumps at jump
+/// speed, the laser and jump delays), as the knots seed 001's routes are planned on.
+pub fn nominal_tool_knots(
+    geometries: &[Geometry],
+    plan: &Plan,
+    profile: &MachineProfile,
+) -> Result<Vec<ToolKnot>, OtfError> {
+    let mut path = Toolpath::default();
+    let pieces = tool_pieces(geometries, plan, profile, 0.0, &mut path)?;
+    let mut out = Vec::new();
+    for piece in &pieces {
+        let marking = piece.kind == SegmentKind::Mark;
+        for (u, at) in piece_knots(piece, &path) {
+            let t_s = piece.nominal_start_s + u * piece.nominal_s;
+            // a knot's flag says what follows it: the last knot of a mark part is followed by
+            // the next piece, which pushes its own first knot at the same instant
+            out.push(ToolKnot {
+                t_s,
+                at,
+                marking: marking && u < 1.0,
+            });
+        }
+    }
+    Ok(out)
+}
+
+/// A stroke cut at its vertices into parts of at least [`PART_MM`] (the last part may be
+/// shorter): `(start_frac, end_frac)` fractions of its length. Retiming slows whole pieces, so
+/// a long stroke is slowed only where its route needs it.
+fn stroke_parts(path: &Toolpath, stroke: usize) -> Vec<(f64, f64)> {
+    let length_mm = path.strokes[stroke].length_mm;
+    let mut parts = Vec::new();
+    let mut start = 0.0;
+    for (u, _) in stroke_knots(path, stroke) {
+        if (u - start) * length_mm >= PART_MM {
+            parts.push((start, u));
+            start = u;
+        }
+    }
+    if start < 1.0 || parts.is_empty() {
+        parts.push((start, 1.0));
+    }
+    parts
+}
+
+/// The knots of part `[start_frac, end_frac]` of stroke `s`: its ends and the vertices between,
+/// with their fraction of the part (0 to 1).
+fn part_knots(path: &Toolpath, s: usize, start_frac: f64, end_frac: f64) -> Vec<(f64, Pt)> {
+    let span = end_frac - start_frac;
+    let of_part = |u: f64| {
+        if span > 0.0 {
+            ((u - start_frac) / span).clamp(0.0, 1.0)
+        } else {
+            1.0
+        }
+    };
+    let mut out = vec![(0.0, path.point_along(s, start_frac))];
+    out.extend(
+        stroke_knots(path, s)
+            .into_iter()
+            .filter(|&(u, _)| u > start_frac && u < end_frac)
+            .map(|(u, p)| (of_part(u), p)),
+    );
+    out.push((1.0, path.point_along(s, end_frac)));
+    out
 }
 
 /// The vertices of stroke `s` with their fraction of its length.
@@ -432,13 +661,17 @@ fn routes(
     pieces: &[Piece],
     path: &Toolpath,
     profile: &MachineProfile,
+    follow: Option<&TimedRoute>,
 ) -> Result<[Vec<(f64, f64)>; 2], OtfError> {
     let Knots {
         times,
+        nominal_s,
         points,
         owners,
         tube_mm,
     } = knots(pieces, path);
+    let targets: Option<Vec<Pt>> =
+        follow.map(|route| nominal_s.iter().map(|&t| route.position(t)).collect());
     let mut out: [Vec<(f64, f64)>; 2] = Default::default();
     for (k, axis) in ['x', 'y'].into_iter().enumerate() {
         let coord = |p: &Pt| if k == 0 { p.x } else { p.y };
@@ -459,6 +692,10 @@ fn routes(
                 axis,
             });
         }
+        let (mut lower, mut upper) = (lower, upper);
+        if let Some(targets) = &targets {
+            follow_band(&mut lower, &mut upper, targets.iter().map(coord));
+        }
         let tube = Tube {
             t_s: &times,
             lower_mm: &lower,
@@ -469,16 +706,42 @@ fn routes(
     Ok(out)
 }
 
-/// Slows the pieces under every stretch of the route faster than its axis cap, until none is.
+/// Narrows each knot's interval to within [`FOLLOW_MM`] of the route's position at that knot
+/// (seed 001's routes), where the two meet; where they do not (the route would put the tool
+/// out of reach), the interval stays the scanner's reach.
+fn follow_band(lower: &mut [f64], upper: &mut [f64], targets: impl Iterator<Item = f64>) {
+    for ((lo, hi), target) in lower.iter_mut().zip(upper.iter_mut()).zip(targets) {
+        let (band_lo, band_hi) = (lo.max(target - FOLLOW_MM), hi.min(target + FOLLOW_MM));
+        if band_lo <= band_hi {
+            (*lo, *hi) = (band_lo, band_hi);
+        }
+    }
+}
+
+/// Slows the pieces under every stretch of the route faster than its axis cap, and (with
+/// `corner_mm`) under every corner whose blend would depart from it by more than that, until
+/// none is.
 fn retime(
     pieces: &mut [Piece],
     path: &Toolpath,
     profile: &MachineProfile,
     cap_mm_s: [f64; 2],
+    corner_mm: Option<f64>,
+    follow: Option<&TimedRoute>,
 ) -> Result<(), OtfError> {
+    let accel = [
+        profile.axis_x.max_accel_mm_s2,
+        profile.axis_y.max_accel_mm_s2,
+    ];
     for _ in 0..RETIME_ROUNDS {
-        let routes = routes(pieces, path, profile)?;
-        let factors = stretch_factors(pieces, &routes, cap_mm_s);
+        let routes = routes(pieces, path, profile, follow)?;
+        let mut factors = stretch_factors(pieces, &routes, cap_mm_s);
+        if let Some(corner_mm) = corner_mm {
+            let starts = piece_starts(pieces);
+            for (route, a) in routes.iter().zip(accel) {
+                corner_factors(&starts, route, a, corner_mm, &mut factors);
+            }
+        }
         if factors.iter().all(|&f| f <= 1.0) {
             return Ok(());
         }
@@ -487,7 +750,7 @@ fn retime(
         }
     }
     // what is left: the whole job slower by the worst excess (slopes scale exactly)
-    let routes = routes(pieces, path, profile)?;
+    let routes = routes(pieces, path, profile, follow)?;
     let worst = [0, 1]
         .map(|k| peak_speed_mm_s(&routes[k]) / cap_mm_s[k])
         .into_iter()
@@ -498,18 +761,62 @@ fn retime(
     Ok(())
 }
 
-/// Per piece, how much it must be slowed: the largest excess of a route stretch over it.
-fn stretch_factors(
-    pieces: &[Piece],
-    routes: &[Vec<(f64, f64)>; 2],
-    cap_mm_s: [f64; 2],
-) -> Vec<f64> {
+/// The start time of each piece.
+fn piece_starts(pieces: &[Piece]) -> Vec<f64> {
     let mut starts = Vec::with_capacity(pieces.len());
     let mut t_s = 0.0;
     for p in pieces {
         starts.push(t_s);
         t_s += p.duration_s;
     }
+    starts
+}
+
+/// Raises `factors` (per piece, starting at `starts`) under every corner of `route` whose
+/// blend at `accel_mm_s2` would depart from it by more than `corner_mm`: a corner's speed
+/// change `Δv` departs by `Δv² / (8 a)` over `|Δv| / a` around it, and slowing the pieces
+/// there by `f` divides `Δv` by `f` (the start and the end count as corners from rest).
+fn corner_factors(
+    starts: &[f64],
+    route: &[(f64, f64)],
+    accel_mm_s2: f64,
+    corner_mm: f64,
+    factors: &mut [f64],
+) {
+    let slope = |k: usize| -> f64 {
+        match (route.get(k), route.get(k + 1)) {
+            (Some(&(ta, xa)), Some(&(tb, xb))) => (xb - xa) / (tb - ta),
+            _ => 0.0,
+        }
+    };
+    for (k, &(t_s, _)) in route.iter().enumerate() {
+        let before = if k == 0 { 0.0 } else { slope(k - 1) };
+        let dv = (slope(k) - before).abs();
+        let departure_mm = dv * dv / (8.0 * accel_mm_s2);
+        if departure_mm <= corner_mm * (1.0 + SPEED_TOLERANCE) {
+            continue;
+        }
+        let f = (departure_mm / corner_mm).sqrt() * (1.0 + RETIME_OVERSHOOT);
+        let half_s = dv / (2.0 * accel_mm_s2);
+        let first = starts
+            .partition_point(|&s| s <= t_s - half_s)
+            .saturating_sub(1);
+        for j in first..starts.len() {
+            if starts[j] >= t_s + half_s {
+                break;
+            }
+            factors[j] = factors[j].max(f);
+        }
+    }
+}
+
+/// Per piece, how much it must be slowed: the largest excess of a route stretch over it.
+fn stretch_factors(
+    pieces: &[Piece],
+    routes: &[Vec<(f64, f64)>; 2],
+    cap_mm_s: [f64; 2],
+) -> Vec<f64> {
+    let starts = piece_starts(pieces);
     let mut factors = vec![1.0f64; pieces.len()];
     for (route, cap) in routes.iter().zip(cap_mm_s) {
         for w in route.windows(2) {
@@ -530,32 +837,52 @@ fn stretch_factors(
     factors
 }
 
-/// The pieces on a controller clock: marks start and end on ticks (a wait at the mark's start
-/// before it, the mark slower to fill whole ticks), one laser-off tick between marks.
+/// The pieces on a controller clock: marks (all the parts of a stroke together) start and end
+/// on ticks (a wait at the mark's start before it, the parts slower to fill whole ticks), one
+/// laser-off tick between marks.
 fn on_clock(pieces: &[Piece], path: &Toolpath, period_s: f64) -> Vec<Piece> {
     let mut out = Vec::with_capacity(pieces.len() * 2);
     let (mut t_s, mut clock) = (0.0, MarkClock::new(period_s));
-    for piece in pieces {
-        let Tool::Stroke(s) = piece.tool else {
-            out.push(*piece);
+    let mut k = 0;
+    while k < pieces.len() {
+        let piece = pieces[k];
+        let Tool::Stroke { stroke, .. } = piece.tool else {
+            out.push(piece);
             t_s += piece.duration_s;
+            k += 1;
             continue;
         };
-        let (start_s, duration_s) = clock.place(t_s, piece.duration_s);
+        let parts = pieces[k..]
+            .iter()
+            .take_while(|p| matches!(p.tool, Tool::Stroke { stroke: s, .. } if s == stroke))
+            .count();
+        let mark_s: f64 = pieces[k..k + parts].iter().map(|p| p.duration_s).sum();
+        let (start_s, duration_s) = clock.place(t_s, mark_s);
         if start_s > t_s {
-            let at = path.stroke_points(s).first().copied().unwrap_or_default();
+            let at = path
+                .stroke_points(stroke)
+                .first()
+                .copied()
+                .unwrap_or_default();
             out.push(Piece {
                 kind: SegmentKind::LaserOnDelay,
                 duration_s: start_s - t_s,
                 tool: Tool::Hold(at),
-                ..*piece
+                nominal_s: 0.0,
+                ..piece
             });
         }
-        out.push(Piece {
-            duration_s,
-            ..*piece
-        });
+        let stretch = if mark_s > 0.0 {
+            duration_s / mark_s
+        } else {
+            1.0
+        };
+        out.extend(pieces[k..k + parts].iter().map(|p| Piece {
+            duration_s: p.duration_s * stretch,
+            ..*p
+        }));
         t_s = start_s + duration_s;
+        k += parts;
     }
     out
 }
@@ -565,7 +892,9 @@ fn on_clock(pieces: &[Piece], path: &Toolpath, period_s: f64) -> Vec<Piece> {
 fn push_segments(path: &mut Toolpath, pieces: &[Piece], pad_s: f64) {
     let first = pieces.first().map(|p| match p.tool {
         Tool::Hold(q) | Tool::Line(q, _) => q,
-        Tool::Stroke(s) => path.stroke_points(s).first().copied().unwrap_or_default(),
+        Tool::Stroke {
+            stroke, start_frac, ..
+        } => path.point_along(stroke, start_frac),
     });
     let mut t_s = 0.0;
     if let (Some(at), true) = (first, pad_s > 0.0) {
@@ -586,11 +915,19 @@ fn push_segments(path: &mut Toolpath, pieces: &[Piece], pad_s: f64) {
                 to,
                 move_s: piece.duration_s,
             },
-            Tool::Stroke(stroke) => {
-                if let Some(route) = &path.route {
+            Tool::Stroke {
+                stroke,
+                start_frac,
+                end_frac,
+            } => {
+                if let (Some(route), true) = (&path.route, start_frac == 0.0) {
                     path.strokes[stroke].stage = route.position(t_s);
                 }
-                ScanMotion::Mark { stroke }
+                ScanMotion::Mark {
+                    stroke,
+                    start_frac,
+                    end_frac,
+                }
             }
         };
         path.segments.push(Segment {

@@ -94,8 +94,8 @@ impl AxisRoute {
     /// The acceleration-limited route through `vertices` (speed at most their peak).
     pub fn smooth(vertices: Vec<(f64, f64)>, accel_mm_s2: f64) -> Self {
         match CornerBlends::new(&vertices, accel_mm_s2) {
-            Some(blends) => AxisRoute::Blends(blends),
-            None => {
+            Ok(blends) => AxisRoute::Blends(blends),
+            Err(_) => {
                 let window_s = 2.0 * super::taut::peak_speed_mm_s(&vertices) / accel_mm_s2;
                 AxisRoute::Window(SmoothedAxis::new(vertices, window_s))
             }
@@ -106,6 +106,13 @@ impl AxisRoute {
         match self {
             AxisRoute::Blends(b) => b.position_mm(t_s),
             AxisRoute::Window(w) => w.position_mm(t_s),
+        }
+    }
+    /// The stretch of the path (route time, s) whose corners move the route at `t_s`.
+    pub fn active_span(&self, t_s: f64) -> Option<(f64, f64)> {
+        match self {
+            AxisRoute::Blends(b) => b.active_span(t_s),
+            AxisRoute::Window(w) => Some((t_s - w.window_s() / 2.0, t_s + w.window_s() / 2.0)),
         }
     }
     /// How long before or after a vertex the route may depart from the path, s (the longest

@@ -37,6 +37,7 @@ fn plan(fields: Vec<ScanField>, order: Vec<Step>) -> Plan {
         metrics: Metrics::default(),
         history: vec![],
         motion: Default::default(),
+        stage_route: None,
     }
 }
 
@@ -178,7 +179,7 @@ fn on_the_clock_marks_start_and_end_on_ticks() {
         }
         // marked no faster than the mark speed
         let len = clocked.strokes[match s.scan {
-            ScanMotion::Mark { stroke } => stroke,
+            ScanMotion::Mark { stroke, .. } => stroke,
             _ => unreachable!(),
         }]
         .length_mm;

@@ -56,11 +56,17 @@ pub enum ScanMotion {
         /// Duration of the straight move, s.
         move_s: f64,
     },
-    /// Marks stroke `stroke` of the toolpath at constant speed over the whole segment; the
-    /// offset is the stroke's point less the stage.
+    /// Marks the part `[start_frac, end_frac]` (fractions of its length) of stroke `stroke`
+    /// at constant speed over the whole segment; the offset is the stroke's point less the
+    /// stage. Step-and-scan marks a stroke in one segment (`0..1`); on the fly a stroke may
+    /// run as consecutive parts at different speeds (the laser stays on between them).
     Mark {
         /// Index into [`Toolpath::strokes`].
         stroke: usize,
+        /// Where the segment starts along the stroke (fraction of its length).
+        start_frac: f64,
+        /// Where it ends (fraction of its length).
+        end_frac: f64,
     },
     /// Holds the tool-centre point (the offset follows the moving stage; on the fly).
     TcpHold(Pt),
@@ -349,20 +355,25 @@ impl Toolpath {
                 };
                 (from.plus(to.minus(from).scale(u)), false)
             }
-            ScanMotion::Mark { stroke } => {
+            ScanMotion::Mark {
+                stroke,
+                start_frac,
+                end_frac,
+            } => {
                 let u = if seg.duration_s > 0.0 {
                     local_s / seg.duration_s
                 } else {
                     1.0
                 };
-                (self.point_along(stroke, u).minus(stage), true)
+                let along = start_frac + (end_frac - start_frac) * u;
+                (self.point_along(stroke, along).minus(stage), true)
             }
         };
         MachineState { stage, scan, laser }
     }
 
     /// The point at fraction `u` (0..=1) of stroke `k`'s length.
-    fn point_along(&self, k: usize, u: f64) -> Pt {
+    pub(crate) fn point_along(&self, k: usize, u: f64) -> Pt {
         let Some(s) = self.strokes.get(k) else {
             return Pt::default();
         };

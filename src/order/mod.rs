@@ -18,7 +18,7 @@ use crate::document::{
     SolverSettings, Step,
 };
 use crate::job::{Cancelled, JobCtx};
-use crate::motion::{lower_motion, MotionError, OtfError, Toolpath};
+use crate::motion::{lower_motion, plan_stage_route, MotionError, OtfError, Toolpath};
 use thiserror::Error;
 
 /// Why ordering failed.
@@ -58,7 +58,7 @@ pub fn order_plan(
     let mut detail = Vec::new();
     let (ordering, seed_ordering, history) =
         run_algorithm(geometries, fields, profile, settings, ctx, &mut detail)?;
-    let (ordering, toolpath) = if settings.cost_model == CostModel::Time
+    let (ordering, toolpath, stage_route) = if settings.cost_model == CostModel::Time
         && settings.algo != Algo::AsIs
         && settings.motion == MotionMode::Step
     {
@@ -72,10 +72,28 @@ pub fn order_plan(
             }
         }
         detail.push(("time".into(), t.elapsed().as_secs_f64()));
-        best
+        (best.0, best.1, None)
     } else {
-        let toolpath = lower_ordering(geometries, fields, profile, settings, &ordering, ctx)?;
-        (ordering, toolpath)
+        let t = std::time::Instant::now();
+        let mut plan = plan_of(fields, settings, &ordering);
+        plan.stage_route = plan_stage_route(
+            geometries,
+            &plan,
+            profile,
+            settings.stage_route,
+            &settings.route_ga,
+            settings.seed,
+            ctx,
+        )
+        .map_err(|e| match e {
+            OtfError::Cancelled(c) => OrderError::Cancelled(c),
+            other => OrderError::Lower(MotionError::OnTheFly(other)),
+        })?;
+        if plan.stage_route.is_some() {
+            detail.push(("route".into(), t.elapsed().as_secs_f64()));
+        }
+        let toolpath = lower_unless_cancelled(geometries, profile, &plan, ctx)?;
+        (ordering, toolpath, plan.stage_route)
     };
     let order_s = t0.elapsed().as_secs_f64();
     let plan_fields = fields_in_order(fields, &ordering.field_order);
@@ -96,6 +114,7 @@ pub fn order_plan(
         metrics: m,
         history,
         motion: settings.motion,
+        stage_route,
     })
 }
 
@@ -173,7 +192,17 @@ fn lower_ordering(
     ordering: &Ordering,
     ctx: &JobCtx,
 ) -> Result<Toolpath, OrderError> {
-    let plan = Plan {
+    lower_unless_cancelled(
+        geometries,
+        profile,
+        &plan_of(fields, settings, ordering),
+        ctx,
+    )
+}
+
+/// An unnamed plan of an ordering (for lowering it).
+fn plan_of(fields: &[ScanField], settings: &SolverSettings, ordering: &Ordering) -> Plan {
+    Plan {
         name: String::new(),
         algo: Algo::default(),
         fields: fields_in_order(fields, &ordering.field_order),
@@ -181,12 +210,22 @@ fn lower_ordering(
         metrics: Default::default(),
         history: Vec::new(),
         motion: settings.motion,
-    };
+        stage_route: None,
+    }
+}
+
+/// The toolpath of `plan`.
+fn lower_unless_cancelled(
+    geometries: &[Geometry],
+    profile: &MachineProfile,
+    plan: &Plan,
+    ctx: &JobCtx,
+) -> Result<Toolpath, OrderError> {
     // a search cancelled with a result (HGA's best so far) still gets its toolpath; a cancel
     // during the lowering itself (on the fly, seconds on large jobs) stops it
     let finish = JobCtx::default();
     let ctx = if ctx.is_cancelled() { &finish } else { ctx };
-    match lower_motion(geometries, &plan, profile, None, ctx) {
+    match lower_motion(geometries, plan, profile, None, ctx) {
         Err(MotionError::OnTheFly(OtfError::Cancelled(c))) => Err(OrderError::Cancelled(c)),
         other => Ok(other?),
     }
