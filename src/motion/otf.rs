@@ -613,43 +613,36 @@ fn stroke_parts(path: &Toolpath, stroke: usize) -> Vec<(f64, f64)> {
 }
 
 /// The knots of part `[start_frac, end_frac]` of stroke `s`: its ends and the vertices between,
-/// with their fraction of the part (0 to 1).
+/// with their fraction of the part (0 to 1). Finds the vertices by bisection on the arc
+/// lengths: a long stroke's many parts cost no more than its vertices.
 fn part_knots(path: &Toolpath, s: usize, start_frac: f64, end_frac: f64) -> Vec<(f64, Pt)> {
-    let span = end_frac - start_frac;
-    let of_part = |u: f64| {
-        if span > 0.0 {
-            ((u - start_frac) / span).clamp(0.0, 1.0)
-        } else {
-            1.0
-        }
-    };
+    let length_mm = path.strokes[s].length_mm;
+    let (start_mm, end_mm) = (start_frac * length_mm, end_frac * length_mm);
+    let (pts, arc) = (path.stroke_points(s), path.stroke_arc_mm(s));
+    let first = arc.partition_point(|&a| a <= start_mm);
+    let last = arc.partition_point(|&a| a < end_mm);
+    let span_mm = end_mm - start_mm;
     let mut out = vec![(0.0, path.point_along(s, start_frac))];
-    out.extend(
-        stroke_knots(path, s)
-            .into_iter()
-            .filter(|&(u, _)| u > start_frac && u < end_frac)
-            .map(|(u, p)| (of_part(u), p)),
-    );
+    if first < last {
+        out.extend(
+            arc[first..last]
+                .iter()
+                .zip(&pts[first..last])
+                .map(|(&a, &p)| (((a - start_mm) / span_mm).clamp(0.0, 1.0), p)),
+        );
+    }
     out.push((1.0, path.point_along(s, end_frac)));
     out
 }
 
 /// The vertices of stroke `s` with their fraction of its length.
 fn stroke_knots(path: &Toolpath, s: usize) -> Vec<(f64, Pt)> {
-    let pts = path.stroke_points(s);
     let length_mm = path.strokes[s].length_mm;
-    let mut arc_mm = 0.0;
-    pts.iter()
-        .enumerate()
-        .map(|(j, &p)| {
-            if j > 0 {
-                arc_mm += p.dist(pts[j - 1]);
-            }
-            let u = if length_mm > 0.0 {
-                arc_mm / length_mm
-            } else {
-                1.0
-            };
+    path.stroke_arc_mm(s)
+        .iter()
+        .zip(path.stroke_points(s))
+        .map(|(&a, &p)| {
+            let u = if length_mm > 0.0 { a / length_mm } else { 1.0 };
             (u, p)
         })
         .collect()

@@ -241,6 +241,13 @@ impl Toolpath {
             .map_or(&[][..], |s| &self.points[s.points.clone()])
     }
 
+    /// The arc length (mm) from stroke `k`'s start to each of its points.
+    pub(crate) fn stroke_arc_mm(&self, k: usize) -> &[f64] {
+        self.strokes
+            .get(k)
+            .map_or(&[][..], |s| &self.arc_mm[s.points.clone()])
+    }
+
     /// Total duration, s.
     pub fn duration_s(&self) -> f64 {
         self.segments.last().map_or(0.0, Segment::end_s)
