@@ -1,6 +1,7 @@
 //! Ordering: which field after which, which geometry after which, where each one starts.
 
 mod as_is;
+mod bands;
 mod baseline;
 pub mod cost;
 pub mod hga;
@@ -58,6 +59,15 @@ pub fn order_plan(
     let mut detail = Vec::new();
     let (ordering, seed_ordering, history) =
         run_algorithm(geometries, fields, profile, settings, ctx, &mut detail)?;
+    let (ordering, taut) = if settings.motion == MotionMode::OnTheFly && settings.algo != Algo::AsIs
+    {
+        let t = std::time::Instant::now();
+        let best = faster_on_the_fly(geometries, fields, profile, settings, ordering, ctx)?;
+        detail.push(("bands".into(), t.elapsed().as_secs_f64()));
+        (best.0, Some(best.1))
+    } else {
+        (ordering, None)
+    };
     let (ordering, toolpath, stage_route) = if settings.cost_model == CostModel::Time
         && settings.algo != Algo::AsIs
         && settings.motion == MotionMode::Step
@@ -92,7 +102,10 @@ pub fn order_plan(
         if plan.stage_route.is_some() {
             detail.push(("route".into(), t.elapsed().as_secs_f64()));
         }
-        let toolpath = lower_unless_cancelled(geometries, profile, &plan, ctx)?;
+        let toolpath = match (taut, &plan.stage_route) {
+            (Some(toolpath), None) => toolpath,
+            _ => lower_unless_cancelled(geometries, profile, &plan, ctx)?,
+        };
         (ordering, toolpath, plan.stage_route)
     };
     let order_s = t0.elapsed().as_secs_f64();
@@ -139,6 +152,27 @@ fn run_algorithm(
             let (r, seed) = run_hga(geometries, fields, profile, settings, ctx, detail)?;
             (r.ordering, seed, r.history)
         }
+    })
+}
+
+/// On the fly: the algorithm's ordering or the sweep of field-wide bands
+/// ([`bands::band_order`]), whichever runs faster on the taut route, with that toolpath.
+fn faster_on_the_fly(
+    geometries: &[Geometry],
+    fields: &[ScanField],
+    profile: &MachineProfile,
+    settings: &SolverSettings,
+    ordering: Ordering,
+    ctx: &JobCtx,
+) -> Result<(Ordering, Toolpath), OrderError> {
+    let by_fields = lower_ordering(geometries, fields, profile, settings, &ordering, ctx)?;
+    let band_mm = profile.field_mm[0].min(profile.field_mm[1]);
+    let bands = bands::band_order(geometries, fields, band_mm, ctx)?;
+    let by_bands = lower_ordering(geometries, fields, profile, settings, &bands, ctx)?;
+    Ok(if by_bands.duration_s() < by_fields.duration_s() {
+        (bands, by_bands)
+    } else {
+        (ordering, by_fields)
     })
 }
 
