@@ -31,7 +31,8 @@ t = json.loads(tj); r = json.load(open(rep))["metrics"]
 try: j = json.loads(job).get("ok")
 except Exception: j = job[:80]
 print(f"{name:14s} traj_ok={t['ok']} job_ok={j} job_s={t['job_time_s']:.3f} route_mm={t['stage_path_mm']:.0f} "
-      f"peak_mm_s={t['stage_max_speed_mm_s']:.0f} offset={t['scan_max_offset_mm']} {' | '.join(t['fails'])[:200]}")
+      f"peak_mm_s={t['stage_max_speed_mm_s']:.0f} variation_mm_s={t['stage_speed_variation_mm_s']:.0f} "
+      f"offset_mm={max(t['scan_max_offset_mm']):.2f} plan_s={r['solve_s']['total']:.2f} {' | '.join(t['fails'])[:200]}")
 PY
 }
 for p in lissajous tree spiral; do run "$p" "$S/bench/otf/$p.svg" assets/profiles/seed000.toml; done

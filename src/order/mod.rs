@@ -168,6 +168,9 @@ fn faster_on_the_fly(
     let by_fields = lower_ordering(geometries, fields, profile, settings, &ordering, ctx)?;
     let band_mm = profile.field_mm[0].min(profile.field_mm[1]);
     let bands = bands::band_order(geometries, fields, band_mm, ctx)?;
+    if bands.steps == ordering.steps {
+        return Ok((ordering, by_fields));
+    }
     let by_bands = lower_ordering(geometries, fields, profile, settings, &bands, ctx)?;
     Ok(if by_bands.duration_s() < by_fields.duration_s() {
         (bands, by_bands)
