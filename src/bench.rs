@@ -74,6 +74,10 @@ pub struct BenchRow {
     pub stage_route_mm: Stat,
     /// Largest scanner offset, mm.
     pub scan_peak_offset_mm: Stat,
+    /// Peak stage speed (vector), mm/s.
+    pub stage_peak_speed_mm_s: Stat,
+    /// Total variation of the stage speed (seed 001 Table IV's sum of speed differences), mm/s.
+    pub stage_speed_variation_mm_s: Stat,
     /// Import, ms.
     pub import_ms: f64,
     /// Field placement, ms.
@@ -129,7 +133,7 @@ pub fn run_instance(
     ctx: &JobCtx,
 ) -> Result<BenchRow, PipelineError> {
     let mut times: [Vec<f64>; 5] = Default::default();
-    let mut quality: [Vec<f64>; 9] = Default::default();
+    let mut quality: [Vec<f64>; 11] = Default::default();
     let (mut geometries, mut marked_mm, mut lower) = (0, 0.0, None);
     for k in 0..seeds.max(1) {
         let mut s = settings.clone();
@@ -172,6 +176,8 @@ pub fn run_instance(
                     b.stage + b.settle,
                     motion.stage_route_mm,
                     motion.scan_peak_offset_mm,
+                    motion.stage_peak_speed_mm_s,
+                    motion.stage_speed_variation_mm_s,
                 ]) {
                     v.push(x);
                 }
@@ -182,7 +188,7 @@ pub fn run_instance(
         }
     }
     let [mut a, mut b, mut c, mut d, mut e] = times;
-    let [f, o, i, bm, dc, jt, st, route, offset] = quality;
+    let [f, o, i, bm, dc, jt, st, route, offset, peak, variation] = quality;
     Ok(BenchRow {
         instance: path
             .file_stem()
@@ -201,6 +207,8 @@ pub fn run_instance(
         stage_time_s: Stat::of(&st),
         stage_route_mm: Stat::of(&route),
         scan_peak_offset_mm: Stat::of(&offset),
+        stage_peak_speed_mm_s: Stat::of(&peak),
+        stage_speed_variation_mm_s: Stat::of(&variation),
         import_ms: median(&mut a),
         fields_ms: median(&mut b),
         order_ms: median(&mut c),
@@ -212,12 +220,12 @@ pub fn run_instance(
 /// Formats rows as a Markdown table (quality as mean ± sd when several seeds ran).
 pub fn format_table(rows: &[BenchRow]) -> String {
     let mut s = String::from(
-        "| instance | geometries | fields | LB | overlap % | idle mm | base mm | marked mm | dir. changes | job s | stage s | route mm | offset mm | import ms | fields ms | order ms | export ms | total ms |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "| instance | geometries | fields | LB | overlap % | idle mm | base mm | marked mm | dir. changes | job s | stage s | route mm | offset mm | peak stage mm/s | stage speed var. mm/s | import ms | fields ms | order ms | export ms | total ms |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
         let sd = r.seeds > 1;
         s.push_str(&format!(
-            "| {} | {} | {} | {} | {} | {} | {} | {:.1} | {} | {} | {} | {} | {} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} |\n",
+            "| {} | {} | {} | {} | {} | {} | {} | {:.1} | {} | {} | {} | {} | {} | {} | {} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} |\n",
             r.instance,
             r.geometries,
             r.fields.show(if sd { 1 } else { 0 }, sd),
@@ -231,6 +239,8 @@ pub fn format_table(rows: &[BenchRow]) -> String {
             r.stage_time_s.show(2, sd),
             r.stage_route_mm.show(0, sd),
             r.scan_peak_offset_mm.show(2, sd),
+            r.stage_peak_speed_mm_s.show(0, sd),
+            r.stage_speed_variation_mm_s.show(0, sd),
             r.import_ms,
             r.fields_ms,
             r.order_ms,

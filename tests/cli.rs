@@ -254,6 +254,8 @@ fn on_the_fly_plans_oversize_artwork_without_splitting() {
             motion,
             "--trajectory",
             &d("job.csv"),
+            "--preview",
+            &d("job.svg"),
         ])
     };
     // step-and-scan refuses geometries larger than a field unless told to split them
@@ -276,4 +278,23 @@ fn on_the_fly_plans_oversize_artwork_without_splitting() {
     assert!(rows
         .windows(2)
         .any(|w| w[0][5] == 1.0 && w[1][5] == 1.0 && (w[0][1] != w[1][1] || w[0][2] != w[1][2])));
+    // the preview draws the stage's route
+    let preview = std::fs::read_to_string(d("job.svg")).unwrap();
+    assert!(preview.contains("id=\"stage-route\""));
+    // bad route settings: a worded error, exit ≠ 0
+    let out = galvoplan(&[
+        "plan",
+        &svg,
+        "-o",
+        &d("bad.gcode"),
+        "--motion",
+        "on-the-fly",
+        "--stage-route",
+        "cetsp-ga",
+        "--route-population",
+        "0",
+    ]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("population"));
+    assert!(!std::path::Path::new(&d("bad.gcode")).exists());
 }

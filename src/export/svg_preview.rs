@@ -20,8 +20,8 @@ fn header(out: &mut String, w: f64, h: f64, min_x: f64, min_y: f64) {
 }
 
 /// The plan as an SVG in mm: scan fields as translucent numbered squares (visiting order), the
-/// toolpath's marks in black, its idle moves as dashed red lines, start (green) and end (red)
-/// markers.
+/// toolpath's marks in black, its idle moves as dashed red lines, on the fly the stage's route
+/// in blue, start (green) and end (red) markers.
 pub fn preview_svg(toolpath: &Toolpath, plan: &Plan, page_mm: [f64; 2]) -> String {
     let mut b = crate::geom::BBox {
         min_x: 0.0,
@@ -62,6 +62,7 @@ pub fn preview_svg(toolpath: &Toolpath, plan: &Plan, page_mm: [f64; 2]) -> Strin
         );
     }
     out.push_str("</g>\n");
+    stage_route(&mut out, toolpath);
     if let (Some(first), Some(last)) = (ends.first(), ends.last()) {
         let _ = writeln!(
             out,
@@ -71,6 +72,25 @@ pub fn preview_svg(toolpath: &Toolpath, plan: &Plan, page_mm: [f64; 2]) -> Strin
     }
     out.push_str("</svg>\n");
     out
+}
+
+/// Sampling step of the stage route in the preview, s (5 ms: under 2.5 mm at 500 mm/s).
+const ROUTE_PREVIEW_STEP_S: f64 = 5e-3;
+
+/// On the fly: the stage's route as a blue polyline (nothing for step-and-scan).
+fn stage_route(out: &mut String, toolpath: &Toolpath) {
+    let Some(route) = &toolpath.route else {
+        return;
+    };
+    let samples = (toolpath.duration_s() / ROUTE_PREVIEW_STEP_S).ceil() as usize;
+    let points: Vec<crate::geom::Pt> = (0..=samples)
+        .map(|k| route.position((k as f64 * ROUTE_PREVIEW_STEP_S).min(toolpath.duration_s())))
+        .collect();
+    let _ = writeln!(
+        out,
+        "<polyline id=\"stage-route\" fill=\"none\" stroke=\"#2563eb\" stroke-width=\"0.4\" points=\"{}\"/>",
+        pts_attr(&points)
+    );
 }
 
 /// Exactly the geometry to be marked, as an SVG in mm (user unit = 1 mm, page as given): one
