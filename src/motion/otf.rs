@@ -187,7 +187,7 @@ pub fn lower_on_the_fly(
     ];
     for _ in 0..SLOW_ROUNDS {
         ctx.check()?;
-        retime(
+        let retimed = retime(
             &mut pieces,
             &path,
             profile,
@@ -196,7 +196,12 @@ pub fn lower_on_the_fly(
             follow,
         )?;
         let run = clocked(&pieces, &path, clock_s);
-        let trouble = match blended_routes(&run, &path, profile, follow)? {
+        // without a clock the pieces run as retimed: their routes are known
+        let strings = match clock_s {
+            None => retimed,
+            Some(_) => routes(&run, &path, profile, follow)?,
+        };
+        let trouble = match blend(strings, profile) {
             Err(spans) => spans
                 .into_iter()
                 .map(|span| Trouble {
@@ -243,25 +248,19 @@ fn clocked(pieces: &[Piece], path: &Toolpath, clock_s: Option<f64>) -> Vec<Piece
 /// acceleration.
 type Blended = Result<[AxisRoute; 2], Vec<(f64, f64)>>;
 
-/// The taut strings of `pieces` with their corners blended at each axis' acceleration; where
+/// The taut strings `[rx, ry]` with their corners blended at each axis' acceleration; where
 /// blends overlap beyond it, the spans (route time) to slow down.
-fn blended_routes(
-    pieces: &[Piece],
-    path: &Toolpath,
-    profile: &MachineProfile,
-    follow: Option<&TimedRoute>,
-) -> Result<Blended, OtfError> {
-    let [rx, ry] = routes(pieces, path, profile, follow)?;
+fn blend([rx, ry]: [Vec<(f64, f64)>; 2], profile: &MachineProfile) -> Blended {
     let x = CornerBlends::new(&rx, profile.axis_x.max_accel_mm_s2);
     let y = CornerBlends::new(&ry, profile.axis_y.max_accel_mm_s2);
-    Ok(match (x, y) {
+    match (x, y) {
         (Ok(x), Ok(y)) => Ok([AxisRoute::Blends(x), AxisRoute::Blends(y)]),
         (x, y) => Err([x.err(), y.err()]
             .into_iter()
             .flatten()
             .flat_map(|o| o.spans)
             .collect()),
-    })
+    }
 }
 
 /// Installs the route `x`, `y` of `pieces` in `path` and lays out its segments: the stage
@@ -713,7 +712,7 @@ fn follow_band(lower: &mut [f64], upper: &mut [f64], targets: impl Iterator<Item
 
 /// Slows the pieces under every stretch of the route faster than its axis cap, and (with
 /// `corner_mm`) under every corner whose blend would depart from it by more than that, until
-/// none is.
+/// none is. Returns the taut strings of the retimed pieces.
 fn retime(
     pieces: &mut [Piece],
     path: &Toolpath,
@@ -721,37 +720,37 @@ fn retime(
     cap_mm_s: [f64; 2],
     corner_mm: Option<f64>,
     follow: Option<&TimedRoute>,
-) -> Result<(), OtfError> {
+) -> Result<[Vec<(f64, f64)>; 2], OtfError> {
     let accel = [
         profile.axis_x.max_accel_mm_s2,
         profile.axis_y.max_accel_mm_s2,
     ];
     for _ in 0..RETIME_ROUNDS {
-        let routes = routes(pieces, path, profile, follow)?;
-        let mut factors = stretch_factors(pieces, &routes, cap_mm_s);
+        let strings = routes(pieces, path, profile, follow)?;
+        let mut factors = stretch_factors(pieces, &strings, cap_mm_s);
         if let Some(corner_mm) = corner_mm {
             let starts = piece_starts(pieces);
-            for (route, a) in routes.iter().zip(accel) {
+            for (route, a) in strings.iter().zip(accel) {
                 corner_factors(&starts, route, a, corner_mm, &mut factors);
             }
         }
         if factors.iter().all(|&f| f <= 1.0) {
-            return Ok(());
+            return Ok(strings);
         }
         for (piece, f) in pieces.iter_mut().zip(factors) {
             piece.duration_s *= f;
         }
     }
     // what is left: the whole job slower by the worst excess (slopes scale exactly)
-    let routes = routes(pieces, path, profile, follow)?;
+    let strings = routes(pieces, path, profile, follow)?;
     let worst = [0, 1]
-        .map(|k| peak_speed_mm_s(&routes[k]) / cap_mm_s[k])
+        .map(|k| peak_speed_mm_s(&strings[k]) / cap_mm_s[k])
         .into_iter()
         .fold(1.0, f64::max);
     for piece in pieces.iter_mut() {
         piece.duration_s *= worst * (1.0 + SPEED_TOLERANCE);
     }
-    Ok(())
+    routes(pieces, path, profile, follow)
 }
 
 /// The start time of each piece.
