@@ -277,3 +277,84 @@ fn on_the_fly_plans_oversize_artwork_without_splitting() {
         .windows(2)
         .any(|w| w[0][5] == 1.0 && w[1][5] == 1.0 && (w[0][1] != w[1][1] || w[0][2] != w[1][2])));
 }
+
+#[test]
+fn plan_with_pens_writes_each_layers_power_feed_and_passes() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = |n: &str| dir.path().join(n).display().to_string();
+    let ex = |n: &str| {
+        common::root()
+            .join("assets/examples")
+            .join(n)
+            .display()
+            .to_string()
+    };
+    let run = |extra: &[&str], out: &str| {
+        let mut args = vec![
+            "plan".to_string(),
+            ex("two-layers.svg"),
+            "-o".into(),
+            d(&format!("{out}.gcode")),
+            "--report".into(),
+            d(&format!("{out}.json")),
+        ];
+        args.extend(extra.iter().map(|s| s.to_string()));
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let o = galvoplan(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let report: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(d(&format!("{out}.json"))).unwrap())
+                .unwrap();
+        (
+            std::fs::read_to_string(d(&format!("{out}.gcode"))).unwrap(),
+            report,
+        )
+    };
+    let pens = ex("two-layers.pens.toml");
+    let (gcode, report) = run(&["--pens", &pens], "pens");
+    assert!(
+        gcode.contains("\nM3 S40\n") && gcode.contains("\nM3 S85\n"),
+        "both powers"
+    );
+    assert!(
+        gcode.contains(" F90000\n") && gcode.contains(" F36000\n"),
+        "both feeds"
+    );
+    let (plain_gcode, plain) = run(&[], "plain");
+    assert!(!plain_gcode.contains(" S85"));
+    let job = |r: &serde_json::Value| r["metrics"]["job_time_s"].as_f64().unwrap();
+    let mark = |r: &serde_json::Value| {
+        r["metrics"]["job_time_breakdown_s"]["mark"]
+            .as_f64()
+            .unwrap()
+    };
+    // hatched and marked twice at 600 mm/s: far more marking than the outlines at 1000 mm/s
+    assert!(
+        mark(&report) > 3.0 * mark(&plain),
+        "{} vs {}",
+        mark(&report),
+        mark(&plain)
+    );
+    assert!(job(&report) > job(&plain));
+    // a bad pens file is one worded line naming the file
+    std::fs::write(
+        d("bad.toml"),
+        "version = 1\n[[layer]]\nname = \"fill\"\nmark_speed_mm_s = -3\n",
+    )
+    .unwrap();
+    let o = galvoplan(&[
+        "plan",
+        &ex("two-layers.svg"),
+        "-o",
+        &d("x.gcode"),
+        "--pens",
+        &d("bad.toml"),
+    ]);
+    assert!(!o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("bad.toml")
+            && err.contains("Layer 'fill': Mark speed (mm/s) must be a positive number, not -3"),
+        "{err}"
+    );
+}

@@ -53,6 +53,7 @@ pub fn open(
     path: &Path,
     profile: &MachineProfile,
     settings: &SolverSettings,
+    ctx: &JobCtx,
 ) -> Result<Opened, String> {
     if is_svg(path) {
         let (mut doc, _) = load_svg(
@@ -62,9 +63,13 @@ pub fn open(
             &ImportOptions::default(),
         )
         .map_err(|e| e.to_string())?;
-        let problem = place_document_fields(&mut doc, &JobCtx::default())
-            .err()
-            .map(|e| e.to_string());
+        let problem = match place_document_fields(&mut doc, ctx) {
+            Ok(_) => None,
+            Err(e) if ctx.is_cancelled() => {
+                return Err(format!("{}: cancelled ({e})", path.display()))
+            }
+            Err(e) => Some(e.to_string()),
+        };
         Ok(Opened {
             doc,
             problem,
@@ -130,6 +135,27 @@ pub fn pick_open() -> Option<PathBuf> {
         .add_filter("SVG", &["svg", "svgz"])
         .add_filter("galvoplan project", &[PROJECT_EXT, "json"])
         .pick_file()
+}
+
+/// An open dialog for one kind of file.
+pub fn pick_load(filter: &str, ext: &str) -> Option<PathBuf> {
+    rfd::FileDialog::new()
+        .add_filter(filter, &[ext])
+        .pick_file()
+}
+
+/// True when a native file dialog may be shown: on Linux and the BSDs the dialogs go through
+/// the desktop portal on the session bus, so without a session bus there is none (rfd then
+/// returns "nothing chosen" at once).
+pub fn native_dialogs_available() -> bool {
+    if cfg!(any(target_os = "windows", target_os = "macos")) {
+        return true;
+    }
+    let bus_env = std::env::var_os("DBUS_SESSION_BUS_ADDRESS").is_some_and(|v| !v.is_empty());
+    let bus_socket = std::env::var_os("XDG_RUNTIME_DIR")
+        .map(|d| PathBuf::from(d).join("bus"))
+        .is_some_and(|p| p.exists());
+    bus_env || bus_socket
 }
 
 /// A save dialog for one kind of file.

@@ -179,6 +179,7 @@ mod tests {
             metrics: Metrics::default(),
             history: Vec::new(),
             motion: MotionMode::Step,
+            layers: Vec::new(),
         };
         Document {
             geometries: vec![line],

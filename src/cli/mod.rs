@@ -8,7 +8,7 @@ mod progress;
 use anyhow::Result;
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use galvoplan::document::{
-    Algo, CostModel, FieldsMode, MachineProfile, MotionMode, SolverSettings, VertexMode,
+    Algo, CostModel, FieldsMode, MachineProfile, MotionMode, PenLibrary, SolverSettings, VertexMode,
 };
 use galvoplan::hatch::{HatchSettings, OutlineMode};
 use galvoplan::import::ImportOptions;
@@ -141,6 +141,11 @@ struct JobOpts {
     /// contour (closed paths of one SVG element form one region, even-odd).
     #[arg(long, value_name = "STYLE:SPACING_MM[:ANGLE_DEG]")]
     hatch: Option<String>,
+    /// Pens by layer (TOML: `version = 1`, `[default]`, `[[layer]]` with `name`, `enabled`,
+    /// `mark_speed_mm_s`, `power`, `frequency_khz`, `passes`, `colour`, `[layer.hatch]`); layers
+    /// it does not name get its default pen, with --hatch as that pen's hatch.
+    #[arg(long, value_name = "PENS.toml")]
+    pens: Option<PathBuf>,
     /// Hatch edge offset from the outline, mm (default: one spacing).
     #[arg(
         long,
@@ -170,17 +175,25 @@ impl JobOpts {
         Ok(MachineProfile::load(&self.profile)?)
     }
     fn settings(&self) -> Result<SolverSettings> {
-        anyhow::ensure!(
-            self.direction_weight.is_finite() && self.direction_weight >= 0.0,
-            "--direction-weight must be zero or positive, got {}",
-            self.direction_weight
-        );
-        if let Some(t) = self.time_limit {
-            anyhow::ensure!(
-                t.is_finite() && t > 0.0,
-                "--time-limit must be a positive number of seconds, got {t}"
-            );
-        }
+        let s = self.unchecked_settings()?;
+        s.validate().map_err(|e| {
+            let flag = match e.key.as_str() {
+                "direction_weight" => " (--direction-weight)",
+                "time_limit_s" => " (--time-limit)",
+                _ => "",
+            };
+            anyhow::anyhow!("invalid settings: {e}{flag}")
+        })?;
+        Ok(s)
+    }
+    fn pens(&self) -> Result<Option<PenLibrary>> {
+        self.pens
+            .as_deref()
+            .map(PenLibrary::load)
+            .transpose()
+            .map_err(Into::into)
+    }
+    fn unchecked_settings(&self) -> Result<SolverSettings> {
         Ok(SolverSettings {
             fields: match self.fields {
                 FieldsArg::Auto => FieldsMode::Auto,

@@ -1,5 +1,6 @@
 //! One continuous stroke of the artwork.
 
+use super::DEFAULT_LAYER;
 use crate::geom::{polyline_length, BBox, Pt};
 use serde::{Deserialize, Serialize};
 
@@ -26,6 +27,14 @@ pub struct Geometry {
     pub closed: bool,
     /// Origin in the source file.
     pub source: Source,
+    /// The layer it belongs to (its pen says how it is marked): SVG top-level group id or
+    /// label, else stroke colour; DXF layer; [`DEFAULT_LAYER`] when the import gave none.
+    #[serde(default = "default_layer")]
+    pub layer: String,
+}
+
+fn default_layer() -> String {
+    DEFAULT_LAYER.to_string()
 }
 
 impl Geometry {
@@ -42,7 +51,13 @@ impl Geometry {
             points,
             closed,
             source,
+            layer: default_layer(),
         }
+    }
+    /// The same geometry on layer `name`.
+    pub fn with_layer(mut self, name: &str) -> Self {
+        self.layer = name.to_string();
+        self
     }
     /// Bounding box.
     pub fn bbox(&self) -> BBox {

@@ -334,7 +334,7 @@ fn tool_pieces(
             laser.on_delay_s,
             Tool::Hold(start),
         );
-        let mark_s = path.strokes[stroke].length_mm / scanner.mark_speed_mm_s;
+        let mark_s = path.strokes[stroke].length_mm / plan.mark_speed_mm_s(g, profile);
         piece(SegmentKind::Mark, mark_s, Tool::Stroke(stroke));
         piece(
             SegmentKind::LaserOffDelay,

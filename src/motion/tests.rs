@@ -37,6 +37,7 @@ fn plan(fields: Vec<ScanField>, order: Vec<Step>) -> Plan {
         metrics: Metrics::default(),
         history: vec![],
         motion: Default::default(),
+        layers: vec![],
     }
 }
 

@@ -96,6 +96,7 @@ pub fn order_plan(
         metrics: m,
         history,
         motion: settings.motion,
+        layers: Vec::new(),
     })
 }
 
@@ -181,6 +182,7 @@ fn lower_ordering(
         metrics: Default::default(),
         history: Vec::new(),
         motion: settings.motion,
+        layers: Vec::new(),
     };
     // a search cancelled with a result (HGA's best so far) still gets its toolpath; a cancel
     // during the lowering itself (on the fly, seconds on large jobs) stops it
