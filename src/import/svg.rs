@@ -117,8 +117,10 @@ pub fn import_svg(bytes: &[u8], file: &str, opts: &ImportOptions) -> Result<Impo
         geometries: Vec::new(),
         warnings: &mut warnings,
         path_count: 0,
+        labels: group_labels(&xml),
+        layer: None,
     };
-    walker.group(tree.root());
+    walker.group(tree.root(), true);
     let geometries = walker.geometries;
     if geometries.is_empty() {
         let detail = if warnings.is_empty() {
@@ -188,6 +190,24 @@ struct Walker<'w> {
     geometries: Vec<Geometry>,
     warnings: &'w mut Vec<Warning>,
     path_count: usize,
+    /// `inkscape:label` of groups by id.
+    labels: std::collections::HashMap<String, String>,
+    /// The layer of the top-level group being walked (its label, else its id).
+    layer: Option<String>,
+}
+
+/// Inkscape's namespace, whose `label` names a layer.
+const INKSCAPE_NS: &str = "http://www.inkscape.org/namespaces/inkscape";
+
+/// `inkscape:label` of every `<g>` with an id and a label.
+fn group_labels(xml: &roxmltree::Document) -> std::collections::HashMap<String, String> {
+    xml.descendants()
+        .filter(|n| n.has_tag_name("g"))
+        .filter_map(|n| {
+            let label = n.attribute((INKSCAPE_NS, "label"))?;
+            Some((n.attribute("id")?.to_string(), label.to_string()))
+        })
+        .collect()
 }
 
 fn paint_hex(paint: &usvg::Paint) -> String {
@@ -198,10 +218,23 @@ fn paint_hex(paint: &usvg::Paint) -> String {
 }
 
 impl Walker<'_> {
-    fn group(&mut self, g: &usvg::Group) {
+    /// Walks a group; `top` while no named group encloses it (the first named group on the
+    /// way down is the layer).
+    fn group(&mut self, g: &usvg::Group, top: bool) {
         for node in g.children() {
             match node {
-                usvg::Node::Group(child) => self.group(child),
+                usvg::Node::Group(child) if top && !child.id().is_empty() => {
+                    let id = child.id();
+                    let name = self
+                        .labels
+                        .get(id)
+                        .cloned()
+                        .unwrap_or_else(|| id.to_string());
+                    let outer = self.layer.replace(name);
+                    self.group(child, false);
+                    self.layer = outer;
+                }
+                usvg::Node::Group(child) => self.group(child, top),
                 usvg::Node::Path(p) => self.path(p),
                 // Text and images were reported from the XML scan, with their line numbers.
                 usvg::Node::Image(_) | usvg::Node::Text(_) => {}
@@ -275,7 +308,12 @@ impl Walker<'_> {
                 layer: layer.clone(),
             };
             match normalise(pts, closed) {
-                Ok((pts, closed)) => self.geometries.push(Geometry::new(pts, closed, source)),
+                Ok((pts, closed)) => {
+                    // the top-level group, else the stroke colour
+                    let name = self.layer.as_deref().unwrap_or(&layer);
+                    let g = Geometry::new(pts, closed, source).with_layer(name);
+                    self.geometries.push(g);
+                }
                 Err(why) => self.warnings.push(Warning {
                     element: format!("{element} subpath {sub_index}"),
                     line: None,
