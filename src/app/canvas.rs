@@ -355,8 +355,9 @@ impl Canvas<'_> {
         if let Some(k) = geometry {
             let g = &self.geometries[k];
             lines.push(format!(
-                "geometry {k}: {}, {}, {} vertices, {:.2} mm long",
+                "geometry {k}: {}, layer {}, {}, {} vertices, {:.2} mm long",
                 g.describe(),
+                g.source.layer,
                 if g.closed { "closed" } else { "open" },
                 g.points.len(),
                 g.length_mm()

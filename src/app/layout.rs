@@ -81,7 +81,7 @@ impl App {
     fn menu_bar(&mut self, ui: &mut egui::Ui) {
         egui::MenuBar::new().ui(ui, |ui| {
             ui.menu_button("File", |ui| {
-                if ui.button("Open SVG or project…").clicked() {
+                if ui.button("Open SVG, DXF or project…").clicked() {
                     self.open_dialog();
                 }
                 ui.menu_button("Open recent", |ui| {
@@ -175,7 +175,7 @@ impl App {
         ui.horizontal_wrapped(|ui| {
             if ui
                 .button("Open…")
-                .on_hover_text("Open an SVG or a project (or drop a file on the window)")
+                .on_hover_text("Open an SVG, a DXF or a project (or drop a file on the window)")
                 .clicked()
             {
                 self.open_dialog();
@@ -342,7 +342,7 @@ impl App {
                 ui.label(RichText::new(s).small());
             }
             None => {
-                ui.label("No document. Open an SVG or a project.");
+                ui.label("No document. Open an SVG, a DXF or a project.");
             }
         }
         if self.has_document() {
@@ -475,7 +475,9 @@ impl App {
     fn workbench_view(&mut self, ui: &mut egui::Ui) {
         if !self.has_document() {
             ui.centered_and_justified(|ui| {
-                ui.label("Open an SVG or a project (File > Open, or drag and drop a file here).");
+                ui.label(
+                    "Open an SVG, a DXF or a project (File > Open, or drag and drop a file here).",
+                );
             });
             return;
         }

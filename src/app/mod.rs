@@ -55,9 +55,9 @@ pub const SOLVERS: &[(Algo, &str)] = &[
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct Prefs {
-    /// Machine profile used for newly opened SVGs.
+    /// Machine profile used for newly opened artwork (SVG, DXF).
     pub profile: MachineProfile,
-    /// Solver settings used for newly opened SVGs.
+    /// Solver settings used for newly opened artwork (SVG, DXF).
     pub settings: SolverSettings,
     /// Recent files.
     pub recent: Recent,
@@ -229,7 +229,8 @@ impl App {
             recent: prefs.recent,
             layers: prefs.layers,
             status: Status {
-                text: "Open an SVG or a project (File menu, or drag and drop) to start.".into(),
+                text: "Open an SVG, a DXF or a project (File menu, or drag and drop) to start."
+                    .into(),
                 error: false,
             },
             frames: FrameStats::default(),
@@ -267,7 +268,7 @@ impl App {
         !self.doc.geometries.is_empty()
     }
 
-    /// Opens an SVG (fields placed automatically) or a project file; errors go to the status
+    /// Opens an SVG or DXF (fields placed automatically) or a project file; errors go to the status
     /// line. Returns true on success.
     pub fn open(&mut self, path: &Path) -> bool {
         match files::open(path, &self.doc.profile, &self.doc.settings) {

@@ -10,7 +10,9 @@ pub struct Source {
     pub element: String,
     /// Index of the subpath inside the element (0 for the first).
     pub subpath: usize,
-    /// Layer: the stroke colour as `#rrggbb` (or `none`).
+    /// Layer name: the DXF layer; for SVG the `inkscape:label` (else the `id`) of the top-level
+    /// group holding the element, else its stroke colour as `#rrggbb` (`fill #rrggbb` when it
+    /// has only a fill, `none` when neither).
     pub layer: String,
 }
 
