@@ -272,53 +272,64 @@ impl Nurbs {
         self.knots.insert(k + 1, u);
     }
 
-    /// The rational Bézier pieces of the curve over its domain, in order.
+    /// The rational Bézier pieces of the curve over its domain, in order: each non-empty knot
+    /// span is cut out with its own `p + 1` control points and `2p + 2` knots and its knots
+    /// raised to multiplicity `p` there, so the cost is linear in the number of spans.
     pub fn bezier_pieces(&self) -> Vec<Vec<[f64; 3]>> {
         let p = self.degree;
-        let mut s = self.clone();
-        let (lo, hi) = (s.knots[p], s.knots[s.control.len()]);
-        let mut values: Vec<f64> = s
-            .knots
-            .iter()
-            .copied()
-            .filter(|&k| k >= lo && k <= hi)
-            .collect();
-        values.dedup();
-        for v in values {
-            let mult = s.knots.iter().filter(|&&k| k == v).count();
-            for _ in mult..p {
-                s.insert(v);
-            }
-        }
-        let n = s.control.len();
-        (p..n)
-            .filter(|&k| s.knots[k] < s.knots[k + 1] && s.knots[k] >= lo && s.knots[k + 1] <= hi)
-            .map(|k| s.control[k - p..=k].to_vec())
+        (p..self.control.len())
+            .filter(|&k| self.knots[k] < self.knots[k + 1])
+            .filter_map(|k| {
+                let mut local = Nurbs {
+                    degree: p,
+                    knots: self.knots[k - p..=k + p + 1].to_vec(),
+                    control: self.control[k - p..=k].to_vec(),
+                };
+                for v in [local.knots[p], local.knots[p + 1]] {
+                    let mult = local.knots.iter().filter(|&&x| x == v).count();
+                    for _ in mult..p {
+                        local.insert(v);
+                    }
+                }
+                let k = local.span(local.knots[p]);
+                local.control.get(k - p..=k).map(<[_]>::to_vec)
+            })
             .collect()
     }
 
     /// The flattened curve: one polyline, or several where the knots make it jump (a knot of
     /// multiplicity above the degree; CAD programs do not write those, but files may hold them).
-    pub fn flatten(&self, tol_mm: f64) -> Vec<Vec<Pt>> {
+    /// More than `max_points` vertices is an error (absurd weights or tolerances).
+    pub fn flatten(&self, tol_mm: f64, max_points: usize) -> Result<Vec<Vec<Pt>>, &'static str> {
         let mut paths: Vec<Vec<Pt>> = Vec::new();
+        let mut budget = Budget {
+            left: max_points,
+            tol: tol_mm.max(1e-9),
+        };
         for piece in self.bezier_pieces() {
             let Some(&start) = piece.first() else {
                 continue;
             };
             let start = dehom(start);
-            match paths.last_mut() {
-                Some(path) if path.last().is_some_and(|q| q.dist(start) <= 1e-9) => {
-                    flatten_rational_bezier(&piece, tol_mm.max(1e-9), 0, path);
-                }
-                _ => {
-                    let mut path = vec![start];
-                    flatten_rational_bezier(&piece, tol_mm.max(1e-9), 0, &mut path);
-                    paths.push(path);
-                }
+            let joined = paths
+                .last()
+                .and_then(|p| p.last())
+                .is_some_and(|q| q.dist(start) <= 1e-9);
+            if !joined {
+                paths.push(vec![start]);
+            }
+            if let Some(path) = paths.last_mut() {
+                flatten_rational_bezier(&piece, &mut budget, 0, path)?;
             }
         }
-        paths
+        Ok(paths)
     }
+}
+
+/// What a NURBS flattening may still spend.
+struct Budget {
+    left: usize,
+    tol: f64,
 }
 
 fn lerp3(a: [f64; 3], b: [f64; 3], t: f64) -> [f64; 3] {
@@ -333,18 +344,27 @@ fn dehom(h: [f64; 3]) -> Pt {
     Pt::new(h[0] / h[2], h[1] / h[2])
 }
 
-/// Appends the piece's end, or its halves', until it is within `tol` of its chord.
-fn flatten_rational_bezier(ctrl: &[[f64; 3]], tol: f64, depth: u32, out: &mut Vec<Pt>) {
+/// Appends the piece's end, or its halves', until it is within the tolerance of its chord.
+fn flatten_rational_bezier(
+    ctrl: &[[f64; 3]],
+    budget: &mut Budget,
+    depth: u32,
+    out: &mut Vec<Pt>,
+) -> Result<(), &'static str> {
     let (Some(&first), Some(&last)) = (ctrl.first(), ctrl.last()) else {
-        return;
+        return Ok(());
     };
     let (a, b) = (dehom(first), dehom(last));
     let flat = ctrl
         .iter()
-        .all(|&h| point_segment_dist(dehom(h), a, b) <= tol);
+        .all(|&h| point_segment_dist(dehom(h), a, b) <= budget.tol);
     if flat || depth >= MAX_SPLIT_DEPTH {
+        budget.left = budget
+            .left
+            .checked_sub(1)
+            .ok_or("the spline needs too many vertices")?;
         out.push(b);
-        return;
+        return Ok(());
     }
     // de Casteljau at t = 1/2 in homogeneous coordinates
     let mut left = Vec::with_capacity(ctrl.len());
@@ -358,23 +378,30 @@ fn flatten_rational_bezier(ctrl: &[[f64; 3]], tol: f64, depth: u32, out: &mut Ve
         row = row.windows(2).map(|w| lerp3(w[0], w[1], 0.5)).collect();
     }
     right.reverse();
-    flatten_rational_bezier(&left, tol, depth + 1, out);
-    flatten_rational_bezier(&right, tol, depth + 1, out);
+    flatten_rational_bezier(&left, budget, depth + 1, out)?;
+    flatten_rational_bezier(&right, budget, depth + 1, out)
 }
 
-/// The cubic interpolating spline through `fit` (chord-length parameters, C²), with end
+/// The cubic interpolating spline through `fit_points` (repeated points dropped) (chord-length parameters, C²), with end
 /// tangent directions when given (else natural ends), as Bézier control points per span:
 /// `[p0, p1, p2, p3]`.
 pub fn fit_point_spline(
-    fit: &[Pt],
+    fit_points: &[Pt],
     start_tangent: Option<Pt>,
     end_tangent: Option<Pt>,
 ) -> Vec<[Pt; 4]> {
+    // repeated fit points would make a zero-length parameter step
+    let mut fit: Vec<Pt> = Vec::with_capacity(fit_points.len());
+    for &p in fit_points {
+        if fit.last().is_none_or(|q| q.dist(p) > 1e-9) {
+            fit.push(p);
+        }
+    }
     let n = fit.len();
     if n < 2 {
         return Vec::new();
     }
-    let h: Vec<f64> = fit.windows(2).map(|w| w[0].dist(w[1]).max(1e-12)).collect();
+    let h: Vec<f64> = fit.windows(2).map(|w| w[0].dist(w[1])).collect();
     // tridiagonal system in the first derivatives m_i (per coordinate, shared matrix)
     let mut lower = vec![0.0; n];
     let mut diag = vec![0.0; n];
@@ -546,7 +573,7 @@ mod tests {
             let Ok(s) = Nurbs::new(degree, knots, &ctrl, &weights) else {
                 return Ok(());
             };
-            let paths = s.flatten(tol);
+            let paths = s.flatten(tol, 1_000_000).unwrap();
             let (lo, hi) = (s.knots[degree], s.knots[ctrl.len()]);
             let (first, last) = (&paths[0], &paths[paths.len() - 1]);
             prop_assert!(first[0].dist(s.at(lo)) < 1e-6);

@@ -574,11 +574,14 @@ fn curve_paths(t: &EntityType, m: &Affine, tol: f64) -> Result<Option<Vec<Outlin
             }
             let (a0, sweep) = (a.start_angle.to_radians(), sweep.to_radians());
             let arc = ConicArc::circle(pt(&a.center), a.radius, a0, sweep);
-            (conic_path(&arc.mapped(&m), tol), false)
+            (conic_path(&bounded_arc(arc.mapped(&m))?, tol), false)
         }
         EntityType::Circle(c) => {
             let arc = ConicArc::circle(pt(&c.center), c.radius, 0.0, TAU);
-            (closed_conic(&arc.mapped(&planar(&c.normal)?), tol), true)
+            (
+                closed_conic(&bounded_arc(arc.mapped(&planar(&c.normal)?))?, tol),
+                true,
+            )
         }
         EntityType::Ellipse(el) => ellipse_path(el, m, tol)?,
         EntityType::Spline(s) => return spline_paths(s, m, tol).map(Some),
@@ -605,6 +608,7 @@ fn ellipse_path(el: &::dxf::entities::Ellipse, m: &Affine, tol: f64) -> Result<O
         t1: el.start_parameter + sweep,
     }
     .mapped(m);
+    let arc = bounded_arc(arc)?;
     Ok(if sweep == TAU {
         (closed_conic(&arc, tol), true)
     } else {
@@ -631,8 +635,9 @@ fn bulge_path(v: &[(Pt, f64)], closed: bool, m: &Affine, tol: f64) -> Outline {
     for i in 0..segments {
         let (p0, bulge) = v[i];
         let p1 = v[(i + 1) % n].0;
-        match bulge_arc(p0, p1, bulge) {
-            Some(arc) => arc.mapped(m).flatten(tol, &mut out),
+        // an arc beyond the coordinate limit is not flattened: normalise rejects the path
+        match bulge_arc(p0, p1, bulge).and_then(|a| bounded_arc(a.mapped(m)).ok()) {
+            Some(arc) => arc.flatten(tol, &mut out),
             None => out.push(m.apply(p1)),
         }
     }
@@ -641,6 +646,23 @@ fn bulge_path(v: &[(Pt, f64)], closed: bool, m: &Affine, tol: f64) -> Outline {
         out.pop();
     }
     (out, closed)
+}
+
+const BEYOND: &str = "coordinates beyond 1 km";
+
+fn bounded(p: Pt) -> bool {
+    p.x.abs() <= MAX_COORD_MM && p.y.abs() <= MAX_COORD_MM
+}
+
+/// The arc when it lies within the coordinate limit (checked before it is flattened).
+fn bounded_arc(arc: ConicArc) -> Result<ConicArc, String> {
+    let reach = arc.u.norm() + arc.v.norm();
+    let ok = arc.t0.is_finite() && arc.t1.is_finite() && reach <= MAX_COORD_MM && bounded(arc.c);
+    if ok {
+        Ok(arc)
+    } else {
+        Err(BEYOND.into())
+    }
 }
 
 fn conic_path(arc: &ConicArc, tol: f64) -> Vec<Pt> {
@@ -664,9 +686,12 @@ fn spline_paths(s: &::dxf::entities::Spline, m: &Affine, tol: f64) -> Result<Vec
         let degree =
             usize::try_from(s.degree_of_curve).map_err(|_| "negative degree".to_string())?;
         let ctrl: Vec<Pt> = s.control_points.iter().map(|p| m.apply(pt(p))).collect();
+        if !ctrl.iter().all(|&p| bounded(p)) {
+            return Err(BEYOND.into());
+        }
         let nurbs = Nurbs::new(degree, s.knot_values.clone(), &ctrl, &s.weight_values)
             .map_err(|why| format!("invalid spline: {why}"))?;
-        let paths = nurbs.flatten(tol);
+        let paths = nurbs.flatten(tol, MAX_POINTS)?;
         let closed = closed && paths.len() == 1;
         Ok(paths.into_iter().map(|p| (p, closed)).collect())
     } else if s.fit_points.len() >= 2 {
@@ -676,16 +701,13 @@ fn spline_paths(s: &::dxf::entities::Spline, m: &Affine, tol: f64) -> Result<Vec
             (v.norm() > 0.0).then_some(v)
         };
         let spans = fit_point_spline(&fit, tangent(&s.start_tangent), tangent(&s.end_tangent));
+        let mapped: Vec<[Pt; 4]> = spans.iter().map(|b| b.map(|p| m.apply(p))).collect();
+        if !mapped.iter().flatten().all(|&p| bounded(p)) {
+            return Err(BEYOND.into());
+        }
         let mut out = vec![m.apply(fit[0])];
-        for [p0, p1, p2, p3] in spans {
-            flatten_cubic(
-                m.apply(p0),
-                m.apply(p1),
-                m.apply(p2),
-                m.apply(p3),
-                tol,
-                &mut out,
-            );
+        for [p0, p1, p2, p3] in mapped {
+            flatten_cubic(p0, p1, p2, p3, tol, &mut out);
         }
         Ok(vec![(out, closed)])
     } else {
