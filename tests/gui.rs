@@ -760,3 +760,19 @@ fn motion_plots_show_an_on_the_fly_plan() {
     assert!(h.query_by_label_contains("Scanner offset").is_none());
     assert!(h.query_by_label_contains("Motion plots").is_none());
 }
+
+#[test]
+fn a_dropped_dxf_opens_with_its_layers() {
+    let mut h = harness(App::default());
+    h.run();
+    let path = common::root().join("tests/data/dxf/entities-inch.dxf");
+    h.input_mut().dropped_files.push(egui::DroppedFile {
+        path: Some(path),
+        ..Default::default()
+    });
+    h.run();
+    let doc = &h.state().doc;
+    assert_eq!(doc.geometries.len(), 26, "{}", h.state().status());
+    assert!(doc.geometries.iter().any(|g| g.source.layer == "CUT"));
+    assert!(!doc.fields.is_empty());
+}
