@@ -6,7 +6,7 @@ use crate::document::{
 };
 use crate::fields::{place_fields, split_oversize, FieldError, Placement};
 use crate::hatch::{is_hatch_output, layer_geometries, HatchError};
-use crate::import::{import_svg_file, ImportError, ImportOptions};
+use crate::import::{import_file, ImportError, ImportOptions};
 use crate::job::JobCtx;
 use crate::motion::{lower_motion, MotionError, Toolpath};
 use crate::order::{order_plan, OrderError};
@@ -68,8 +68,9 @@ pub enum PipelineError {
     },
 }
 
-/// Imports an SVG into a new document with the given profile and settings; returns it with the
-/// import time in s.
+/// Imports an SVG or DXF file ([`import_file`]) into a new document with the given profile and
+/// settings; returns it with the import time in s. A DXF drawing is placed in the profile's
+/// base stroke where its extents allow (`opts.work_area_mm` unset is taken from the profile).
 pub fn load_svg(
     path: &Path,
     profile: MachineProfile,
@@ -77,7 +78,11 @@ pub fn load_svg(
     opts: &ImportOptions,
 ) -> Result<(Document, f64), PipelineError> {
     let t0 = Instant::now();
-    let imported = import_svg_file(path, opts)?;
+    let mut opts = opts.clone();
+    if opts.work_area_mm.is_none() {
+        opts.work_area_mm = Some(profile.stroke_mm);
+    }
+    let imported = import_file(path, &opts)?;
     let mut layers = Vec::new();
     sync_layers(&mut layers, &imported.geometries, &default_pen(&settings));
     let doc = Document {

@@ -69,15 +69,21 @@ fn plan_writes_gcode_report_preview_geometry() {
 fn bad_inputs_exit_nonzero_with_one_line_naming_the_file() {
     let dir = tempfile::tempdir().unwrap();
     let full = std::fs::read_to_string(common::root().join("assets/examples/demo.svg")).unwrap();
-    let cases: [(&str, &[u8], &str); 4] = [
+    let dxf = std::fs::read(common::root().join("tests/data/dxf/entities-inch.dxf")).unwrap();
+    let garbage: Vec<u8> = (0..3000u32)
+        .map(|i| (i.wrapping_mul(2_654_435_761) >> 11) as u8)
+        .collect();
+    let cases: [(&str, &[u8], &str); 6] = [
         ("truncated.svg", &full.as_bytes()[..full.len() / 3], "malformed XML"),
         ("empty.svg", b"", "empty file"),
         ("notes.svg", b"just some notes\n", "not a valid SVG"),
         (
-            "text.svg",
-            br#"<svg xmlns="http://www.w3.org/2000/svg" width="10mm" height="10mm"><text x="1" y="5">hi</text></svg>"#,
+            "image.svg",
+            br#"<svg xmlns="http://www.w3.org/2000/svg" width="10mm" height="10mm"><image x="1" y="5" width="2" height="2" href="a.png"/></svg>"#,
             "no markable geometry",
         ),
+        ("truncated.dxf", &dxf[..dxf.len() / 2], "not a valid DXF"),
+        ("garbage.dxf", &garbage, "not a valid DXF"),
     ];
     for (name, bytes, what) in cases {
         let p = dir.path().join(name);
@@ -357,4 +363,26 @@ fn plan_with_pens_writes_each_layers_power_feed_and_passes() {
             && err.contains("Layer 'fill': Mark speed (mm/s) must be a positive number, not -3"),
         "{err}"
     );
+}
+
+#[test]
+fn plan_takes_dxf_and_text_labels() {
+    let dir = tempfile::tempdir().unwrap();
+    for (input, geometries) in [
+        ("tests/data/dxf/entities-inch.dxf", 26),
+        ("assets/examples/label.svg", 25),
+    ] {
+        let gcode = dir.path().join("job.gcode").display().to_string();
+        let report = dir.path().join("job.json").display().to_string();
+        let path = common::root().join(input).display().to_string();
+        let out = galvoplan(&["plan", &path, "-o", &gcode, "--report", &report]);
+        assert!(
+            out.status.success(),
+            "{input}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let r: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+        assert_eq!(r["order"].as_array().unwrap().len(), geometries, "{input}");
+    }
 }

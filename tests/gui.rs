@@ -51,6 +51,18 @@ fn section(h: &mut Harness<'_, App>, name: &str) {
     h.run();
 }
 
+/// A file dropped on the window.
+#[derive(Debug)]
+struct Dropped(PathBuf);
+impl egui::DroppedFile for Dropped {
+    fn path(&self) -> &Path {
+        &self.0
+    }
+    fn bytes(&self) -> Result<Vec<u8>, String> {
+        std::fs::read(&self.0).map_err(|e| e.to_string())
+    }
+}
+
 fn ctrl() -> Modifiers {
     Modifiers::COMMAND | Modifiers::CTRL
 }
@@ -421,16 +433,6 @@ fn project_round_trip_and_drag_and_drop() {
     assert!(std::fs::read_to_string(&gcode).unwrap().contains("G21"));
 
     // a fresh window; the project is dropped on it
-    #[derive(Debug)]
-    struct Dropped(PathBuf);
-    impl egui::DroppedFile for Dropped {
-        fn path(&self) -> &Path {
-            &self.0
-        }
-        fn bytes(&self) -> Result<Vec<u8>, String> {
-            std::fs::read(&self.0).map_err(|e| e.to_string())
-        }
-    }
     let mut h2 = harness(App::default());
     h2.run();
     h2.input_mut()
@@ -496,13 +498,13 @@ fn import_warnings_are_listed() {
         &svg,
         r#"<svg xmlns="http://www.w3.org/2000/svg" width="100mm" height="100mm" viewBox="0 0 100 100">
 <rect x="10" y="10" width="5" height="5" fill="none" stroke="black"/>
-<text id="caption" x="20" y="20">hello</text></svg>"#,
+<image id="photo" x="20" y="20" width="10" height="10" href="p.png"/></svg>"#,
     )
     .unwrap();
     let h = opened(&svg);
     assert_eq!(h.state().doc.warnings.len(), 1);
     h.get_by_label("Import warnings (1)");
-    h.get_by_label_contains("caption");
+    h.get_by_label_contains("photo");
 }
 
 /// Frame time of `App::ui` while a solve runs on a large instance (not run by default):
@@ -1004,4 +1006,20 @@ fn fields_are_numbered_from_one_in_placement_then_visiting_order() {
     }
     // no debug timings in the status bar unless the View option asks for them
     assert!(h.query_by_label_contains(" ms (max ").is_none());
+}
+
+#[test]
+fn a_dropped_dxf_opens_with_its_layers() {
+    let mut h = harness(App::default());
+    h.run();
+    let path = common::root().join("tests/data/dxf/entities-inch.dxf");
+    h.input_mut()
+        .dropped_files
+        .push(std::sync::Arc::new(Dropped(path)));
+    h.step();
+    wait_idle(&mut h, Duration::from_secs(60));
+    let doc = &h.state().doc;
+    assert_eq!(doc.geometries.len(), 26, "{}", h.state().status());
+    assert!(doc.geometries.iter().any(|g| g.source.layer == "CUT"));
+    assert!(!doc.fields.is_empty());
 }

@@ -30,11 +30,14 @@ impl Recent {
     }
 }
 
-/// True for an SVG (by extension); everything else is read as a project file.
-pub fn is_svg(path: &Path) -> bool {
+/// Extensions of artwork files (imported by [`crate::import::import_file`]).
+pub const ARTWORK_EXTS: [&str; 3] = ["svg", "svgz", "dxf"];
+
+/// True for artwork, SVG or DXF (by extension); everything else is read as a project file.
+pub fn is_artwork(path: &Path) -> bool {
     path.extension()
         .and_then(|e| e.to_str())
-        .is_some_and(|e| e.eq_ignore_ascii_case("svg") || e.eq_ignore_ascii_case("svgz"))
+        .is_some_and(|e| ARTWORK_EXTS.iter().any(|x| e.eq_ignore_ascii_case(x)))
 }
 
 /// The result of opening a file.
@@ -47,7 +50,7 @@ pub struct Opened {
     pub is_project: bool,
 }
 
-/// Opens an SVG (imported with `profile` and `settings`, fields placed automatically as the CLI
+/// Opens an SVG or DXF (imported with `profile` and `settings`, fields placed automatically as the CLI
 /// places them) or a project file (with its own profile, settings, fields and plans).
 pub fn open(
     path: &Path,
@@ -55,7 +58,7 @@ pub fn open(
     settings: &SolverSettings,
     ctx: &JobCtx,
 ) -> Result<Opened, String> {
-    if is_svg(path) {
+    if is_artwork(path) {
         let (mut doc, _) = load_svg(
             path,
             profile.clone(),
@@ -125,14 +128,14 @@ pub fn export(doc: &Document, plan: &Plan, kind: ExportKind, path: &Path) -> Res
         .map_err(|e| format!("{}: cannot write: {e}", path.display()))
 }
 
-/// The open dialog (SVG or project).
+/// The open dialog (SVG, DXF or project).
 pub fn pick_open() -> Option<PathBuf> {
     rfd::FileDialog::new()
         .add_filter(
-            "SVG or galvoplan project",
-            &["svg", "svgz", PROJECT_EXT, "json"],
+            "SVG, DXF or galvoplan project",
+            &["svg", "svgz", "dxf", PROJECT_EXT, "json"],
         )
-        .add_filter("SVG", &["svg", "svgz"])
+        .add_filter("SVG or DXF artwork", &ARTWORK_EXTS)
         .add_filter("galvoplan project", &[PROJECT_EXT, "json"])
         .pick_file()
 }

@@ -234,7 +234,7 @@ impl LayerEditor {
                 let hint = |c: Col| match c {
                     Col::Speed => format!("{}", profile.scanner.mark_speed_mm_s),
                     Col::Power => profile.gcode.power.map_or("none".into(), |p| p.to_string()),
-                    Col::Edge => "= spacing".into(),
+                    Col::Edge => "spacing".into(),
                     _ => String::new(),
                 };
                 let hatched = layer.pen.hatch.is_some();

@@ -19,7 +19,7 @@ impl App {
         if self.tab == Tab::Workbench {
             egui::Panel::left("left")
                 .resizable(true)
-                .default_size(330.0)
+                .default_size(370.0)
                 .show(ui, |ui| {
                     egui::ScrollArea::vertical().show(ui, |ui| self.left_panel(ui));
                 });
@@ -59,7 +59,7 @@ impl App {
                     self.request_new();
                 }
                 if ui
-                    .add(egui::Button::new("Open SVG or project…").shortcut_text("Ctrl+O"))
+                    .add(egui::Button::new("Open SVG, DXF or project…").shortcut_text("Ctrl+O"))
                     .clicked()
                 {
                     self.request_open(None, &ctx);
@@ -168,7 +168,9 @@ impl App {
             let ctx = ui.ctx().clone();
             if ui
                 .button("Open…")
-                .on_hover_text("Open an SVG or a project (Ctrl+O, or drop a file on the window)")
+                .on_hover_text(
+                    "Open an SVG, a DXF or a project (Ctrl+O, or drop a file on the window)",
+                )
                 .clicked()
             {
                 self.request_open(None, &ctx);
@@ -370,7 +372,7 @@ impl App {
                 ui.label(RichText::new(s).small());
             }
             None => {
-                ui.label("No document. Open an SVG or a project.");
+                ui.label("No document. Open an SVG, a DXF or a project.");
             }
         }
         if self.has_document() {
@@ -536,7 +538,9 @@ impl App {
     fn workbench_view(&mut self, ui: &mut egui::Ui) {
         if !self.has_document() {
             ui.centered_and_justified(|ui| {
-                ui.label("Open an SVG or a project (File > Open, or drag and drop a file here).");
+                ui.label(
+                    "Open an SVG, a DXF or a project (File > Open, or drag and drop a file here).",
+                );
             });
             return;
         }
@@ -553,7 +557,10 @@ impl App {
             profile: &self.doc.profile,
             fields: &self.doc.fields,
             visiting: plan.map(|p| p.fields.as_slice()),
-            colours: Some(&self.colours),
+            // layer colours when the layers tell something apart (several, or a hatch)
+            colours: (self.doc.layers.len() > 1
+                || self.doc.layers.iter().any(|l| l.pen.hatch.is_some()))
+            .then_some(self.colours.as_slice()),
             out_of_reach: &self.out_of_reach,
             paths: plan
                 .zip(lowered)

@@ -61,9 +61,9 @@ pub const SOLVERS: &[(Algo, &str)] = &[
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct Prefs {
-    /// Machine profile used for newly opened SVGs.
+    /// Machine profile used for newly opened artwork (SVG, DXF).
     pub profile: MachineProfile,
-    /// Solver settings used for newly opened SVGs.
+    /// Solver settings used for newly opened artwork (SVG, DXF).
     pub settings: SolverSettings,
     /// Recent files.
     pub recent: Recent,
@@ -262,7 +262,8 @@ impl App {
             recent: prefs.recent,
             layers: prefs.layers,
             status: Status {
-                text: "Open an SVG or a project (File menu, or drag and drop) to start.".into(),
+                text: "Open an SVG, a DXF or a project (File menu, or drag and drop) to start."
+                    .into(),
                 error: false,
             },
             frames: FrameStats::default(),
@@ -333,7 +334,7 @@ impl App {
         !self.doc.geometries.is_empty()
     }
 
-    /// Opens an SVG (fields placed automatically) or a project file on this thread (the
+    /// Opens an SVG or DXF (fields placed automatically) or a project file on this thread (the
     /// command-line argument and tests); errors go to the status line. Returns true on success.
     pub fn open(&mut self, path: &Path) -> bool {
         match files::open(

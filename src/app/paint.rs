@@ -190,8 +190,10 @@ fn paint_artwork(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
             None if g.closed => colour::CLOSED,
             None => colour::OPEN,
         };
+        // layer colours (several layers or a hatch) win over the colours by order
+        let by_layer = c.colours.is_some();
         let col = match &rank {
-            Some(r) if r[k] >= 0.0 => lerp(colour::ORDER[0], colour::ORDER[1], r[k]),
+            Some(r) if r[k] >= 0.0 && !by_layer => lerp(colour::ORDER[0], colour::ORDER[1], r[k]),
             _ => base,
         }
         .gamma_multiply(fade);

@@ -20,13 +20,13 @@ use std::path::PathBuf;
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
-    /// With no subcommand: an SVG or project file to open in the GUI.
+    /// With no subcommand: an SVG, DXF or project file to open in the GUI.
     file: Option<PathBuf>,
 }
 
 #[derive(Subcommand, Debug)]
 enum Command {
-    /// Plan one job: SVG in, G-code (and report, preview) out.
+    /// Plan one job: SVG or DXF in, G-code (and report, preview) out.
     Plan(PlanArgs),
     /// Run the pipeline over SVG files or folders and print one row per instance.
     Bench(BenchArgs),
@@ -254,13 +254,14 @@ impl JobOpts {
         );
         Ok(ImportOptions {
             chord_tol_mm: self.chord_tol,
+            ..ImportOptions::default()
         })
     }
 }
 
 #[derive(Args, Debug)]
 struct PlanArgs {
-    /// Input SVG.
+    /// Input SVG or DXF.
     input: PathBuf,
     /// Output G-code.
     #[arg(short, long)]
