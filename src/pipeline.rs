@@ -1,9 +1,12 @@
 //! The whole pipeline on a [`Document`]: import → fields → order → metrics, with stage times.
 
-use crate::document::{Document, MachineProfile, MotionMode, Plan, ScanField, SolverSettings};
+use crate::document::{
+    pen_of, sync_layers, DerivedKey, Document, Geometry, Layer, MachineProfile, MotionMode, Pen,
+    PenLibrary, Plan, ScanField, SolverSettings, Step,
+};
 use crate::fields::{place_fields, split_oversize, FieldError, Placement};
-use crate::hatch::{hatch_geometries, is_hatch_output, HatchError};
-use crate::import::{import_svg_file, ImportError, ImportOptions};
+use crate::hatch::{is_hatch_output, layer_geometries, HatchError};
+use crate::import::{import_file, ImportError, ImportOptions};
 use crate::job::JobCtx;
 use crate::motion::{lower_motion, MotionError, Toolpath};
 use crate::order::{order_plan, OrderError};
@@ -49,6 +52,12 @@ pub enum PipelineError {
         /// The cause.
         source: crate::export::GcodeError,
     },
+    /// Every layer is disabled.
+    #[error("{file}: every layer is disabled: nothing to mark")]
+    AllDisabled {
+        /// The document's source file.
+        file: String,
+    },
     /// Hatching failed.
     #[error("{file}: {source}")]
     Hatch {
@@ -59,8 +68,9 @@ pub enum PipelineError {
     },
 }
 
-/// Imports an SVG into a new document with the given profile and settings; returns it with the
-/// import time in s.
+/// Imports an SVG or DXF file ([`import_file`]) into a new document with the given profile and
+/// settings; returns it with the import time in s. A DXF drawing is placed in the profile's
+/// base stroke where its extents allow (`opts.work_area_mm` unset is taken from the profile).
 pub fn load_svg(
     path: &Path,
     profile: MachineProfile,
@@ -68,10 +78,19 @@ pub fn load_svg(
     opts: &ImportOptions,
 ) -> Result<(Document, f64), PipelineError> {
     let t0 = Instant::now();
-    let imported = import_svg_file(path, opts)?;
+    let mut opts = opts.clone();
+    if opts.work_area_mm.is_none() {
+        opts.work_area_mm = Some(profile.stroke_mm);
+    }
+    let imported = import_file(path, &opts)?;
+    let mut layers = Vec::new();
+    sync_layers(&mut layers, &imported.geometries, &default_pen(&settings));
     let doc = Document {
         source: Some(path.display().to_string()),
         page_mm: imported.page_mm,
+        artwork: imported.geometries.clone(),
+        layers,
+        derived_with: None,
         geometries: imported.geometries,
         warnings: imported.warnings,
         profile,
@@ -87,7 +106,7 @@ pub fn load_svg(
 /// `split_oversize`, geometries larger than a field are first cut into pieces (and reported as
 /// warnings). The plan is not added to `doc.plans`.
 pub fn plan_document(doc: &mut Document, ctx: &JobCtx) -> Result<Plan, PipelineError> {
-    let hatch_s = apply_hatch(doc, ctx)?;
+    let hatch_s = derive_geometries(doc, ctx)?;
     let t0 = Instant::now();
     let lower_bound = place_document_fields(doc, ctx)?;
     let fields_s = t0.elapsed().as_secs_f64();
@@ -100,43 +119,151 @@ pub fn plan_document(doc: &mut Document, ctx: &JobCtx) -> Result<Plan, PipelineE
     Ok(plan)
 }
 
-/// The hatch stage: with `settings.hatch` set, fills the closed geometries (one region per SVG
-/// element, see [`hatch_geometries`]) and replaces the document's geometries with the outlines
-/// (as the settings say) and the hatch, each hatch geometry small enough for one scan field.
-/// Does nothing when the document already holds hatch output (so it runs once per import).
-/// Returns the wall time in s.
-pub fn apply_hatch(doc: &mut Document, ctx: &JobCtx) -> Result<f64, PipelineError> {
+/// The hatch stage: makes the geometries to mark from the artwork and its layers' pens
+/// ([`layer_geometries`]: disabled layers left out, hatched layers filled, each hatch geometry
+/// small enough for one scan field). Layers the table lacks are added first with the default
+/// pen (whose hatch is `settings.hatch`, the CLI's `--hatch`). Runs only when the layers'
+/// names, enabled flags or hatches or the field size changed since the geometries were last
+/// made; when the geometries change, fields and plans of the old list are cleared (indices
+/// changed). Returns the wall time in s.
+pub fn derive_geometries(doc: &mut Document, ctx: &JobCtx) -> Result<f64, PipelineError> {
     let t0 = Instant::now();
-    let Some(settings) = doc.settings.hatch.clone() else {
-        return Ok(0.0);
-    };
-    if doc.geometries.iter().any(is_hatch_output) {
+    if doc.artwork.is_empty() {
+        // a document made before pens (or by hand): its geometries are the artwork
+        doc.artwork = doc
+            .geometries
+            .iter()
+            .filter(|g| !is_hatch_output(g))
+            .cloned()
+            .collect();
+    }
+    sync_layers(&mut doc.layers, &doc.artwork, &default_pen(&doc.settings));
+    let key = DerivedKey::of(&doc.layers, doc.profile.field_mm);
+    if doc.derived_with.as_ref() == Some(&key) {
         return Ok(0.0);
     }
-    let hatched = hatch_geometries(&doc.geometries, &settings, doc.profile.field_mm, ctx).map_err(
+    let made = layer_geometries(&doc.artwork, &doc.layers, doc.profile.field_mm, ctx).map_err(
         |source| PipelineError::Hatch {
             file: doc.source.clone().unwrap_or_else(|| "document".into()),
             source,
         },
     )?;
-    doc.geometries = hatched.geometries;
-    for w in hatched.warnings {
-        // a hatch that left no output runs again on the next call: report it once
+    if made.geometries != doc.geometries {
+        doc.geometries = made.geometries;
+        // indices changed: fields and plans of the old geometry list are void
+        doc.fields.clear();
+        doc.plans.clear();
+    }
+    for w in made.warnings {
         if !doc.warnings.contains(&w) {
             doc.warnings.push(w);
         }
     }
-    // indices changed: fields and plans of the old geometry list are void
-    doc.fields.clear();
-    doc.plans.clear();
+    doc.derived_with = Some(key);
     Ok(t0.elapsed().as_secs_f64())
 }
 
-/// The field stage alone: hatches (once, when the settings ask for it), splits oversize
+/// The pen of layers nothing else names: defaults, with the settings' hatch (`--hatch`).
+pub fn default_pen(settings: &SolverSettings) -> Pen {
+    Pen {
+        hatch: settings.hatch.clone(),
+        ..Pen::default()
+    }
+}
+
+/// Gives the document's layers the pens of a library (`--pens`; the library's default pen, or
+/// the settings' hatch as the default pen's hatch, for layers it does not name); returns the
+/// names the library has but the document lacks. The geometries are made again on the next
+/// [`derive_geometries`].
+pub fn apply_pen_library(doc: &mut Document, library: &PenLibrary) -> Vec<String> {
+    sync_layers(&mut doc.layers, &doc.artwork, &default_pen(&doc.settings));
+    let mut library = library.clone();
+    if let Some(h) = &doc.settings.hatch {
+        let d = library.default.get_or_insert_with(Pen::default);
+        if d.hatch.is_none() {
+            d.hatch = Some(h.clone());
+        }
+    }
+    library.apply(&mut doc.layers)
+}
+
+/// Repeats each layer's strokes for its passes: inside each run of one field, the run's
+/// strokes are marked again, in the same order, once for every further pass of their layer
+/// (the stage does not move between passes).
+pub fn expand_passes(order: &[Step], geometries: &[Geometry], layers: &[Layer]) -> Vec<Step> {
+    let passes = |s: &Step| {
+        geometries
+            .get(s.geometry)
+            .and_then(|g| pen_of(layers, g))
+            .map_or(1, |p| p.passes)
+    };
+    let mut out = Vec::with_capacity(order.len());
+    for run in order.chunk_by(|a, b| a.field == b.field) {
+        let most = run.iter().map(passes).max().unwrap_or(1);
+        for pass in 0..most {
+            out.extend(run.iter().filter(|s| passes(s) > pass));
+        }
+    }
+    out
+}
+
+/// Gives a fresh plan the document's layers (its pens: mark speeds, powers, passes): repeats
+/// strokes for passes, and when a pen changes speed or passes lowers it again and computes its
+/// metrics on that toolpath. A seed 001 stage route (planned on the profile's speeds) is
+/// planned again on the pens' time law.
+fn apply_pens(doc: &Document, plan: &mut Plan, ctx: &JobCtx) -> Result<(), PipelineError> {
+    plan.layers = doc.layers.clone();
+    let timed = plan
+        .layers
+        .iter()
+        .any(|l| l.pen.mark_speed_mm_s.is_some() || l.pen.passes > 1);
+    if !timed {
+        return Ok(());
+    }
+    plan.order = expand_passes(&plan.order, &doc.geometries, &plan.layers);
+    if plan.stage_route.is_some() {
+        let s = &doc.settings;
+        plan.stage_route = crate::motion::plan_stage_route(
+            &doc.geometries,
+            plan,
+            &doc.profile,
+            s.stage_route,
+            &s.route_ga,
+            s.seed,
+            ctx,
+        )
+        .map_err(|e| PipelineError::Lower {
+            file: doc.source.clone().unwrap_or_else(|| "document".into()),
+            source: MotionError::OnTheFly(e),
+        })?;
+    }
+    let toolpath = lower_plan(doc, plan)?;
+    let m = crate::order::metrics::compute(
+        &doc.geometries,
+        &plan.fields,
+        &plan.order,
+        &doc.profile,
+        &toolpath,
+    );
+    plan.metrics = crate::document::Metrics {
+        solve_s: std::mem::take(&mut plan.metrics.solve_s),
+        fields_lower_bound: plan.metrics.fields_lower_bound,
+        ..m
+    };
+    Ok(())
+}
+
+/// The field stage alone: makes the geometries from the layers (when they changed, see
+/// [`derive_geometries`]), splits oversize
 /// geometries when the settings say so, then places the fields (keeping locked ones) and
 /// allocates the geometries. Returns the lower bound on fields.
 pub fn place_document_fields(doc: &mut Document, ctx: &JobCtx) -> Result<usize, PipelineError> {
-    apply_hatch(doc, ctx)?;
+    derive_geometries(doc, ctx)?;
+    if doc.geometries.is_empty() && !doc.artwork.is_empty() {
+        return Err(PipelineError::AllDisabled {
+            file: doc.source.clone().unwrap_or_else(|| "document".into()),
+        });
+    }
     let file = doc.source.clone().unwrap_or_else(|| "document".into());
     if doc.settings.split_oversize {
         let warnings = split_oversize(&mut doc.geometries, doc.profile.field_mm);
@@ -197,6 +324,7 @@ pub fn order_document(doc: &Document, ctx: &JobCtx) -> Result<Plan, PipelineErro
     )
     .map_err(|source| PipelineError::Order { file, source })?;
     plan.metrics.solve_s.total = plan.metrics.solve_s.order;
+    apply_pens(doc, &mut plan, ctx)?;
     if let Some(r) = ctx.recorder() {
         r.plan(&plan, &lower_plan(doc, &plan)?);
     }

@@ -69,15 +69,21 @@ fn plan_writes_gcode_report_preview_geometry() {
 fn bad_inputs_exit_nonzero_with_one_line_naming_the_file() {
     let dir = tempfile::tempdir().unwrap();
     let full = std::fs::read_to_string(common::root().join("assets/examples/demo.svg")).unwrap();
-    let cases: [(&str, &[u8], &str); 4] = [
+    let dxf = std::fs::read(common::root().join("tests/data/dxf/entities-inch.dxf")).unwrap();
+    let garbage: Vec<u8> = (0..3000u32)
+        .map(|i| (i.wrapping_mul(2_654_435_761) >> 11) as u8)
+        .collect();
+    let cases: [(&str, &[u8], &str); 6] = [
         ("truncated.svg", &full.as_bytes()[..full.len() / 3], "malformed XML"),
         ("empty.svg", b"", "empty file"),
         ("notes.svg", b"just some notes\n", "not a valid SVG"),
         (
-            "text.svg",
-            br#"<svg xmlns="http://www.w3.org/2000/svg" width="10mm" height="10mm"><text x="1" y="5">hi</text></svg>"#,
+            "image.svg",
+            br#"<svg xmlns="http://www.w3.org/2000/svg" width="10mm" height="10mm"><image x="1" y="5" width="2" height="2" href="a.png"/></svg>"#,
             "no markable geometry",
         ),
+        ("truncated.dxf", &dxf[..dxf.len() / 2], "not a valid DXF"),
+        ("garbage.dxf", &garbage, "not a valid DXF"),
     ];
     for (name, bytes, what) in cases {
         let p = dir.path().join(name);
@@ -297,4 +303,107 @@ fn on_the_fly_plans_oversize_artwork_without_splitting() {
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("population"));
     assert!(!std::path::Path::new(&d("bad.gcode")).exists());
+}
+
+#[test]
+fn plan_with_pens_writes_each_layers_power_feed_and_passes() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = |n: &str| dir.path().join(n).display().to_string();
+    let ex = |n: &str| {
+        common::root()
+            .join("assets/examples")
+            .join(n)
+            .display()
+            .to_string()
+    };
+    let run = |extra: &[&str], out: &str| {
+        let mut args = vec![
+            "plan".to_string(),
+            ex("two-layers.svg"),
+            "-o".into(),
+            d(&format!("{out}.gcode")),
+            "--report".into(),
+            d(&format!("{out}.json")),
+        ];
+        args.extend(extra.iter().map(|s| s.to_string()));
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let o = galvoplan(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let report: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(d(&format!("{out}.json"))).unwrap())
+                .unwrap();
+        (
+            std::fs::read_to_string(d(&format!("{out}.gcode"))).unwrap(),
+            report,
+        )
+    };
+    let pens = ex("two-layers.pens.toml");
+    let (gcode, report) = run(&["--pens", &pens], "pens");
+    assert!(
+        gcode.contains("\nM3 S40\n") && gcode.contains("\nM3 S85\n"),
+        "both powers"
+    );
+    assert!(
+        gcode.contains(" F90000\n") && gcode.contains(" F36000\n"),
+        "both feeds"
+    );
+    let (plain_gcode, plain) = run(&[], "plain");
+    assert!(!plain_gcode.contains(" S85"));
+    let job = |r: &serde_json::Value| r["metrics"]["job_time_s"].as_f64().unwrap();
+    let mark = |r: &serde_json::Value| {
+        r["metrics"]["job_time_breakdown_s"]["mark"]
+            .as_f64()
+            .unwrap()
+    };
+    // hatched and marked twice at 600 mm/s: far more marking than the outlines at 1000 mm/s
+    assert!(
+        mark(&report) > 3.0 * mark(&plain),
+        "{} vs {}",
+        mark(&report),
+        mark(&plain)
+    );
+    assert!(job(&report) > job(&plain));
+    // a bad pens file is one worded line naming the file
+    std::fs::write(
+        d("bad.toml"),
+        "version = 1\n[[layer]]\nname = \"fill\"\nmark_speed_mm_s = -3\n",
+    )
+    .unwrap();
+    let o = galvoplan(&[
+        "plan",
+        &ex("two-layers.svg"),
+        "-o",
+        &d("x.gcode"),
+        "--pens",
+        &d("bad.toml"),
+    ]);
+    assert!(!o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("bad.toml")
+            && err.contains("Layer 'fill': Mark speed (mm/s) must be a positive number, not -3"),
+        "{err}"
+    );
+}
+
+#[test]
+fn plan_takes_dxf_and_text_labels() {
+    let dir = tempfile::tempdir().unwrap();
+    for (input, geometries) in [
+        ("tests/data/dxf/entities-inch.dxf", 26),
+        ("assets/examples/label.svg", 25),
+    ] {
+        let gcode = dir.path().join("job.gcode").display().to_string();
+        let report = dir.path().join("job.json").display().to_string();
+        let path = common::root().join(input).display().to_string();
+        let out = galvoplan(&["plan", &path, "-o", &gcode, "--report", &report]);
+        assert!(
+            out.status.success(),
+            "{input}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let r: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+        assert_eq!(r["order"].as_array().unwrap().len(), geometries, "{input}");
+    }
 }

@@ -45,6 +45,24 @@ fn wait_idle(h: &mut Harness<'_, App>, limit: Duration) {
     h.run_ok();
 }
 
+/// Shows a section of the left panel ("Layers (n)", "Solver settings", "Machine profile").
+fn section(h: &mut Harness<'_, App>, name: &str) {
+    h.get_by_label(name).click();
+    h.run();
+}
+
+/// A file dropped on the window.
+#[derive(Debug)]
+struct Dropped(PathBuf);
+impl egui::DroppedFile for Dropped {
+    fn path(&self) -> &Path {
+        &self.0
+    }
+    fn bytes(&self) -> Result<Vec<u8>, String> {
+        std::fs::read(&self.0).map_err(|e| e.to_string())
+    }
+}
+
 fn ctrl() -> Modifiers {
     Modifiers::COMMAND | Modifiers::CTRL
 }
@@ -176,9 +194,10 @@ fn add_lock_delete_and_replace_fields() {
     h.get_by_label("Lock").click();
     h.run();
     assert!(h.state().doc.fields.iter().any(|f| f.id == id && f.locked));
-    // re-placing keeps the locked field
+    // re-placing keeps the locked field (a background job)
     h.get_by_label("Re-place automatically").click();
-    h.run();
+    h.step();
+    wait_idle(&mut h, Duration::from_secs(60));
     assert!(h.state().doc.fields.iter().any(|f| f.id == id && f.locked));
     assert!(h.state().uncovered().is_empty());
     h.get_by_label("Delete field").click();
@@ -190,6 +209,18 @@ fn add_lock_delete_and_replace_fields() {
         h.run();
     }
     assert_eq!(h.state().doc.fields.len(), n);
+}
+
+/// Types `text` into the `n`-th field labelled `label` and presses Enter; steps once (a
+/// background job may start).
+fn enter_nth(h: &mut Harness<'_, App>, label: &str, n: usize, text: &str) {
+    nth_by_label(h, label, n).focus();
+    h.run();
+    h.key_press_modifiers(ctrl(), Key::A);
+    nth_by_label(h, label, n).type_text(text);
+    h.run();
+    h.key_press(Key::Enter);
+    h.step();
 }
 
 fn set_text(h: &mut Harness<'_, App>, label: &str, text: &str) {
@@ -205,19 +236,24 @@ fn set_text(h: &mut Harness<'_, App>, label: &str, text: &str) {
 #[test]
 fn invalid_profile_and_settings_input_is_rejected() {
     let mut h = opened(&demo());
+    section(&mut h, "Machine profile");
     set_text(&mut h, "Field width (mm)", "-5");
-    h.get_by_label_contains("field_mm[0] = -5 must be a positive number");
+    // worded, without file keys
+    h.get_by_label("Field width (mm) must be a positive number, not -5");
+    assert!(h.query_by_label_contains("field_mm").is_none());
     assert_eq!(h.state().doc.profile.field_mm, [70.0, 70.0]);
     set_text(&mut h, "Field width (mm)", "abc");
-    h.get_by_label_contains("'abc' is not a number");
+    h.get_by_label_contains("Field width (mm): 'abc' is not a number");
     assert_eq!(h.state().doc.profile.field_mm, [70.0, 70.0]);
+    section(&mut h, "Solver settings");
     set_text(&mut h, "GA mutation rate", "1.5");
-    h.get_by_label_contains("must lie in [0, 1]");
+    h.get_by_label("GA mutation rate must be between 0 and 1, not 1.5");
     assert_eq!(
         h.state().doc.settings.ga.mutation_rate,
         SolverSettings::default().ga.mutation_rate
     );
     // a valid value is applied, resizes the fields and can be undone
+    section(&mut h, "Machine profile");
     set_text(&mut h, "Field width (mm)", "60");
     assert!(h
         .query_by_label_contains("must be a positive number")
@@ -262,6 +298,7 @@ fn same_plan_as_cli(algo: &str, button: &str) {
         serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
 
     let mut h = opened(&demo());
+    section(&mut h, "Solver settings");
     set_text(&mut h, "Seed", "7");
     assert_eq!(h.state().doc.settings.seed, 7);
     h.get_by_label(button).click();
@@ -396,22 +433,13 @@ fn project_round_trip_and_drag_and_drop() {
     assert!(std::fs::read_to_string(&gcode).unwrap().contains("G21"));
 
     // a fresh window; the project is dropped on it
-    #[derive(Debug)]
-    struct Dropped(PathBuf);
-    impl egui::DroppedFile for Dropped {
-        fn path(&self) -> &Path {
-            &self.0
-        }
-        fn bytes(&self) -> Result<Vec<u8>, String> {
-            std::fs::read(&self.0).map_err(|e| e.to_string())
-        }
-    }
     let mut h2 = harness(App::default());
     h2.run();
     h2.input_mut()
         .dropped_files
         .push(std::sync::Arc::new(Dropped(project.clone())));
-    h2.run();
+    h2.step();
+    wait_idle(&mut h2, Duration::from_secs(60));
     let (a, b) = (&h.state().doc, &h2.state().doc);
     assert_eq!(a.fields, b.fields);
     assert_eq!(a.plans, b.plans);
@@ -435,12 +463,20 @@ fn oversize_geometries_are_shown_uncovered_until_split() {
         h.state().status()
     );
     assert!(h.state().solve_blocker().is_some());
+    // what no field can hold is told apart from what is merely uncovered, in the GUI's words
+    let far = h.state().out_of_reach().len();
+    assert!(far > 0 && far < n, "{far} of {n}");
+    h.get_by_label_contains("cannot be held by any scan field");
+    assert!(!h.state().status().contains("--split-oversize"));
+    assert!(h.state().status().contains("Split oversize geometries"));
+    section(&mut h, "Solver settings");
     h.get_by_label("Split oversize geometries (on re-place)")
         .click();
     h.run();
     assert!(h.state().doc.settings.split_oversize);
     h.get_by_label("Re-place automatically").click();
-    h.run();
+    h.step();
+    wait_idle(&mut h, Duration::from_secs(60));
     assert!(h.state().doc.geometries.len() > n);
     assert!(h.state().uncovered().is_empty());
     // the split pieces are reported as warnings in the panel
@@ -462,13 +498,13 @@ fn import_warnings_are_listed() {
         &svg,
         r#"<svg xmlns="http://www.w3.org/2000/svg" width="100mm" height="100mm" viewBox="0 0 100 100">
 <rect x="10" y="10" width="5" height="5" fill="none" stroke="black"/>
-<text id="caption" x="20" y="20">hello</text></svg>"#,
+<image id="photo" x="20" y="20" width="10" height="10" href="p.png"/></svg>"#,
     )
     .unwrap();
     let h = opened(&svg);
     assert_eq!(h.state().doc.warnings.len(), 1);
     h.get_by_label("Import warnings (1)");
-    h.get_by_label_contains("caption");
+    h.get_by_label_contains("photo");
 }
 
 /// Frame time of `App::ui` while a solve runs on a large instance (not run by default):
@@ -538,6 +574,7 @@ fn solve(h: &mut Harness<'_, App>, button: &str) -> galvoplan::document::Plan {
 fn the_cost_switch_decides_what_the_solve_minimises() {
     let mut h = opened(&demo());
     assert_eq!(h.state().doc.settings.cost_model, CostModel::Time);
+    section(&mut h, "Solver settings");
     h.get_by_label("Cost model").hover();
     h.run();
     h.get_by_label_contains("What the ordering minimises");
@@ -658,6 +695,7 @@ fn playback_scrubs_plays_pauses_and_rewinds() {
 
 /// Switches the motion mode through the settings panel's combo box.
 fn set_motion(h: &mut Harness<'_, App>, option: &str) {
+    section(h, "Solver settings");
     h.get_by_label("Motion").click();
     h.run();
     h.get_by_label(option).click();
@@ -668,6 +706,7 @@ fn set_motion(h: &mut Harness<'_, App>, option: &str) {
 fn the_motion_switch_plans_on_the_fly() {
     let mut h = opened(&demo());
     assert_eq!(h.state().doc.settings.motion, MotionMode::Step);
+    section(&mut h, "Solver settings");
     h.get_by_label("Motion").hover();
     h.run();
     h.get_by_label_contains("How the machine moves while it marks");
@@ -774,4 +813,228 @@ fn the_stage_route_switch_plans_seed001_routes() {
     let plan = solve(&mut h, "Run HHA");
     assert!(plan.stage_route.is_some());
     assert!(h.state().toolpath(0).unwrap().unwrap().on_the_fly());
+}
+
+fn two_layers() -> PathBuf {
+    common::root().join("assets/examples/two-layers.svg")
+}
+
+/// The `n`-th widget labelled `label` (several layers have one each).
+fn nth_by_label<'a>(h: &'a Harness<'_, App>, label: &'a str, n: usize) -> egui_kittest::Node<'a> {
+    h.get_all_by_label(label).nth(n).expect(label)
+}
+
+#[test]
+fn hatch_settings_in_the_layers_panel_rehatch_the_document() {
+    let mut h = opened(&two_layers());
+    let names: Vec<String> = h
+        .state()
+        .doc
+        .layers
+        .iter()
+        .map(|l| l.name.clone())
+        .collect();
+    assert_eq!(names, ["outline", "fill"]);
+    let outlines = h.state().doc.geometries.len();
+    h.get_by_label("Layers (2)");
+    // choose a hatch for the second layer: a background job hatches and places fields again
+    nth_by_label(&h, "Hatch", 1).click();
+    h.run();
+    h.get_by_label("zigzag").click();
+    h.step();
+    wait_idle(&mut h, Duration::from_secs(60));
+    let doc = &h.state().doc;
+    let hatch = doc.layers[1].pen.hatch.clone().expect("a hatch");
+    assert_eq!(hatch.style, galvoplan::hatch::HatchStyle::Zigzag);
+    let hatched = doc.geometries.len();
+    assert!(hatched > outlines, "{hatched} vs {outlines}");
+    assert!(doc
+        .geometries
+        .iter()
+        .filter(|g| galvoplan::hatch::is_hatch_output(g))
+        .all(|g| g.layer == "fill"));
+    assert!(h.state().uncovered().is_empty());
+    // a finer spacing hatches again with more strokes
+    enter_nth(&mut h, "Spacing (mm)", 0, "0.25");
+    wait_idle(&mut h, Duration::from_secs(60));
+    let finer = h.state().doc.geometries.len();
+    let len = |doc: &galvoplan::document::Document| -> f64 {
+        doc.geometries.iter().map(|g| g.length_mm()).sum()
+    };
+    assert_eq!(
+        h.state().doc.layers[1]
+            .pen
+            .hatch
+            .as_ref()
+            .unwrap()
+            .spacing_mm,
+        0.25
+    );
+    assert!(finer >= hatched);
+    let fine_mm = len(&h.state().doc);
+    // undo goes back to the coarser hatch, then to outlines only
+    h.key_press_modifiers(ctrl(), Key::Z);
+    h.run();
+    assert!(len(&h.state().doc) < fine_mm);
+    assert_eq!(h.state().doc.geometries.len(), hatched);
+    h.key_press_modifiers(ctrl(), Key::Z);
+    h.run();
+    assert_eq!(h.state().doc.geometries.len(), outlines);
+    assert!(h.state().doc.layers[1].pen.hatch.is_none());
+}
+
+#[test]
+fn a_disabled_layer_is_left_out_and_pens_change_at_once() {
+    let mut h = opened(&two_layers());
+    let all = h.state().doc.geometries.len();
+    let fill = h
+        .state()
+        .doc
+        .geometries
+        .iter()
+        .filter(|g| g.layer == "fill")
+        .count();
+    h.get_by_label("fill").click();
+    h.step();
+    wait_idle(&mut h, Duration::from_secs(60));
+    assert!(!h.state().doc.layers[1].pen.enabled);
+    assert_eq!(h.state().doc.geometries.len(), all - fill);
+    // a speed is a pen change only: no job, the geometries stay
+    enter_nth(&mut h, "Speed (mm/s)", 0, "750");
+    h.run();
+    assert!(!h.state().is_busy());
+    assert_eq!(h.state().doc.layers[0].pen.mark_speed_mm_s, Some(750.0));
+    assert_eq!(h.state().doc.geometries.len(), all - fill);
+}
+
+#[test]
+fn a_rejected_pen_value_shows_a_worded_error() {
+    let mut h = opened(&two_layers());
+    let before = h.state().doc.layers.clone();
+    let passes = h.get_all_by_label("Passes").count();
+    assert_eq!(passes, 2);
+    // the second layer's passes
+    enter_nth(&mut h, "Passes", 1, "0");
+    h.run();
+    h.get_by_label("Layer 'fill': Passes must be a whole number from 1 to 100, not 0");
+    assert_eq!(h.state().doc.layers, before);
+    enter_nth(&mut h, "Speed (mm/s)", 0, "fast");
+    h.run();
+    h.get_by_label("Layer 'outline': Mark speed (mm/s) must be a number, not 'fast'");
+    assert_eq!(h.state().doc.layers, before);
+}
+
+#[test]
+fn without_a_file_dialog_a_path_field_is_offered() {
+    let mut app = App::default();
+    app.set_native_dialogs(false);
+    let mut h = harness(app);
+    h.run();
+    h.get_by_label("Open…").click();
+    h.run();
+    h.get_by_label_contains("No file dialog can be shown");
+    enter_nth(&mut h, "File path", 0, &demo().display().to_string());
+    wait_idle(&mut h, Duration::from_secs(60));
+    assert!(h.state().prompt().is_none());
+    assert_eq!(h.state().doc.geometries.len(), 122);
+    // Ctrl+S asks for the project's path the same way
+    h.key_press_modifiers(ctrl(), Key::S);
+    h.run();
+    assert!(matches!(
+        h.state().prompt(),
+        Some(galvoplan::app::Prompt::Path {
+            action: galvoplan::app::PathAction::SaveProject,
+            ..
+        })
+    ));
+    let dir = tempfile::tempdir().unwrap();
+    let project = dir.path().join("demo.galvoplan");
+    enter_nth(&mut h, "File path", 0, &project.display().to_string());
+    h.run();
+    assert!(project.exists(), "{}", h.state().status());
+    assert!(!h.state().has_unsaved_changes());
+}
+
+#[test]
+fn quitting_after_an_edit_asks_about_unsaved_changes() {
+    let mut h = opened(&demo());
+    assert!(!h.state().has_unsaved_changes());
+    let id = h.state().doc.fields[0].id;
+    h.state_mut()
+        .execute(Command::SetLocked { id, locked: true })
+        .unwrap();
+    h.run();
+    assert!(h.state().has_unsaved_changes());
+    h.key_press_modifiers(ctrl(), Key::Q);
+    h.run();
+    h.get_by_label("Unsaved changes");
+    h.get_by_label("Cancel").click();
+    h.run();
+    assert!(h.state().prompt().is_none());
+    assert!(h.query_by_label("Unsaved changes").is_none());
+    // opening another file asks too
+    h.key_press_modifiers(ctrl(), Key::O);
+    h.run();
+    h.get_by_label("Unsaved changes");
+    h.get_by_label("Discard changes").click();
+    h.run();
+    assert!(!matches!(
+        h.state().prompt(),
+        Some(galvoplan::app::Prompt::Unsaved(_))
+    ));
+}
+
+#[test]
+fn exporting_a_stale_plan_asks_first() {
+    let mut h = opened(&demo());
+    h.get_by_label("Run HHA").click();
+    h.step();
+    wait_idle(&mut h, Duration::from_secs(120));
+    let id = h.state().doc.fields[0].id;
+    let c = h.state().doc.fields[0].center;
+    h.state_mut()
+        .execute(Command::MoveField {
+            id,
+            center: galvoplan::geom::Pt::new(c.x + 1.0, c.y),
+        })
+        .unwrap();
+    h.run();
+    h.key_press_modifiers(ctrl(), Key::E);
+    h.run();
+    h.get_by_label("Export a stale plan?");
+}
+
+#[test]
+fn fields_are_numbered_from_one_in_placement_then_visiting_order() {
+    use galvoplan::app::field_number;
+    let mut h = opened(&demo());
+    let fields = h.state().doc.fields.clone();
+    for (k, f) in fields.iter().enumerate() {
+        assert_eq!(field_number(&fields, None, f.id), k + 1);
+    }
+    h.get_by_label("Run HHA").click();
+    h.step();
+    wait_idle(&mut h, Duration::from_secs(120));
+    let plan = h.state().active_plan().unwrap().clone();
+    for (k, f) in plan.fields.iter().enumerate() {
+        assert_eq!(field_number(&fields, Some(&plan.fields), f.id), k + 1);
+    }
+    // no debug timings in the status bar unless the View option asks for them
+    assert!(h.query_by_label_contains(" ms (max ").is_none());
+}
+
+#[test]
+fn a_dropped_dxf_opens_with_its_layers() {
+    let mut h = harness(App::default());
+    h.run();
+    let path = common::root().join("tests/data/dxf/entities-inch.dxf");
+    h.input_mut()
+        .dropped_files
+        .push(std::sync::Arc::new(Dropped(path)));
+    h.step();
+    wait_idle(&mut h, Duration::from_secs(60));
+    let doc = &h.state().doc;
+    assert_eq!(doc.geometries.len(), 26, "{}", h.state().status());
+    assert!(doc.geometries.iter().any(|g| g.source.layer == "CUT"));
+    assert!(!doc.fields.is_empty());
 }

@@ -67,7 +67,10 @@ fn flattened_circle_stays_within_chord_tolerance() {
         let im = import_svg(
             svg(r#"<circle cx="50" cy="50" r="20"/>"#).as_bytes(),
             "t.svg",
-            &ImportOptions { chord_tol_mm: tol },
+            &ImportOptions {
+                chord_tol_mm: tol,
+                ..ImportOptions::default()
+            },
         )
         .unwrap();
         let g = &im.geometries[0];
@@ -166,16 +169,16 @@ fn layers_from_stroke_colour() {
 #[test]
 fn unsupported_content_is_warned_not_dropped_silently() {
     let im = import(&svg(r#"<line x1="0" y1="0" x2="1" y2="0"/>
-<text id="label" x="5" y="5">hello</text>
-<image x="0" y="0" width="5" height="5" href="data:image/png;base64,AAAA"/>"#));
+<image x="0" y="0" width="5" height="5" href="data:image/png;base64,AAAA"/>
+<foreignObject id="fo" width="5" height="5"/>"#));
     assert_eq!(im.geometries.len(), 1);
     assert_eq!(im.warnings.len(), 2);
-    let w = im.warnings[0].to_string();
+    let w = im.warnings[1].to_string();
     assert!(
-        w.contains("<text id=\"label\">") && w.contains("line 2"),
+        w.contains("<foreignObject id=\"fo\">") && w.contains("line 3"),
         "{w}"
     );
-    assert!(im.warnings[1].to_string().contains("<image>"));
+    assert!(im.warnings[0].to_string().contains("<image>"));
 }
 
 #[test]
@@ -207,9 +210,10 @@ fn bad_files_name_the_file_and_the_problem() {
     assert!(e.starts_with("bad.svg: not a valid SVG"), "{e}");
     let e = err(b"<html><body/></html>").to_string();
     assert!(e.contains("root element is <html>"), "{e}");
-    let e = err(svg(r#"<text x="1" y="1">only text</text>"#).as_bytes()).to_string();
+    let e = err(svg(r#"<image x="1" y="1" width="2" height="2" href="a.png"/>"#).as_bytes())
+        .to_string();
     assert!(
-        e.starts_with("bad.svg: no markable geometry") && e.contains("<text>"),
+        e.starts_with("bad.svg: no markable geometry") && e.contains("<image>"),
         "{e}"
     );
     let e = err(&[0xff, 0xfe, 0x00, 0x41]).to_string();

@@ -142,8 +142,13 @@ pub struct Canvas<'a> {
     pub profile: &'a MachineProfile,
     /// Fields to draw.
     pub fields: &'a [ScanField],
-    /// Number fields by their position in this list (visiting order) instead of by id.
-    pub number_by_order: bool,
+    /// The shown plan's fields in visiting order: fields are numbered 1…n in that order (the
+    /// others after them), else in the order of `fields` (placement order).
+    pub visiting: Option<&'a [ScanField]>,
+    /// Each geometry's layer colour (none: closed dark, open green).
+    pub colours: Option<&'a [Color32]>,
+    /// Uncovered geometries no scan field can hold (drawn apart from merely uncovered ones).
+    pub out_of_reach: &'a [usize],
     /// Planned paths to draw (one, or two overlaid).
     pub paths: Vec<PathLayer<'a>>,
     /// Geometries no field holds (drawn in red).
@@ -355,16 +360,25 @@ impl Canvas<'_> {
         if let Some(k) = geometry {
             let g = &self.geometries[k];
             lines.push(format!(
-                "geometry {k}: {}, {}, {} vertices, {:.2} mm long",
+                "geometry {}: {}, layer {}, {}, {} vertices, {:.2} mm long",
+                k + 1,
                 g.describe(),
+                g.layer,
                 if g.closed { "closed" } else { "open" },
                 g.points.len(),
                 g.length_mm()
             ));
             match self.fields.iter().find(|f| f.geometries.contains(&k)) {
-                Some(f) => lines.push(format!("  allocated to field {}", f.id)),
+                Some(f) => lines.push(format!(
+                    "  allocated to field {}",
+                    super::field_number(self.fields, self.visiting, f.id)
+                )),
+                None if self.out_of_reach.contains(&k) => lines.push(
+                    "  no scan field can hold it: larger than a field or beyond the stage's reach"
+                        .into(),
+                ),
                 None if self.uncovered.contains(&k) => {
-                    lines.push("  not covered by any field".into())
+                    lines.push("  not covered by any field (add one, or re-place)".into())
                 }
                 None => {}
             }
@@ -379,7 +393,7 @@ impl Canvas<'_> {
         if let Some(f) = field {
             lines.push(format!(
                 "field {}: centre ({:.2}, {:.2}) mm, {} geometries{}",
-                f.id,
+                super::field_number(self.fields, self.visiting, f.id),
                 f.center.x,
                 f.center.y,
                 f.geometries.len(),

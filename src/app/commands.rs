@@ -6,7 +6,10 @@
 //! Consecutive commands of one gesture (the moves of one field drag) share a group and so undo
 //! together.
 
-use crate::document::{Document, Geometry, MachineProfile, Plan, ScanField, SolverSettings};
+use crate::document::{
+    validate_layers, DerivedKey, Document, Geometry, Layer, MachineProfile, Plan, ScanField,
+    SolverSettings,
+};
 use crate::fields::{add_field, delete_field, move_field, reallocate, set_locked};
 use crate::geom::Pt;
 use crate::import::Warning;
@@ -51,6 +54,17 @@ pub enum Command {
     SetProfile(Box<MachineProfile>),
     /// Replaces the solver settings (already validated).
     SetSettings(Box<SolverSettings>),
+    /// Replaces the layer table when only pens change that do not change the geometries
+    /// (speed, power, frequency, passes, colour); refused otherwise.
+    SetLayers(Vec<Layer>),
+    /// Puts the result of a background job into the document: geometries, layers, fields,
+    /// plans and warnings made from this document (re-placement, re-hatching).
+    SetContent {
+        /// The document the job returned.
+        doc: Box<Document>,
+        /// What the job did, for the status line and the undo menu.
+        what: String,
+    },
 }
 
 impl Command {
@@ -65,6 +79,8 @@ impl Command {
             Command::ReplaceAutomatically => "re-place fields automatically".into(),
             Command::SetProfile(_) => "change machine profile".into(),
             Command::SetSettings(_) => "change solver settings".into(),
+            Command::SetLayers(_) => "change pens".into(),
+            Command::SetContent { what, .. } => what.clone(),
         }
     }
 }
@@ -109,7 +125,7 @@ pub fn apply(doc: &mut Document, cmd: &Command) -> Result<Outcome, String> {
             Ok(uncovered(reallocate(doc)))
         }
         Command::SetProfile(p) => {
-            p.validate()?;
+            p.validate().map_err(|e| e.to_string())?;
             doc.profile = (**p).clone();
             let [sw, sh] = doc.profile.stroke_mm;
             for f in &mut doc.fields {
@@ -119,7 +135,26 @@ pub fn apply(doc: &mut Document, cmd: &Command) -> Result<Outcome, String> {
             Ok(uncovered(reallocate(doc)))
         }
         Command::SetSettings(s) => {
+            s.validate().map_err(|e| e.to_string())?;
             doc.settings = (**s).clone();
+            Ok(uncovered(reallocate(doc)))
+        }
+        Command::SetLayers(layers) => {
+            validate_layers(layers).map_err(|e| e.to_string())?;
+            if doc.derived_with.as_ref() != Some(&DerivedKey::of(layers, doc.profile.field_mm)) {
+                return Err("the change needs the geometries made again (a background job)".into());
+            }
+            doc.layers = layers.clone();
+            Ok(uncovered(reallocate(doc)))
+        }
+        Command::SetContent { doc: new, .. } => {
+            new.validate().map_err(|e| e.to_string())?;
+            doc.geometries = new.geometries.clone();
+            doc.layers = new.layers.clone();
+            doc.derived_with = new.derived_with.clone();
+            doc.fields = new.fields.clone();
+            doc.plans = new.plans.clone();
+            doc.warnings = new.warnings.clone();
             Ok(uncovered(reallocate(doc)))
         }
     }
@@ -131,6 +166,8 @@ struct Snapshot {
     fields: Vec<ScanField>,
     profile: MachineProfile,
     settings: SolverSettings,
+    layers: Vec<Layer>,
+    derived_with: Option<DerivedKey>,
     /// Geometries, plans and warnings, for commands that can rewrite them.
     content: Option<(Vec<Geometry>, Vec<Plan>, Vec<Warning>)>,
     what: String,
@@ -138,7 +175,11 @@ struct Snapshot {
 
 impl Snapshot {
     fn take(doc: &Document, cmd: &Command) -> Self {
-        let content = matches!(cmd, Command::ReplaceAutomatically).then(|| {
+        let rewrites = matches!(
+            cmd,
+            Command::ReplaceAutomatically | Command::SetContent { .. }
+        );
+        let content = rewrites.then(|| {
             (
                 doc.geometries.clone(),
                 doc.plans.clone(),
@@ -149,6 +190,8 @@ impl Snapshot {
             fields: doc.fields.clone(),
             profile: doc.profile.clone(),
             settings: doc.settings.clone(),
+            layers: doc.layers.clone(),
+            derived_with: doc.derived_with.clone(),
             content,
             what: cmd.describe(),
         }
@@ -166,6 +209,8 @@ impl Snapshot {
             fields: std::mem::replace(&mut doc.fields, self.fields),
             profile: std::mem::replace(&mut doc.profile, self.profile),
             settings: std::mem::replace(&mut doc.settings, self.settings),
+            layers: std::mem::replace(&mut doc.layers, self.layers),
+            derived_with: std::mem::replace(&mut doc.derived_with, self.derived_with),
             content,
             what: self.what,
         }

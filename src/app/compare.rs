@@ -320,6 +320,9 @@ pub fn relowered_notes(ui: &mut egui::Ui, plans: &[(&Plan, Option<Result<&Lowere
     }
 }
 
+/// Width kept for the convergence plot's y tick labels (e.g. `12 345.6`), px.
+const Y_AXIS_WIDTH_PX: f32 = 56.0;
+
 /// The GA convergence plot: best and mean idle travel per generation of every plan with a
 /// history, and the HHA plan's idle travel as a horizontal line.
 pub fn convergence_plot(ui: &mut egui::Ui, plans: &[(&Plan, Color32)], hha: Option<&Plan>) {
@@ -332,8 +335,14 @@ pub fn convergence_plot(ui: &mut egui::Ui, plans: &[(&Plan, Color32)], hha: Opti
     }
     Plot::new("convergence")
         .legend(Legend::default())
-        .x_axis_label("generation")
-        .y_axis_label("idle mm")
+        .x_axis_label("Generation")
+        .y_axis_label("Idle travel (mm)")
+        // ticks with as many decimals as their spacing needs, in a column wide enough for them
+        .y_axis_formatter(|mark, _| {
+            let decimals = (-mark.step_size.log10()).ceil().clamp(0.0, 3.0) as usize;
+            format!("{:.*}", decimals, mark.value)
+        })
+        .y_axis_min_width(Y_AXIS_WIDTH_PX)
         .allow_scroll(false)
         .show(ui, |pui| {
             for (p, col) in &with_history {
@@ -462,7 +471,9 @@ pub fn show(
         geometries: &doc.geometries,
         profile: &doc.profile,
         fields: &doc.plans[k].fields,
-        number_by_order: true,
+        visiting: Some(&doc.plans[k].fields),
+        colours: None,
+        out_of_reach: &[],
         paths: vec![PathLayer {
             plan: &doc.plans[k],
             lowered: toolpaths.get(k).unwrap_or(Err("not lowered yet")),

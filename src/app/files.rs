@@ -30,11 +30,14 @@ impl Recent {
     }
 }
 
-/// True for an SVG (by extension); everything else is read as a project file.
-pub fn is_svg(path: &Path) -> bool {
+/// Extensions of artwork files (imported by [`crate::import::import_file`]).
+pub const ARTWORK_EXTS: [&str; 3] = ["svg", "svgz", "dxf"];
+
+/// True for artwork, SVG or DXF (by extension); everything else is read as a project file.
+pub fn is_artwork(path: &Path) -> bool {
     path.extension()
         .and_then(|e| e.to_str())
-        .is_some_and(|e| e.eq_ignore_ascii_case("svg") || e.eq_ignore_ascii_case("svgz"))
+        .is_some_and(|e| ARTWORK_EXTS.iter().any(|x| e.eq_ignore_ascii_case(x)))
 }
 
 /// The result of opening a file.
@@ -47,14 +50,15 @@ pub struct Opened {
     pub is_project: bool,
 }
 
-/// Opens an SVG (imported with `profile` and `settings`, fields placed automatically as the CLI
+/// Opens an SVG or DXF (imported with `profile` and `settings`, fields placed automatically as the CLI
 /// places them) or a project file (with its own profile, settings, fields and plans).
 pub fn open(
     path: &Path,
     profile: &MachineProfile,
     settings: &SolverSettings,
+    ctx: &JobCtx,
 ) -> Result<Opened, String> {
-    if is_svg(path) {
+    if is_artwork(path) {
         let (mut doc, _) = load_svg(
             path,
             profile.clone(),
@@ -62,9 +66,13 @@ pub fn open(
             &ImportOptions::default(),
         )
         .map_err(|e| e.to_string())?;
-        let problem = place_document_fields(&mut doc, &JobCtx::default())
-            .err()
-            .map(|e| e.to_string());
+        let problem = match place_document_fields(&mut doc, ctx) {
+            Ok(_) => None,
+            Err(e) if ctx.is_cancelled() => {
+                return Err(format!("{}: cancelled ({e})", path.display()))
+            }
+            Err(e) => Some(e.to_string()),
+        };
         Ok(Opened {
             doc,
             problem,
@@ -120,16 +128,37 @@ pub fn export(doc: &Document, plan: &Plan, kind: ExportKind, path: &Path) -> Res
         .map_err(|e| format!("{}: cannot write: {e}", path.display()))
 }
 
-/// The open dialog (SVG or project).
+/// The open dialog (SVG, DXF or project).
 pub fn pick_open() -> Option<PathBuf> {
     rfd::FileDialog::new()
         .add_filter(
-            "SVG or galvoplan project",
-            &["svg", "svgz", PROJECT_EXT, "json"],
+            "SVG, DXF or galvoplan project",
+            &["svg", "svgz", "dxf", PROJECT_EXT, "json"],
         )
-        .add_filter("SVG", &["svg", "svgz"])
+        .add_filter("SVG or DXF artwork", &ARTWORK_EXTS)
         .add_filter("galvoplan project", &[PROJECT_EXT, "json"])
         .pick_file()
+}
+
+/// An open dialog for one kind of file.
+pub fn pick_load(filter: &str, ext: &str) -> Option<PathBuf> {
+    rfd::FileDialog::new()
+        .add_filter(filter, &[ext])
+        .pick_file()
+}
+
+/// True when a native file dialog may be shown: on Linux and the BSDs the dialogs go through
+/// the desktop portal on the session bus, so without a session bus there is none (rfd then
+/// returns "nothing chosen" at once).
+pub fn native_dialogs_available() -> bool {
+    if cfg!(any(target_os = "windows", target_os = "macos")) {
+        return true;
+    }
+    let bus_env = std::env::var_os("DBUS_SESSION_BUS_ADDRESS").is_some_and(|v| !v.is_empty());
+    let bus_socket = std::env::var_os("XDG_RUNTIME_DIR")
+        .map(|d| PathBuf::from(d).join("bus"))
+        .is_some_and(|p| p.exists());
+    bus_env || bus_socket
 }
 
 /// A save dialog for one kind of file.

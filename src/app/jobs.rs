@@ -1,9 +1,11 @@
-//! Background solves: the ordering stage runs on a snapshot of the document in a named thread;
-//! the GUI polls the result each frame and never blocks on the worker.
+//! Background work: solves, imports, hatching, field placement and exports run on a snapshot in
+//! a named thread; the GUI polls the result each frame and never blocks on the worker.
 
+use super::files::{ExportKind, Opened};
 use crate::document::{Algo, Document, Plan};
 use crate::job::{CancelToken, JobCtx, Progress, ProgressSink};
 use crate::pipeline::order_document;
+use std::path::PathBuf;
 use std::sync::mpsc::{self, Receiver, TryRecvError};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
@@ -36,48 +38,62 @@ pub fn solver_threads() -> usize {
         })
 }
 
-/// How a finished job ended.
-#[derive(Debug)]
-pub enum JobOutcome {
+/// What a finished job made.
+pub enum JobResult {
     /// A plan (for HGA possibly the best one found before a cancel).
     Plan(Box<Plan>),
-    /// The solve failed or was cancelled without a plan.
+    /// A file opened (imported SVG with fields placed, or a project).
+    Opened {
+        /// The file.
+        path: PathBuf,
+        /// The document and what went wrong on the way.
+        opened: Box<Opened>,
+    },
+    /// The document with geometries made from its layers and fields placed again.
+    Placed {
+        /// The new document (geometries, layers, fields, plans, warnings).
+        doc: Box<Document>,
+        /// What the job did, for the status line and the undo menu.
+        what: String,
+    },
+    /// An export written.
+    Exported {
+        /// The file.
+        path: PathBuf,
+        /// What was exported.
+        kind: ExportKind,
+    },
+}
+
+/// How a finished job ended.
+pub enum JobOutcome {
+    /// Its result.
+    Done(JobResult),
+    /// The job failed or was cancelled without a result.
     Failed(String),
 }
 
-/// A running solve.
+/// A running background job.
 pub struct Job {
-    /// The algorithm.
-    pub algo: Algo,
-    /// The name the plan will get.
+    /// What it does, e.g. `HHA #1` or `importing demo.svg`.
     pub name: String,
     started: Instant,
     time_limit_s: Option<f64>,
     cancel: CancelToken,
     progress: Arc<SharedProgress>,
-    rx: Receiver<Result<Plan, String>>,
+    rx: Receiver<Result<JobResult, String>>,
 }
 
 impl Job {
-    /// Starts ordering a snapshot of `doc` (geometries, fields, profile, settings) with `algo`
-    /// in a new thread; `repaint` is woken on progress and when the job ends.
-    pub fn start(
-        doc: &Document,
-        algo: Algo,
+    /// Runs `work` in a new thread named `galvoplan-{thread}`; `repaint` is woken on progress
+    /// and when the job ends.
+    pub fn spawn(
         name: String,
+        thread: &str,
+        time_limit_s: Option<f64>,
         repaint: &egui::Context,
+        work: impl FnOnce(&JobCtx) -> Result<JobResult, String> + Send + 'static,
     ) -> std::io::Result<Job> {
-        let mut snapshot = Document {
-            source: doc.source.clone(),
-            page_mm: doc.page_mm,
-            geometries: doc.geometries.clone(),
-            warnings: Vec::new(),
-            profile: doc.profile.clone(),
-            settings: doc.settings.clone(),
-            fields: doc.fields.clone(),
-            plans: Vec::new(),
-        };
-        snapshot.settings.algo = algo;
         let progress = Arc::new(SharedProgress {
             latest: Mutex::new(None),
             repaint: repaint.clone(),
@@ -87,45 +103,73 @@ impl Job {
         let (tx, rx) = mpsc::channel();
         let wake = repaint.clone();
         std::thread::Builder::new()
-            .name(format!(
-                "galvoplan-solve-{}",
-                format!("{algo:?}").to_lowercase()
-            ))
+            .name(format!("galvoplan-{thread}"))
             .spawn(move || {
                 let threads = solver_threads();
-                let solve = || order_document(&snapshot, &ctx).map_err(|e| e.to_string());
+                let run = || work(&ctx);
                 let result = match rayon::ThreadPoolBuilder::new()
                     .num_threads(threads)
-                    .thread_name(|k| format!("galvoplan-solve-worker-{k}"))
+                    .thread_name(|k| format!("galvoplan-worker-{k}"))
                     .build()
                 {
-                    Ok(pool) => pool.install(solve),
-                    Err(_) => solve(),
+                    Ok(pool) => pool.install(run),
+                    Err(_) => run(),
                 };
                 // the receiver is gone only when the GUI dropped the job; nothing to tell then
                 let _ = tx.send(result);
                 wake.request_repaint();
             })?;
         Ok(Job {
-            algo,
             name,
             started: Instant::now(),
-            time_limit_s: doc.settings.time_limit_s,
+            time_limit_s,
             cancel,
             progress,
             rx,
         })
     }
 
+    /// Starts ordering a snapshot of `doc` (geometries, fields, profile, settings, layers) with
+    /// `algo`.
+    pub fn solve(
+        doc: &Document,
+        algo: Algo,
+        name: String,
+        repaint: &egui::Context,
+    ) -> std::io::Result<Job> {
+        let mut snapshot = Document {
+            source: doc.source.clone(),
+            page_mm: doc.page_mm,
+            artwork: Vec::new(),
+            layers: doc.layers.clone(),
+            derived_with: doc.derived_with.clone(),
+            geometries: doc.geometries.clone(),
+            warnings: Vec::new(),
+            profile: doc.profile.clone(),
+            settings: doc.settings.clone(),
+            fields: doc.fields.clone(),
+            plans: Vec::new(),
+        };
+        snapshot.settings.algo = algo;
+        let thread = format!("solve-{}", algo.label());
+        let limit = doc.settings.time_limit_s;
+        Job::spawn(name, &thread, limit, repaint, move |ctx| {
+            order_document(&snapshot, ctx)
+                .map(|p| JobResult::Plan(Box::new(p)))
+                .map_err(|e| e.to_string())
+        })
+    }
+
     /// The result once the worker is done (then the job is over); `None` while it runs.
     pub fn poll(&self) -> Option<JobOutcome> {
         match self.rx.try_recv() {
-            Ok(Ok(plan)) => Some(JobOutcome::Plan(Box::new(plan))),
+            Ok(Ok(result)) => Some(JobOutcome::Done(result)),
             Ok(Err(e)) => Some(JobOutcome::Failed(e)),
             Err(TryRecvError::Empty) => None,
-            Err(TryRecvError::Disconnected) => Some(JobOutcome::Failed(
-                "the solver thread ended without a result".into(),
-            )),
+            Err(TryRecvError::Disconnected) => Some(JobOutcome::Failed(format!(
+                "{}: the worker thread ended without a result",
+                self.name
+            ))),
         }
     }
 

@@ -2,9 +2,10 @@
 
 use super::canvas::{Canvas, PathLayer};
 use super::commands::Command;
-use super::files::{self, ExportKind, PROJECT_EXT};
+use super::files::ExportKind;
+use super::layers::LayerAction;
 use super::paint::colour;
-use super::{compare, is_stale, motion_plots, playback, App, Tab, SOLVERS};
+use super::{compare, is_stale, motion_plots, playback, App, Section, Tab, SOLVERS};
 use egui::{Color32, RichText};
 
 const ERROR: Color32 = Color32::from_rgb(200, 30, 30);
@@ -18,7 +19,7 @@ impl App {
         if self.tab == Tab::Workbench {
             egui::Panel::left("left")
                 .resizable(true)
-                .default_size(290.0)
+                .default_size(370.0)
                 .show(ui, |ui| {
                     egui::ScrollArea::vertical().show(ui, |ui| self.left_panel(ui));
                 });
@@ -47,42 +48,21 @@ impl App {
         });
     }
 
-    fn open_dialog(&mut self) {
-        if let Some(p) = files::pick_open() {
-            self.open(&p);
-        }
-    }
-
-    fn save_dialog(&mut self, save_as: bool) {
-        let path = match (&self.project_path, save_as) {
-            (Some(p), false) => Some(p.clone()),
-            _ => files::pick_save(
-                "galvoplan project",
-                PROJECT_EXT,
-                &files::default_name(&self.doc, PROJECT_EXT),
-            ),
-        };
-        if let Some(p) = path {
-            if let Err(e) = self.save_project(&p) {
-                self.set_status(e, true);
-            }
-        }
-    }
-
-    fn export_dialog(&mut self, kind: ExportKind) {
-        let (filter, ext) = kind.filter();
-        if let Some(p) = files::pick_save(filter, ext, &files::default_name(&self.doc, ext)) {
-            if let Err(e) = self.export(kind, &p) {
-                self.set_status(e, true);
-            }
-        }
-    }
-
     fn menu_bar(&mut self, ui: &mut egui::Ui) {
         egui::MenuBar::new().ui(ui, |ui| {
+            let ctx = ui.ctx().clone();
             ui.menu_button("File", |ui| {
-                if ui.button("Open SVG or project…").clicked() {
-                    self.open_dialog();
+                if ui
+                    .add(egui::Button::new("New").shortcut_text("Ctrl+N"))
+                    .clicked()
+                {
+                    self.request_new();
+                }
+                if ui
+                    .add(egui::Button::new("Open SVG, DXF or project…").shortcut_text("Ctrl+O"))
+                    .clicked()
+                {
+                    self.request_open(None, &ctx);
                 }
                 ui.menu_button("Open recent", |ui| {
                     if self.recent.0.is_empty() {
@@ -90,33 +70,44 @@ impl App {
                     }
                     for p in self.recent.0.clone() {
                         if ui.button(p.display().to_string()).clicked() {
-                            self.open(&p);
+                            self.request_open(Some(p), &ctx);
                         }
                     }
                 });
                 ui.separator();
                 let doc = self.has_document();
                 if ui
-                    .add_enabled(doc, egui::Button::new("Save project"))
+                    .add_enabled(
+                        doc,
+                        egui::Button::new("Save project").shortcut_text("Ctrl+S"),
+                    )
                     .clicked()
                 {
-                    self.save_dialog(false);
+                    self.request_save(false, &ctx);
                 }
                 if ui
-                    .add_enabled(doc, egui::Button::new("Save project as…"))
+                    .add_enabled(
+                        doc,
+                        egui::Button::new("Save project as…").shortcut_text("Ctrl+Shift+S"),
+                    )
                     .clicked()
                 {
-                    self.save_dialog(true);
+                    self.request_save(true, &ctx);
                 }
                 ui.separator();
                 let plan = self.active_plan().is_some();
-                for (kind, label) in [
-                    (ExportKind::Gcode, "Export G-code…"),
-                    (ExportKind::Report, "Export report (JSON)…"),
-                    (ExportKind::Preview, "Export SVG preview…"),
+                for (kind, label, keys) in [
+                    (ExportKind::Gcode, "Export G-code…", "Ctrl+E"),
+                    (ExportKind::Report, "Export report (JSON)…", ""),
+                    (ExportKind::Preview, "Export SVG preview…", ""),
                 ] {
-                    if ui.add_enabled(plan, egui::Button::new(label)).clicked() {
-                        self.export_dialog(kind);
+                    let b = egui::Button::new(label).shortcut_text(keys);
+                    if ui
+                        .add_enabled(plan, b)
+                        .on_disabled_hover_text("Run a solver first")
+                        .clicked()
+                    {
+                        self.request_export(kind, &ctx);
                     }
                 }
                 ui.separator();
@@ -124,7 +115,7 @@ impl App {
                     .add(egui::Button::new("Quit").shortcut_text("Ctrl+Q"))
                     .clicked()
                 {
-                    ui.ctx().send_viewport_cmd(egui::ViewportCommand::Close);
+                    self.request_quit(&ctx);
                 }
             });
             ui.menu_button("Edit", |ui| {
@@ -169,23 +160,27 @@ impl App {
         ui.checkbox(&mut l.arrows, "Direction arrows");
         ui.checkbox(&mut l.base_path, "Base path / stage route");
         ui.checkbox(&mut l.order_colours, "Colour marks by order");
+        ui.checkbox(&mut self.frame_times, "Frame timings in the status bar");
     }
 
     fn toolbar(&mut self, ui: &mut egui::Ui) {
         ui.horizontal_wrapped(|ui| {
+            let ctx = ui.ctx().clone();
             if ui
                 .button("Open…")
-                .on_hover_text("Open an SVG or a project (or drop a file on the window)")
+                .on_hover_text(
+                    "Open an SVG, a DXF or a project (Ctrl+O, or drop a file on the window)",
+                )
                 .clicked()
             {
-                self.open_dialog();
+                self.request_open(None, &ctx);
             }
             if ui
                 .add_enabled(self.has_document(), egui::Button::new("Save"))
-                .on_hover_text("Save the project")
+                .on_hover_text("Save the project (Ctrl+S)")
                 .clicked()
             {
-                self.save_dialog(false);
+                self.request_save(false, &ctx);
             }
             ui.separator();
             let can_undo = self.history.undo_label().is_some();
@@ -245,7 +240,7 @@ impl App {
             }
             if ui
                 .add_enabled(
-                    self.has_document(),
+                    self.has_document() && self.job.is_none(),
                     egui::Button::new("Re-place automatically"),
                 )
                 .on_hover_text(
@@ -253,7 +248,7 @@ impl App {
                 )
                 .clicked()
             {
-                let _ = self.execute(Command::ReplaceAutomatically);
+                self.replace_fields(&ctx);
             }
             ui.separator();
             let blocker = self.solve_blocker();
@@ -281,28 +276,8 @@ impl App {
                 job.show(ui);
                 ui.separator();
             }
-            let t = RichText::new(&self.status.text);
-            ui.label(if self.status.error { t.color(ERROR) } else { t });
             ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
-                let f = &self.frames;
-                let cpu = f
-                    .cpu_ms
-                    .map_or(String::new(), |c| format!(", whole frame {c:.1} ms"));
-                ui.label(
-                    RichText::new(format!(
-                        "ui {:.1} ms (max {:.1}){cpu}",
-                        f.last_ms(),
-                        f.recent_max_ms(120)
-                    ))
-                    .small()
-                    .weak(),
-                )
-                .on_hover_text(
-                    "time of App::ui in the last frame (and the maximum of the last 120 \
-                     frames); whole frame: the integration's CPU time including tessellation",
-                );
                 if self.has_document() {
-                    ui.separator();
                     let u = self.uncovered.len();
                     let t = RichText::new(format!(
                         "{} fields · {} uncovered",
@@ -310,26 +285,81 @@ impl App {
                         u
                     ));
                     ui.label(if u > 0 { t.color(ERROR) } else { t });
+                    ui.separator();
                 }
+                if self.frame_times {
+                    let f = &self.frames;
+                    let cpu = f
+                        .cpu_ms
+                        .map_or(String::new(), |c| format!(", whole frame {c:.1} ms"));
+                    ui.label(
+                        RichText::new(format!(
+                            "ui {:.1} ms (max {:.1}){cpu}",
+                            f.last_ms(),
+                            f.recent_max_ms(120)
+                        ))
+                        .small()
+                        .weak(),
+                    )
+                    .on_hover_text(
+                        "time of App::ui in the last frame (and the maximum of the last 120 \
+                         frames); whole frame: the integration's CPU time including tessellation",
+                    );
+                    ui.separator();
+                }
+                ui.with_layout(egui::Layout::left_to_right(egui::Align::Center), |ui| {
+                    let t = RichText::new(&self.status.text);
+                    let t = if self.status.error { t.color(ERROR) } else { t };
+                    ui.add(egui::Label::new(t).wrap());
+                });
             });
         });
     }
 
+    fn layers_ui(&mut self, ui: &mut egui::Ui) {
+        let busy = self.job.as_ref().map(|j| j.name.clone());
+        let action = self.layer_editor.ui(
+            ui,
+            &self.doc.layers,
+            &self.layer_counts,
+            &self.doc.profile,
+            busy.as_deref(),
+        );
+        let ctx = ui.ctx().clone();
+        match action {
+            Some(LayerAction::Set(layers)) => self.set_layers(layers, &ctx),
+            Some(LayerAction::File(a)) => self.choose_path(a, &ctx),
+            None => {}
+        }
+    }
+
     fn left_panel(&mut self, ui: &mut egui::Ui) {
-        egui::CollapsingHeader::new("Machine profile")
-            .default_open(true)
-            .show(ui, |ui| {
-                if let Some(cmd) = self.editors.profile_ui(ui, &self.doc.profile) {
-                    let _ = self.execute(cmd);
-                }
-            });
-        egui::CollapsingHeader::new("Solver settings")
-            .default_open(true)
-            .show(ui, |ui| {
+        ui.horizontal_wrapped(|ui| {
+            let layers = format!("Layers ({})", self.doc.layers.len());
+            ui.selectable_value(&mut self.section, Section::Layers, layers)
+                .on_hover_text("Layers and their pens: speed, power, passes, hatch");
+            ui.selectable_value(&mut self.section, Section::Settings, "Solver settings");
+            ui.selectable_value(&mut self.section, Section::Profile, "Machine profile");
+        });
+        ui.separator();
+        match self.section {
+            Section::Layers => self.layers_ui(ui),
+            Section::Settings => {
                 if let Some(cmd) = self.editors.settings_ui(ui, &self.doc.settings) {
                     let _ = self.execute(cmd);
                 }
-            });
+            }
+            Section::Profile => {
+                if let Some(cmd) = self.editors.profile_ui(ui, &self.doc.profile) {
+                    let _ = self.execute(cmd);
+                }
+                if let Some(a) = self.editors.take_file_request() {
+                    let ctx = ui.ctx().clone();
+                    self.choose_path(a, &ctx);
+                }
+            }
+        }
+        ui.separator();
         egui::CollapsingHeader::new("View")
             .default_open(false)
             .show(ui, |ui| self.layer_toggles(ui));
@@ -342,7 +372,7 @@ impl App {
                 ui.label(RichText::new(s).small());
             }
             None => {
-                ui.label("No document. Open an SVG or a project.");
+                ui.label("No document. Open an SVG, a DXF or a project.");
             }
         }
         if self.has_document() {
@@ -353,18 +383,37 @@ impl App {
                 self.doc.geometries.len() - closed,
                 self.doc.fields.len()
             ));
-            if !self.uncovered.is_empty() {
-                ui.colored_label(
-                    ERROR,
-                    format!(
-                        "{} geometries not covered by any field",
-                        self.uncovered.len()
-                    ),
+            let far = self.out_of_reach.len();
+            let near = self.uncovered.len() - far;
+            if far > 0 {
+                ui.add(
+                    egui::Label::new(
+                        RichText::new(format!(
+                    "{far} geometries (dashed purple) cannot be held by any scan field: they are \
+                     larger than a field or lie beyond the stage's stroke plus half a field. Tick \
+                     \"Split oversize geometries\" in Solver settings and press \"Re-place \
+                     automatically\", or choose \"On the fly\" as the motion."
+                ))
+                        .color(colour::OUT_OF_REACH),
+                    )
+                    .wrap(),
+                );
+            }
+            if near > 0 {
+                ui.add(
+                    egui::Label::new(
+                        RichText::new(format!(
+                    "{near} geometries (red) are not covered by a scan field yet: add a field \
+                     (Add field) or press \"Re-place automatically\"."
+                ))
+                        .color(ERROR),
+                    )
+                    .wrap(),
                 );
             }
         }
         if let Some(p) = &self.problem {
-            ui.colored_label(ERROR, p);
+            ui.add(egui::Label::new(RichText::new(p).color(ERROR)).wrap());
         }
         self.selected_field_ui(ui);
         ui.separator();
@@ -378,18 +427,27 @@ impl App {
         }
         ui.separator();
         let n = self.doc.warnings.len();
-        egui::CollapsingHeader::new(format!("Import warnings ({n})"))
-            .id_salt("warnings")
+        let title = if n > 0 {
+            RichText::new(format!("Import warnings ({n})"))
+                .strong()
+                .color(Color32::from_rgb(180, 83, 9))
+        } else {
+            RichText::new("Import warnings (0)")
+        };
+        // a new id per import: the list opens on each import that has warnings
+        egui::CollapsingHeader::new(title)
+            .id_salt(("warnings", self.imports))
             .default_open(n > 0)
             .show(ui, |ui| {
                 if n == 0 {
                     ui.label("none");
                 }
                 for w in &self.doc.warnings {
-                    ui.label(
-                        RichText::new(w.to_string())
-                            .small()
-                            .color(Color32::from_rgb(180, 83, 9)),
+                    ui.add(
+                        egui::Label::new(
+                            RichText::new(w.to_string()).color(Color32::from_rgb(180, 83, 9)),
+                        )
+                        .wrap(),
                     );
                 }
             });
@@ -398,7 +456,8 @@ impl App {
             .show(ui, |ui| {
                 for p in self.recent.0.clone() {
                     if ui.link(p.display().to_string()).clicked() {
-                        self.open(&p);
+                        let ctx = ui.ctx().clone();
+                        self.request_open(Some(p), &ctx);
                     }
                 }
             });
@@ -412,7 +471,11 @@ impl App {
             return;
         };
         ui.separator();
-        ui.heading(format!("Field {}", f.id));
+        let visiting = self.active_plan().map(|p| p.fields.as_slice());
+        ui.heading(format!(
+            "Field {}",
+            super::field_number(&self.doc.fields, visiting, f.id)
+        ));
         ui.label(format!(
             "centre ({:.2}, {:.2}) mm, {} geometries{}",
             f.center.x,
@@ -475,7 +538,9 @@ impl App {
     fn workbench_view(&mut self, ui: &mut egui::Ui) {
         if !self.has_document() {
             ui.centered_and_justified(|ui| {
-                ui.label("Open an SVG or a project (File > Open, or drag and drop a file here).");
+                ui.label(
+                    "Open an SVG, a DXF or a project (File > Open, or drag and drop a file here).",
+                );
             });
             return;
         }
@@ -491,7 +556,12 @@ impl App {
             geometries: &self.doc.geometries,
             profile: &self.doc.profile,
             fields: &self.doc.fields,
-            number_by_order: false,
+            visiting: plan.map(|p| p.fields.as_slice()),
+            // layer colours when the layers tell something apart (several, or a hatch)
+            colours: (self.doc.layers.len() > 1
+                || self.doc.layers.iter().any(|l| l.pen.hatch.is_some()))
+            .then_some(self.colours.as_slice()),
+            out_of_reach: &self.out_of_reach,
             paths: plan
                 .zip(lowered)
                 .map(|(p, lowered)| PathLayer {

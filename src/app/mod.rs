@@ -18,23 +18,28 @@ pub mod commands;
 pub mod compare;
 pub mod files;
 pub mod jobs;
+pub mod layers;
 mod layout;
 pub mod motion_plots;
 mod paint;
 pub mod panels;
 pub mod playback;
+mod prompts;
 pub mod toolpaths;
 
 pub use canvas::{Canvas, CanvasAction, CanvasState, Layers, View};
 
 use crate::document::{
-    Algo, Document, MachineProfile, MotionMode, Plan, ScanField, SolverSettings,
+    Algo, DerivedKey, Document, Layer, MachineProfile, MotionMode, Plan, ScanField, SolverSettings,
 };
+use crate::job::JobCtx;
+use crate::pipeline::{derive_geometries, place_document_fields};
 use commands::{Command, History, Outcome};
 use compare::CompareState;
 use files::{ExportKind, Recent};
-use jobs::{Job, JobOutcome};
+use jobs::{Job, JobOutcome, JobResult};
 use playback::Playback;
+pub use prompts::{PathAction, Prompt};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -51,29 +56,21 @@ pub const SOLVERS: &[(Algo, &str)] = &[
     (Algo::AsIs, "Run as-is"),
 ];
 
-/// What is kept between runs (eframe storage).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+/// What is kept between runs (eframe storage). The default profile is the built-in seed
+/// machine (`MachineProfile::default()`, a unit test keeps them equal).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct Prefs {
-    /// Machine profile used for newly opened SVGs.
+    /// Machine profile used for newly opened artwork (SVG, DXF).
     pub profile: MachineProfile,
-    /// Solver settings used for newly opened SVGs.
+    /// Solver settings used for newly opened artwork (SVG, DXF).
     pub settings: SolverSettings,
     /// Recent files.
     pub recent: Recent,
     /// Canvas layers.
     pub layers: Layers,
-}
-
-impl Default for Prefs {
-    fn default() -> Self {
-        Self {
-            profile: MachineProfile::builtin("seed000").unwrap_or_default(),
-            settings: SolverSettings::default(),
-            recent: Recent::default(),
-            layers: Layers::default(),
-        }
-    }
+    /// Show the frame timings in the status bar (View menu; a debugging aid).
+    pub frame_times: bool,
 }
 
 /// Opens the main window, with `file` (an SVG or a project) loaded when given.
@@ -99,7 +96,7 @@ pub fn run(file: Option<PathBuf>) -> anyhow::Result<()> {
             app.frame_log =
                 std::env::var_os("GALVOPLAN_FRAME_LOG").and_then(|p| std::fs::File::create(p).ok());
             if let Some(f) = file {
-                app.open(&f);
+                app.open_in_background(&f, &cc.egui_ctx);
             }
             Ok(Box::new(app))
         }),
@@ -114,6 +111,17 @@ pub enum Tab {
     Workbench,
     /// Two plans side by side.
     Compare,
+}
+
+/// The sections of the left panel (one shown at a time, so that none scrolls out of sight).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Section {
+    /// Layers and their pens.
+    Layers,
+    /// Solver settings.
+    Settings,
+    /// Machine profile.
+    Profile,
 }
 
 /// Durations of recent frames.
@@ -193,6 +201,31 @@ pub struct App {
     title: String,
     /// Per-frame timing log (`GALVOPLAN_FRAME_LOG=path`), for measuring responsiveness.
     frame_log: Option<std::fs::File>,
+    /// The layers panel's edit buffers.
+    layer_editor: layers::LayerEditor,
+    /// The section shown in the left panel.
+    section: Section,
+    /// Show frame timings in the status bar.
+    frame_times: bool,
+    /// A question or path field waiting for the operator.
+    prompt: Option<Prompt>,
+    /// Native file dialogs can be shown (else a path field is offered).
+    dialogs: bool,
+    /// Counts changes of the document (edits, plans, layers).
+    revision: u64,
+    /// `revision` when the document was last opened or saved.
+    saved_revision: u64,
+    /// The operator chose to quit without saving.
+    quit_confirmed: bool,
+    /// Counts imports: the warnings list opens again on each one.
+    imports: u64,
+    /// (imported, marked) geometries per layer.
+    layer_counts: Vec<(usize, usize)>,
+    /// Each geometry's layer colour.
+    colours: Vec<egui::Color32>,
+    /// Uncovered geometries no scan field can ever hold (larger than a field, or beyond the
+    /// stage's stroke plus half a field).
+    out_of_reach: Vec<usize>,
 }
 
 impl Default for App {
@@ -229,7 +262,8 @@ impl App {
             recent: prefs.recent,
             layers: prefs.layers,
             status: Status {
-                text: "Open an SVG or a project (File menu, or drag and drop) to start.".into(),
+                text: "Open an SVG, a DXF or a project (File menu, or drag and drop) to start."
+                    .into(),
                 error: false,
             },
             frames: FrameStats::default(),
@@ -237,6 +271,18 @@ impl App {
             dragging: false,
             title: String::new(),
             frame_log: None,
+            layer_editor: layers::LayerEditor::default(),
+            section: Section::Layers,
+            frame_times: prefs.frame_times,
+            prompt: None,
+            dialogs: files::native_dialogs_available(),
+            revision: 0,
+            saved_revision: 0,
+            quit_confirmed: false,
+            imports: 0,
+            layer_counts: Vec::new(),
+            colours: Vec::new(),
+            out_of_reach: Vec::new(),
         }
     }
 
@@ -247,7 +293,28 @@ impl App {
             settings: self.doc.settings.clone(),
             recent: self.recent.clone(),
             layers: self.layers,
+            frame_times: self.frame_times,
         }
+    }
+
+    /// Whether native file dialogs are tried (without them every file action asks for a path
+    /// in a text field).
+    pub fn set_native_dialogs(&mut self, on: bool) {
+        self.dialogs = on;
+    }
+
+    /// The question or path field shown, if any.
+    pub fn prompt(&self) -> Option<&Prompt> {
+        self.prompt.as_ref()
+    }
+
+    /// True when the document has changes that are not saved in a project file.
+    pub fn has_unsaved_changes(&self) -> bool {
+        self.has_document() && self.revision != self.saved_revision
+    }
+
+    fn changed(&mut self) {
+        self.revision += 1;
     }
 
     fn set_status(&mut self, text: impl Into<String>, error: bool) {
@@ -267,40 +334,17 @@ impl App {
         !self.doc.geometries.is_empty()
     }
 
-    /// Opens an SVG (fields placed automatically) or a project file; errors go to the status
-    /// line. Returns true on success.
+    /// Opens an SVG or DXF (fields placed automatically) or a project file on this thread (the
+    /// command-line argument and tests); errors go to the status line. Returns true on success.
     pub fn open(&mut self, path: &Path) -> bool {
-        match files::open(path, &self.doc.profile, &self.doc.settings) {
+        match files::open(
+            path,
+            &self.doc.profile,
+            &self.doc.settings,
+            &JobCtx::default(),
+        ) {
             Ok(o) => {
-                self.job = None;
-                self.doc = o.doc;
-                self.project_path = o.is_project.then(|| path.to_path_buf());
-                self.history.clear();
-                self.selected = None;
-                self.active = self.doc.plans.len().checked_sub(1);
-                self.compare = CompareState::default();
-                self.playback = Playback::default();
-                self.workbench.fit_requested = true;
-                self.compare.canvas.fit_requested = true;
-                self.recent.push(path);
-                self.refresh();
-                let msg = format!(
-                    "{}: {} geometries, {} fields, {} import warnings",
-                    path.display(),
-                    self.doc.geometries.len(),
-                    self.doc.fields.len(),
-                    self.doc.warnings.len()
-                );
-                match o.problem {
-                    Some(p) => {
-                        self.set_status(format!("{msg}; fields not placed: {p}"), true);
-                        self.problem = Some(p);
-                    }
-                    None => {
-                        self.problem = None;
-                        self.set_status(msg, false);
-                    }
-                }
+                self.opened(path, o);
                 true
             }
             Err(e) => {
@@ -310,10 +354,135 @@ impl App {
         }
     }
 
+    /// Opens a file in a background job (progress and Cancel in the status bar).
+    pub fn open_in_background(&mut self, path: &Path, repaint: &egui::Context) {
+        let (file, profile, settings) = (
+            path.to_path_buf(),
+            self.doc.profile.clone(),
+            self.doc.settings.clone(),
+        );
+        let name = format!("opening {}", path.display());
+        self.start_job(name, "open", repaint, move |ctx| {
+            files::open(&file, &profile, &settings, ctx).map(|o| JobResult::Opened {
+                path: file,
+                opened: Box::new(o),
+            })
+        });
+    }
+
+    /// Takes an opened document into the window.
+    fn opened(&mut self, path: &Path, o: files::Opened) {
+        self.job = None;
+        self.doc = o.doc;
+        self.project_path = o.is_project.then(|| path.to_path_buf());
+        self.history.clear();
+        self.selected = None;
+        self.active = self.doc.plans.len().checked_sub(1);
+        self.compare = CompareState::default();
+        self.playback = Playback::default();
+        self.workbench.fit_requested = true;
+        self.compare.canvas.fit_requested = true;
+        self.recent.push(path);
+        self.imports += 1;
+        self.refresh();
+        self.changed();
+        self.saved_revision = self.revision;
+        let msg = format!(
+            "{}: {} geometries on {} layers, {} scan fields, {} import warnings",
+            path.display(),
+            self.doc.geometries.len(),
+            self.doc.layers.len(),
+            self.doc.fields.len(),
+            self.doc.warnings.len()
+        );
+        match o.problem {
+            Some(p) => {
+                let p = gui_words(&p);
+                self.set_status(format!("{msg}; scan fields not placed: {p}"), true);
+                self.problem = Some(p);
+            }
+            None => {
+                self.problem = None;
+                self.set_status(msg, false);
+            }
+        }
+    }
+
+    /// Runs `work` as the background job (one at a time).
+    fn start_job(
+        &mut self,
+        name: String,
+        thread: &str,
+        repaint: &egui::Context,
+        work: impl FnOnce(&JobCtx) -> Result<JobResult, String> + Send + 'static,
+    ) {
+        if let Some(j) = &self.job {
+            let msg = format!("cannot start {name}: {} is running", j.name);
+            self.set_status(msg, true);
+            return;
+        }
+        match Job::spawn(name.clone(), thread, None, repaint, work) {
+            Ok(job) => {
+                self.job = Some(job);
+                self.set_status(format!("{name}…"), false);
+            }
+            Err(e) => self.set_status(format!("cannot start {name}: {e}"), true),
+        }
+    }
+
+    /// Re-places the unlocked fields automatically in a background job (undoable).
+    pub fn replace_fields(&mut self, repaint: &egui::Context) {
+        let mut work = self.doc.clone();
+        self.start_job(
+            "re-placing scan fields".into(),
+            "place",
+            repaint,
+            move |ctx| {
+                place_document_fields(&mut work, ctx).map_err(|e| gui_words(&e.to_string()))?;
+                Ok(JobResult::Placed {
+                    doc: Box::new(work),
+                    what: "re-place fields automatically".into(),
+                })
+            },
+        );
+    }
+
+    /// Gives the document a new layer table: at once when only speeds, powers, passes or
+    /// colours change; else the geometries are made again (hatch) and the fields placed again
+    /// in a background job (undoable when it ends).
+    pub fn set_layers(&mut self, layers: Vec<Layer>, repaint: &egui::Context) {
+        if let Err(e) = crate::document::validate_layers(&layers) {
+            self.set_status(e.to_string(), true);
+            return;
+        }
+        if Some(DerivedKey::of(&layers, self.doc.profile.field_mm)) == self.doc.derived_with {
+            let _ = self.execute(Command::SetLayers(layers));
+            return;
+        }
+        let mut work = self.doc.clone();
+        work.layers = layers;
+        self.start_job("hatching".into(), "hatch", repaint, move |ctx| {
+            let before = work.geometries.len();
+            derive_geometries(&mut work, ctx).map_err(|e| e.to_string())?;
+            if work.fields.is_empty() && !work.geometries.is_empty() {
+                place_document_fields(&mut work, ctx).map_err(|e| gui_words(&e.to_string()))?;
+            }
+            let what = format!(
+                "change layers: {before} to {} geometries",
+                work.geometries.len()
+            );
+            Ok(JobResult::Placed {
+                doc: Box::new(work),
+                what,
+            })
+        });
+    }
+
     /// Saves the document (with its plans) as a project file, atomically.
     pub fn save_project(&mut self, path: &Path) -> Result<(), String> {
         crate::document::save_project(&self.doc, path).map_err(|e| e.to_string())?;
         self.project_path = Some(path.to_path_buf());
+        self.saved_revision = self.revision;
         self.recent.push(path);
         self.set_status(format!("saved {}", path.display()), false);
         Ok(())
@@ -335,6 +504,25 @@ impl App {
         Ok(())
     }
 
+    /// Exports the plan shown on the workbench in a background job.
+    pub fn export_in_background(&mut self, kind: ExportKind, path: &Path, repaint: &egui::Context) {
+        let Some(plan) = self.active_plan().cloned() else {
+            self.set_status("no plan to export: run a solver first", true);
+            return;
+        };
+        let doc = Document {
+            plans: Vec::new(),
+            artwork: Vec::new(),
+            ..self.doc.clone()
+        };
+        let file = path.to_path_buf();
+        let name = format!("exporting {}", path.display());
+        self.start_job(name, "export", repaint, move |_| {
+            files::export(&doc, &plan, kind, &file)?;
+            Ok(JobResult::Exported { path: file, kind })
+        });
+    }
+
     /// Applies an edit command through the undo history.
     pub fn execute(&mut self, cmd: Command) -> Result<Outcome, String> {
         self.execute_grouped(cmd, None)
@@ -344,6 +532,9 @@ impl App {
         let what = cmd.describe();
         let r = self.history.execute(&mut self.doc, cmd, group);
         self.refresh();
+        if r.is_ok() {
+            self.changed();
+        }
         match &r {
             Ok(o) => {
                 if group.is_none() {
@@ -356,7 +547,7 @@ impl App {
                     self.problem = None;
                 }
             }
-            Err(e) => self.set_status(format!("cannot {what}: {e}"), true),
+            Err(e) => self.set_status(format!("cannot {what}: {}", gui_words(e)), true),
         }
         r
     }
@@ -364,7 +555,10 @@ impl App {
     /// Undoes the last edit.
     pub fn undo(&mut self) {
         match self.history.undo(&mut self.doc) {
-            Some(w) => self.set_status(format!("undid: {w}"), false),
+            Some(w) => {
+                self.changed();
+                self.set_status(format!("undid: {w}"), false)
+            }
             None => self.set_status("nothing to undo", false),
         }
         self.refresh();
@@ -373,7 +567,10 @@ impl App {
     /// Redoes the last undone edit.
     pub fn redo(&mut self) {
         match self.history.redo(&mut self.doc) {
-            Some(w) => self.set_status(format!("redid: {w}"), false),
+            Some(w) => {
+                self.changed();
+                self.set_status(format!("redid: {w}"), false)
+            }
             None => self.set_status("nothing to redo", false),
         }
         self.refresh();
@@ -390,6 +587,13 @@ impl App {
             }
         }
         self.uncovered = (0..held.len()).filter(|&g| !held[g]).collect();
+        self.out_of_reach = self
+            .uncovered
+            .iter()
+            .copied()
+            .filter(|&k| !can_be_covered(&self.doc.geometries[k], &self.doc.profile))
+            .collect();
+        self.refresh_layers();
         if self
             .selected
             .is_some_and(|id| !self.doc.fields.iter().any(|f| f.id == id))
@@ -400,6 +604,48 @@ impl App {
             self.active = self.doc.plans.len().checked_sub(1);
         }
         self.toolpaths.sync(&self.doc);
+    }
+
+    /// Layer counts and colours after the geometries or layers changed.
+    fn refresh_layers(&mut self) {
+        let index: std::collections::HashMap<&str, usize> = self
+            .doc
+            .layers
+            .iter()
+            .enumerate()
+            .map(|(k, l)| (l.name.as_str(), k))
+            .collect();
+        let mut counts = vec![(0, 0); self.doc.layers.len()];
+        for g in &self.doc.artwork {
+            if let Some(&k) = index.get(g.layer.as_str()) {
+                counts[k].0 += 1;
+            }
+        }
+        let rgb: Vec<egui::Color32> = self
+            .doc
+            .layers
+            .iter()
+            .map(|l| {
+                let [r, g, b] = l.rgb();
+                egui::Color32::from_rgb(r, g, b)
+            })
+            .collect();
+        self.colours.clear();
+        for g in &self.doc.geometries {
+            match index.get(g.layer.as_str()) {
+                Some(&k) => {
+                    counts[k].1 += 1;
+                    self.colours.push(rgb[k]);
+                }
+                None => self.colours.push(paint::colour::CLOSED),
+            }
+        }
+        self.layer_counts = counts;
+    }
+
+    /// Uncovered geometries that no scan field can hold.
+    pub fn out_of_reach(&self) -> &[usize] {
+        &self.out_of_reach
     }
 
     /// Geometries no field holds.
@@ -427,7 +673,7 @@ impl App {
         &self.playback
     }
 
-    /// True while a solve runs.
+    /// True while a background job (solve, import, hatch, placement, export) runs.
     pub fn is_busy(&self) -> bool {
         self.job.is_some()
     }
@@ -454,8 +700,8 @@ impl App {
 
     /// Why a solve cannot start now, if it cannot.
     pub fn solve_blocker(&self) -> Option<String> {
-        if self.job.is_some() {
-            Some("a solve is running".into())
+        if let Some(j) = &self.job {
+            Some(format!("{} is running", j.name))
         } else if !self.has_document() {
             Some("no document open".into())
         } else if !self.uncovered.is_empty() {
@@ -475,7 +721,7 @@ impl App {
             return;
         }
         let name = self.next_plan_name(algo);
-        match Job::start(&self.doc, algo, name.clone(), repaint) {
+        match Job::solve(&self.doc, algo, name.clone(), repaint) {
             Ok(job) => {
                 self.job = Some(job);
                 self.set_status(format!("{name}: solving…"), false);
@@ -515,7 +761,17 @@ impl App {
         let (name, cancelled, elapsed) = (job.name.clone(), job.is_cancelled(), job.elapsed());
         self.job = None;
         match outcome {
-            JobOutcome::Plan(mut plan) => {
+            JobOutcome::Done(JobResult::Opened { path, opened }) => self.opened(&path, *opened),
+            JobOutcome::Done(JobResult::Placed { doc, what }) => {
+                if self.execute(Command::SetContent { doc, what }).is_ok() {
+                    self.layer_editor.clear_error();
+                }
+            }
+            JobOutcome::Done(JobResult::Exported { path, kind }) => {
+                let what = kind.filter().0;
+                self.set_status(format!("wrote the {what} to {}", path.display()), false);
+            }
+            JobOutcome::Done(JobResult::Plan(mut plan)) => {
                 plan.name = if cancelled {
                     format!("{name} (stopped)")
                 } else {
@@ -538,6 +794,7 @@ impl App {
                     elapsed.as_secs_f64()
                 );
                 self.doc.plans.push(*plan);
+                self.changed();
                 self.toolpaths.sync(&self.doc);
                 let k = self.doc.plans.len() - 1;
                 self.active = Some(k);
@@ -575,7 +832,7 @@ impl App {
                     if let Some(f) = self.doc.fields.iter().find(|f| Some(f.id) == self.selected) {
                         let msg = format!(
                             "moved field {} to ({:.1}, {:.1}) mm: {} geometries, {} uncovered",
-                            f.id,
+                            field_number(&self.doc.fields, None, f.id),
                             f.center.x,
                             f.center.y,
                             f.geometries.len(),
@@ -601,6 +858,7 @@ impl App {
         // plans added, loaded or removed, the profile or the geometries changed
         self.toolpaths.sync(&self.doc);
         self.layout(ui);
+        self.prompt_ui(ui);
         if self.job.is_some() {
             // keep the elapsed time ticking between progress reports
             ui.ctx().request_repaint_after(Duration::from_millis(100));
@@ -628,12 +886,32 @@ impl App {
                 .collect()
         });
         if let Some(p) = dropped.first() {
-            self.open(p);
+            self.request_open(Some(p.clone()), ctx);
         }
-        if ctx.egui_wants_keyboard_input() {
+        let closing = ctx.input(|i| i.viewport().close_requested());
+        if closing && !self.quit_confirmed && self.has_unsaved_changes() {
+            ctx.send_viewport_cmd(egui::ViewportCommand::CancelClose);
+            self.prompt = Some(Prompt::Unsaved(prompts::Then::Quit));
+        }
+        if ctx.egui_wants_keyboard_input() || self.prompt.is_some() {
             return;
         }
         use egui::{Key, KeyboardShortcut, Modifiers};
+        let shortcut = |m: Modifiers, k: Key| {
+            ctx.input_mut(|i| i.consume_shortcut(&KeyboardShortcut::new(m, k)))
+        };
+        let cmd_shift = Modifiers::COMMAND | Modifiers::SHIFT;
+        if shortcut(cmd_shift, Key::S) {
+            self.request_save(true, ctx);
+        } else if shortcut(Modifiers::COMMAND, Key::S) {
+            self.request_save(false, ctx);
+        } else if shortcut(Modifiers::COMMAND, Key::O) {
+            self.request_open(None, ctx);
+        } else if shortcut(Modifiers::COMMAND, Key::E) {
+            self.request_export(ExportKind::Gcode, ctx);
+        } else if shortcut(Modifiers::COMMAND, Key::N) {
+            self.request_new();
+        }
         let redo = ctx.input_mut(|i| {
             i.consume_shortcut(&KeyboardShortcut::new(
                 Modifiers::COMMAND | Modifiers::SHIFT,
@@ -650,8 +928,7 @@ impl App {
         let quit = ctx
             .input_mut(|i| i.consume_shortcut(&KeyboardShortcut::new(Modifiers::COMMAND, Key::Q)));
         if quit {
-            // eframe stores the preferences on the way out
-            ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+            self.request_quit(ctx);
         }
         let (delete, fit) = ctx.input(|i| {
             (
@@ -690,6 +967,36 @@ pub fn is_stale(plan: &Plan, doc: &Document) -> bool {
         v
     }
     key(&plan.fields) != key(&doc.fields)
+}
+
+/// True when some scan-field position within the stage's stroke holds all of `g`.
+fn can_be_covered(g: &crate::document::Geometry, profile: &MachineProfile) -> bool {
+    let (x, y) = crate::fields::center_range(&g.bbox(), profile);
+    !x.is_empty() && !y.is_empty()
+}
+
+/// A library message in the GUI's words: command-line flags become the controls that do the
+/// same.
+pub fn gui_words(msg: &str) -> String {
+    msg.replace(
+        "use --split-oversize to cut them at field borders",
+        "tick \"Split oversize geometries\" in Solver settings and press \"Re-place \
+         automatically\" to cut them at field borders, or choose \"On the fly\" as the motion",
+    )
+}
+
+/// The number shown for field `id`: 1…n in the visiting order of `visiting` (a plan's fields)
+/// for the fields it has, else by placement order (`fields`), after the plan's.
+pub fn field_number(fields: &[ScanField], visiting: Option<&[ScanField]>, id: usize) -> usize {
+    let visited = visiting.unwrap_or(&[]);
+    if let Some(k) = visited.iter().position(|f| f.id == id) {
+        return k + 1;
+    }
+    let others = fields
+        .iter()
+        .filter(|f| !visited.iter().any(|v| v.id == f.id));
+    let rank = others.take_while(|f| f.id != id).count();
+    visited.len() + rank + 1
 }
 
 impl eframe::App for App {

@@ -17,6 +17,8 @@ pub mod colour {
     pub const OPEN: Color32 = Color32::from_rgb(21, 128, 61);
     /// Geometries no field holds.
     pub const UNCOVERED: Color32 = Color32::from_rgb(220, 38, 38);
+    /// Geometries no field can hold (larger than a field, or beyond the stage's reach).
+    pub const OUT_OF_REACH: Color32 = Color32::from_rgb(147, 51, 234);
     /// Scan fields.
     pub const FIELD: Color32 = Color32::from_rgb(79, 70, 229);
     /// The selected field.
@@ -119,7 +121,7 @@ fn paint_fields(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
         let r = Rect::from_two_pos(s(Pt::new(b.min_x, b.min_y)), s(Pt::new(b.max_x, b.max_y)));
         painter.rect_filled(r, 0.0, fill);
     }
-    for (k, f) in c.fields.iter().enumerate() {
+    for f in c.fields {
         let b = f.bbox();
         let r = Rect::from_two_pos(s(Pt::new(b.min_x, b.min_y)), s(Pt::new(b.max_x, b.max_y)));
         let selected = c.selected == Some(f.id);
@@ -133,7 +135,7 @@ fn paint_fields(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
         };
         painter.rect_stroke(r, 0.0, stroke, StrokeKind::Middle);
         painter.circle_filled(s(f.center), 2.0, stroke.color);
-        let number = if c.number_by_order { k + 1 } else { f.id };
+        let number = super::field_number(c.fields, c.visiting, f.id);
         let text = if f.locked {
             format!("{number} locked")
         } else {
@@ -183,13 +185,15 @@ fn paint_artwork(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
         if g.points.is_empty() {
             continue;
         }
-        let base = if g.closed {
-            colour::CLOSED
-        } else {
-            colour::OPEN
+        let base = match c.colours.and_then(|cs| cs.get(k)) {
+            Some(&layer) => layer,
+            None if g.closed => colour::CLOSED,
+            None => colour::OPEN,
         };
+        // layer colours (several layers or a hatch) win over the colours by order
+        let by_layer = c.colours.is_some();
         let col = match &rank {
-            Some(r) if r[k] >= 0.0 => lerp(colour::ORDER[0], colour::ORDER[1], r[k]),
+            Some(r) if r[k] >= 0.0 && !by_layer => lerp(colour::ORDER[0], colour::ORDER[1], r[k]),
             _ => base,
         }
         .gamma_multiply(fade);
@@ -213,7 +217,13 @@ fn paint_artwork(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
             if g.closed && !pts.is_empty() {
                 pts.push(pts[0]);
             }
-            shapes.push(Shape::line(pts, Stroke::new(2.5, colour::UNCOVERED)));
+            if c.out_of_reach.contains(&k) {
+                // no field can hold it: dashed purple, apart from the red of "not covered yet"
+                let stroke = Stroke::new(3.0, colour::OUT_OF_REACH);
+                shapes.extend(Shape::dashed_line(&pts, stroke, 6.0, 4.0));
+            } else {
+                shapes.push(Shape::line(pts, Stroke::new(2.5, colour::UNCOVERED)));
+            }
         }
     }
     painter.extend(shapes);

@@ -242,44 +242,18 @@ fn settings_specs() -> Vec<Spec<SolverSettings>> {
     ]
 }
 
-/// Checks solver settings; returns a message naming the first bad value.
+/// Checks solver settings (the library's [`SolverSettings::validate`]), as a message.
 pub fn validate_settings(s: &SolverSettings) -> Result<(), String> {
-    if !(s.direction_weight.is_finite() && s.direction_weight >= 0.0) {
-        return Err(format!(
-            "direction weight = {} must be zero or positive",
-            s.direction_weight
-        ));
-    }
-    if let Some(t) = s.time_limit_s {
-        if !(t.is_finite() && t > 0.0) {
-            return Err(format!(
-                "time limit = {t} must be a positive number of seconds"
-            ));
-        }
-    }
-    let ga = &s.ga;
-    if ga.population_min < 2 {
-        return Err("GA population min must be at least 2".into());
-    }
-    if !(ga.population_min <= ga.population && ga.population <= ga.population_max) {
-        return Err(format!(
-            "GA population {} must lie between min {} and max {}",
-            ga.population, ga.population_min, ga.population_max
-        ));
-    }
-    for (name, v) in [
-        ("GA elite fraction", ga.elite_fraction),
-        ("GA mutation rate", ga.mutation_rate),
-    ] {
-        if !(0.0..=1.0).contains(&v) {
-            return Err(format!("{name} = {v} must lie in [0, 1]"));
-        }
-    }
-    if ga.stall_generations == 0 {
-        return Err("GA stall generations must be at least 1".into());
-    }
-    Ok(())
+    s.validate().map_err(|e| e.to_string())
 }
+
+/// Checks a machine profile (the library's [`MachineProfile::validate`]), as a message.
+pub fn validate_profile(p: &MachineProfile) -> Result<(), String> {
+    p.validate().map_err(|e| e.to_string())
+}
+
+/// Lines reserved above a form for its message, so that a message never moves the fields.
+const MESSAGE_LINES: f32 = 3.0;
 
 /// Text buffers of one form, re-read whenever the value changes from elsewhere (undo, open).
 struct Form<T> {
@@ -312,6 +286,8 @@ impl<T: Clone + PartialEq> Form<T> {
             self.synced = Some(value.clone());
         }
         let mut out = None;
+        self.message(ui);
+        ui.end_row();
         for (k, spec) in self.specs.iter().enumerate() {
             let label = ui.label(spec.label);
             let bad = self.error[k].is_some();
@@ -327,34 +303,46 @@ impl<T: Clone + PartialEq> Form<T> {
             // commit on Enter / leaving the field, or when set without focus (accessibility)
             if r.lost_focus() || (r.changed() && !r.has_focus()) {
                 let mut candidate = value.clone();
-                let result =
-                    (spec.set)(&mut candidate, &self.text[k]).and_then(|()| validate(&candidate));
+                let result = (spec.set)(&mut candidate, &self.text[k])
+                    .map_err(|e| format!("{}: {e}", spec.label))
+                    .and_then(|()| validate(&candidate));
                 match result {
                     Ok(()) if candidate != *value => out = Some(candidate),
                     Ok(()) => self.error[k] = None,
                     Err(e) => self.error[k] = Some(e),
                 }
             }
-            if let Some(e) = &self.error[k] {
-                ui.label("");
-                ui.label(
-                    RichText::new(e.as_str())
-                        .color(Color32::from_rgb(200, 30, 30))
-                        .small(),
-                );
-                ui.end_row();
-            }
         }
         out
     }
+
+    /// The form's message in reserved lines spanning the grid: the rejected value's reason,
+    /// or a hint.
+    fn message(&self, ui: &mut egui::Ui) {
+        let h = MESSAGE_LINES * ui.text_style_height(&egui::TextStyle::Body);
+        let text = match self.error.iter().flatten().next() {
+            Some(e) => RichText::new(e).color(Color32::from_rgb(200, 30, 30)),
+            None => RichText::new("Values apply on Enter or when leaving a field.").weak(),
+        };
+        ui.label("");
+        let (rect, _) =
+            ui.allocate_exact_size(egui::vec2(MESSAGE_WIDTH_PX, h), egui::Sense::hover());
+        ui.put(rect, egui::Label::new(text).wrap());
+    }
 }
+
+/// Width of a form's message (the value column's edits are narrower; the label column's
+/// width comes first).
+const MESSAGE_WIDTH_PX: f32 = 150.0;
 
 /// The profile and settings editors.
 pub struct Editors {
     profile: Form<MachineProfile>,
     settings: Form<SolverSettings>,
-    /// Last error of loading/saving a profile file.
+    /// Last error of choosing a built-in profile.
     file_error: Option<String>,
+    /// A profile file to load or save, for the window to ask a path for.
+    file_request: Option<super::prompts::PathAction>,
 }
 
 impl Default for Editors {
@@ -363,6 +351,7 @@ impl Default for Editors {
             profile: Form::new(profile_specs()),
             settings: Form::new(settings_specs()),
             file_error: None,
+            file_request: None,
         }
     }
 }
@@ -375,6 +364,11 @@ impl Editors {
             .iter()
             .chain(&self.settings.error)
             .any(Option::is_some)
+    }
+
+    /// A profile file to load or save that the operator asked for.
+    pub fn take_file_request(&mut self) -> Option<super::prompts::PathAction> {
+        self.file_request.take()
     }
 
     /// The machine-profile editor; returns the command for an accepted change.
@@ -399,43 +393,20 @@ impl Editors {
         });
         ui.horizontal(|ui| {
             if ui.button("Load TOML…").clicked() {
-                if let Some(path) = rfd::FileDialog::new()
-                    .add_filter("profile", &["toml"])
-                    .pick_file()
-                {
-                    match MachineProfile::load(&path.display().to_string()) {
-                        Ok(p) => out = Some(p),
-                        Err(e) => self.file_error = Some(e.to_string()),
-                    }
-                }
+                self.file_request = Some(super::prompts::PathAction::LoadProfile);
             }
             if ui.button("Save TOML…").clicked() {
-                if let Some(path) = rfd::FileDialog::new()
-                    .add_filter("profile", &["toml"])
-                    .set_file_name("profile.toml")
-                    .save_file()
-                {
-                    let written = profile
-                        .to_toml()
-                        .map_err(|e| e.to_string())
-                        .and_then(|text| {
-                            crate::document::write_atomic(&path, text.as_bytes())
-                                .map_err(|e| e.to_string())
-                        });
-                    if let Err(e) = written {
-                        self.file_error = Some(format!("{}: cannot write: {e}", path.display()));
-                    }
-                }
+                self.file_request = Some(super::prompts::PathAction::SaveProfile);
             }
         });
         if let Some(e) = &self.file_error {
-            ui.colored_label(Color32::from_rgb(200, 30, 30), e);
+            ui.add(egui::Label::new(RichText::new(e).color(Color32::from_rgb(200, 30, 30))).wrap());
         }
         egui::Grid::new("profile-grid")
             .num_columns(2)
             .striped(true)
             .show(ui, |ui| {
-                if let Some(p) = self.profile.ui(ui, profile, MachineProfile::validate) {
+                if let Some(p) = self.profile.ui(ui, profile, validate_profile) {
                     out = Some(p);
                 }
             });

@@ -181,6 +181,7 @@ mod tests {
             history: Vec::new(),
             motion: MotionMode::Step,
             stage_route: None,
+            layers: Vec::new(),
         };
         Document {
             geometries: vec![line],

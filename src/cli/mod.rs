@@ -8,8 +8,8 @@ mod progress;
 use anyhow::Result;
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use galvoplan::document::{
-    Algo, CostModel, FieldsMode, MachineProfile, MotionMode, RouteGaSettings, SolverSettings,
-    StageRouteKind, VertexMode,
+    Algo, CostModel, FieldsMode, MachineProfile, MotionMode, PenLibrary, RouteGaSettings,
+    SolverSettings, StageRouteKind, VertexMode,
 };
 use galvoplan::hatch::{HatchSettings, OutlineMode};
 use galvoplan::import::ImportOptions;
@@ -21,13 +21,13 @@ use std::path::PathBuf;
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
-    /// With no subcommand: an SVG or project file to open in the GUI.
+    /// With no subcommand: an SVG, DXF or project file to open in the GUI.
     file: Option<PathBuf>,
 }
 
 #[derive(Subcommand, Debug)]
 enum Command {
-    /// Plan one job: SVG in, G-code (and report, preview) out.
+    /// Plan one job: SVG or DXF in, G-code (and report, preview) out.
     Plan(PlanArgs),
     /// Run the pipeline over SVG files or folders and print one row per instance.
     Bench(BenchArgs),
@@ -161,6 +161,11 @@ struct JobOpts {
     /// contour (closed paths of one SVG element form one region, even-odd).
     #[arg(long, value_name = "STYLE:SPACING_MM[:ANGLE_DEG]")]
     hatch: Option<String>,
+    /// Pens by layer (TOML: `version = 1`, `[default]`, `[[layer]]` with `name`, `enabled`,
+    /// `mark_speed_mm_s`, `power`, `frequency_khz`, `passes`, `colour`, `[layer.hatch]`); layers
+    /// it does not name get its default pen, with --hatch as that pen's hatch.
+    #[arg(long, value_name = "PENS.toml")]
+    pens: Option<PathBuf>,
     /// Hatch edge offset from the outline, mm (default: one spacing).
     #[arg(
         long,
@@ -190,17 +195,25 @@ impl JobOpts {
         Ok(MachineProfile::load(&self.profile)?)
     }
     fn settings(&self) -> Result<SolverSettings> {
-        anyhow::ensure!(
-            self.direction_weight.is_finite() && self.direction_weight >= 0.0,
-            "--direction-weight must be zero or positive, got {}",
-            self.direction_weight
-        );
-        if let Some(t) = self.time_limit {
-            anyhow::ensure!(
-                t.is_finite() && t > 0.0,
-                "--time-limit must be a positive number of seconds, got {t}"
-            );
-        }
+        let s = self.unchecked_settings()?;
+        s.validate().map_err(|e| {
+            let flag = match e.key.as_str() {
+                "direction_weight" => " (--direction-weight)",
+                "time_limit_s" => " (--time-limit)",
+                _ => "",
+            };
+            anyhow::anyhow!("invalid settings: {e}{flag}")
+        })?;
+        Ok(s)
+    }
+    fn pens(&self) -> Result<Option<PenLibrary>> {
+        self.pens
+            .as_deref()
+            .map(PenLibrary::load)
+            .transpose()
+            .map_err(Into::into)
+    }
+    fn unchecked_settings(&self) -> Result<SolverSettings> {
         Ok(SolverSettings {
             fields: match self.fields {
                 FieldsArg::Auto => FieldsMode::Auto,
@@ -273,13 +286,14 @@ impl JobOpts {
         );
         Ok(ImportOptions {
             chord_tol_mm: self.chord_tol,
+            ..ImportOptions::default()
         })
     }
 }
 
 #[derive(Args, Debug)]
 struct PlanArgs {
-    /// Input SVG.
+    /// Input SVG or DXF.
     input: PathBuf,
     /// Output G-code.
     #[arg(short, long)]

@@ -8,7 +8,7 @@ use galvoplan::export::{
     geometry_svg, preview_svg, report_json, trajectory_csv, trajectory_period_s, write_gcode,
 };
 use galvoplan::job::{CancelToken, JobCtx};
-use galvoplan::pipeline::{load_svg, lower_plan_on, plan_document};
+use galvoplan::pipeline::{apply_pen_library, load_svg, lower_plan_on, plan_document};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -21,9 +21,20 @@ pub fn run(a: &PlanArgs) -> Result<()> {
         .as_ref()
         .map(|_| trajectory_period_s(a.trajectory_period_ms))
         .transpose()?;
+    let pens = a.job.pens()?;
     let (mut doc, import_s) = load_svg(&a.input, profile, settings, &opts)?;
     for w in &doc.warnings {
         eprintln!("galvoplan: warning: {}: {w}", a.input.display());
+    }
+    if let Some(lib) = &pens {
+        for name in apply_pen_library(&mut doc, lib) {
+            let known: Vec<&str> = doc.layers.iter().map(|l| l.name.as_str()).collect();
+            eprintln!(
+                "galvoplan: warning: {}: the pens file names layer '{name}', which the artwork does not have (its layers: {})",
+                a.input.display(),
+                known.join(", ")
+            );
+        }
     }
     let progress = Arc::new(BarProgress::new());
     let mut ctx = JobCtx::new(CancelToken::new(), progress.clone());

@@ -1,5 +1,6 @@
 //! One continuous stroke of the artwork.
 
+use super::DEFAULT_LAYER;
 use crate::geom::{polyline_length, BBox, Pt};
 use serde::{Deserialize, Serialize};
 
@@ -10,7 +11,9 @@ pub struct Source {
     pub element: String,
     /// Index of the subpath inside the element (0 for the first).
     pub subpath: usize,
-    /// Layer: the stroke colour as `#rrggbb` (or `none`).
+    /// Layer name: the DXF layer; for SVG the `inkscape:label` (else the `id`) of the top-level
+    /// group holding the element, else its stroke colour as `#rrggbb` (`fill #rrggbb` when it
+    /// has only a fill, `none` when neither).
     pub layer: String,
 }
 
@@ -26,10 +29,20 @@ pub struct Geometry {
     pub closed: bool,
     /// Origin in the source file.
     pub source: Source,
+    /// The layer it belongs to (its pen says how it is marked): the import's `source.layer`
+    /// (SVG top-level group label or id, else stroke colour; DXF layer), [`DEFAULT_LAYER`] when
+    /// the import gave none. Hatch output keeps its region's layer.
+    #[serde(default = "default_layer")]
+    pub layer: String,
+}
+
+fn default_layer() -> String {
+    DEFAULT_LAYER.to_string()
 }
 
 impl Geometry {
-    /// Makes a geometry; for a closed one a repeated last point is dropped.
+    /// Makes a geometry on the layer its source names ([`DEFAULT_LAYER`] when none); for a
+    /// closed one a repeated last point is dropped.
     pub fn new(mut points: Vec<Pt>, closed: bool, source: Source) -> Self {
         if closed && points.len() > 1 {
             if let (Some(a), Some(b)) = (points.first(), points.last()) {
@@ -38,11 +51,23 @@ impl Geometry {
                 }
             }
         }
+        // the import's layer name (DXF layer, SVG group or stroke colour)
+        let layer = if source.layer.is_empty() {
+            default_layer()
+        } else {
+            source.layer.clone()
+        };
         Self {
             points,
             closed,
             source,
+            layer,
         }
+    }
+    /// The same geometry on layer `name`.
+    pub fn with_layer(mut self, name: &str) -> Self {
+        self.layer = name.to_string();
+        self
     }
     /// Bounding box.
     pub fn bbox(&self) -> BBox {

@@ -1,12 +1,18 @@
 //! The document model: geometries, machine profile, solver settings, scan fields and plans.
 
 mod geometry;
+mod pens;
 mod plan;
 mod profile;
 mod project;
 mod settings;
+pub mod validate;
 
 pub use geometry::{Geometry, Source};
+pub use pens::{
+    parse_colour, pen_of, sync_layers, validate_layers, Layer, Pen, PenLibrary, PensError,
+    DEFAULT_LAYER, MAX_PASSES, PENS_VERSION,
+};
 pub use plan::{
     GenerationRecord, Metrics, MotionFigures, Plan, ScanField, StageTimes, Step, TimeBreakdown,
 };
@@ -14,14 +20,40 @@ pub use profile::{
     AxisLimits, GcodeDialect, GcodeMode, LaserTiming, MachineProfile, ProfileError, ScannerSpeeds,
     BUILTIN, PROFILE_VERSION,
 };
-pub use project::{load_project, save_project, write_atomic, ProjectError, PROJECT_VERSION};
+pub use project::{
+    load_project, parse_project, save_project, write_atomic, ProjectError, PROJECT_VERSION,
+};
 pub use settings::{
     Algo, CostModel, FieldsMode, GaParams, MotionMode, RouteGaSettings, SolverSettings,
     StageRouteKind, VertexMode,
 };
 
+use crate::hatch::HatchSettings;
 use crate::import::Warning;
 use serde::{Deserialize, Serialize};
+
+/// The parts of the layer table and profile that decide the marked geometries: per layer its
+/// name, whether it is enabled and its hatch; the field size (hatch is cut at field cells).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct DerivedKey {
+    /// (name, enabled, hatch) per layer.
+    pub layers: Vec<(String, bool, Option<HatchSettings>)>,
+    /// Scan-field size, mm.
+    pub field_mm: [f64; 2],
+}
+
+impl DerivedKey {
+    /// The key of a layer table on a field size.
+    pub fn of(layers: &[Layer], field_mm: [f64; 2]) -> Self {
+        Self {
+            layers: layers
+                .iter()
+                .map(|l| (l.name.clone(), l.pen.enabled, l.pen.hatch.clone()))
+                .collect(),
+            field_mm,
+        }
+    }
+}
 
 /// Everything an operator works on: imported artwork, machine, settings, fields and plans.
 #[derive(Debug, Clone, Default, Serialize, Deserialize, PartialEq)]
@@ -30,7 +62,18 @@ pub struct Document {
     pub source: Option<String>,
     /// Page size of the imported artwork in mm (width, height), used for the Y flip.
     pub page_mm: [f64; 2],
-    /// Imported geometries; a geometry's index is its id.
+    /// The artwork as imported (outlines only, every layer), from which `geometries` are
+    /// made by the layers' pens (see [`crate::pipeline::derive_geometries`]).
+    #[serde(default)]
+    pub artwork: Vec<Geometry>,
+    /// The layers of the artwork and their pens, in order of first appearance.
+    #[serde(default)]
+    pub layers: Vec<Layer>,
+    /// What `geometries` were last made from (none: not made yet, they are the artwork).
+    #[serde(default)]
+    pub derived_with: Option<DerivedKey>,
+    /// The geometries to mark: the enabled layers' artwork with their hatch; a geometry's
+    /// index is its id (fields and plans refer to it).
     pub geometries: Vec<Geometry>,
     /// Warnings from the import (skipped elements, degenerate paths).
     pub warnings: Vec<Warning>,
@@ -42,4 +85,44 @@ pub struct Document {
     pub fields: Vec<ScanField>,
     /// Results kept for comparison, newest last.
     pub plans: Vec<Plan>,
+}
+
+impl Document {
+    /// Checks profile, settings and layers, that every geometry's layer is in the table and
+    /// that fields and plans name geometries the document has. The CLI, the GUI and the project
+    /// loader all call it.
+    pub fn validate(&self) -> Result<(), validate::InvalidValue> {
+        use validate::InvalidValue;
+        self.profile.validate()?;
+        self.settings.validate()?;
+        validate_layers(&self.layers)?;
+        for (k, g) in self.artwork.iter().chain(&self.geometries).enumerate() {
+            if !self.layers.is_empty() && !self.layers.iter().any(|l| l.name == g.layer) {
+                return Err(InvalidValue::new(
+                    format!("The layer of geometry {}", k + 1),
+                    "layer",
+                    format!("'{}'", g.layer),
+                    "a layer of the layer table",
+                ));
+            }
+        }
+        let n = self.geometries.len();
+        let held = self
+            .fields
+            .iter()
+            .flat_map(|f| f.geometries.iter().map(move |&g| (f.id, g)));
+        let planned = self
+            .plans
+            .iter()
+            .flat_map(|p| p.order.iter().map(|s| (s.field, s.geometry)));
+        if let Some((field, g)) = held.chain(planned).find(|&(_, g)| g >= n) {
+            return Err(InvalidValue::new(
+                format!("A geometry of scan field {field}"),
+                "geometries",
+                g,
+                format!("one of the document's {n} geometries"),
+            ));
+        }
+        Ok(())
+    }
 }

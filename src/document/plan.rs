@@ -211,4 +211,22 @@ pub struct Plan {
     /// follows (none: the taut string, computed by the lowering itself).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub stage_route: Option<crate::motion::cetsp::TimedRoute>,
+    /// The layers and pens it was planned with (mark speeds, powers, passes): it is lowered
+    /// and exported with them whatever the current layer table. Empty (plans from before
+    /// pens): every geometry with the profile's speed, feed and power.
+    #[serde(default)]
+    pub layers: Vec<super::Layer>,
+}
+
+impl Plan {
+    /// The pen of geometry `g` in this plan (none: the profile's settings).
+    pub fn pen(&self, g: &super::Geometry) -> Option<&super::Pen> {
+        super::pen_of(&self.layers, g)
+    }
+    /// Mark speed of geometry `g` in this plan on `profile`, mm/s.
+    pub fn mark_speed_mm_s(&self, g: &super::Geometry, profile: &super::MachineProfile) -> f64 {
+        self.pen(g).map_or(profile.scanner.mark_speed_mm_s, |p| {
+            p.mark_speed_mm_s(profile)
+        })
+    }
 }

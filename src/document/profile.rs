@@ -1,5 +1,6 @@
 //! Machine profiles: stroke, scan field, dynamics, laser timing and G-code dialect (TOML).
 
+use super::validate::{non_negative, positive, InvalidValue};
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
@@ -138,8 +139,11 @@ pub struct GcodeDialect {
     pub laser_on: String,
     /// Word that switches the laser off.
     pub laser_off: String,
-    /// Laser power written as `S..` after the on word; none when absent.
+    /// Laser power written after the on word with the power word (`M3 S80`); none when
+    /// absent. A layer's pen may set its own.
     pub power: Option<f64>,
+    /// The word that carries the power (`S`).
+    pub power_word: String,
     /// Marking feed in mm/min written on `G1`.
     pub feed_mm_min: f64,
     /// Decimal places for coordinates.
@@ -158,6 +162,7 @@ impl Default for GcodeDialect {
             laser_on: "M3".into(),
             laser_off: "M5".into(),
             power: None,
+            power_word: "S".into(),
             feed_mm_min: 60_000.0,
             decimals: 4,
             flip_y: false,
@@ -279,9 +284,9 @@ impl MachineProfile {
         let mut table: toml::Table = toml::from_str(text).map_err(parse_error)?;
         upgrade(&mut table);
         let p: MachineProfile = table.try_into().map_err(parse_error)?;
-        p.validate().map_err(|msg| ProfileError::Invalid {
+        p.validate().map_err(|e| ProfileError::Invalid {
             file: file.into(),
-            msg,
+            msg: e.with_key(),
         })?;
         Ok(p)
     }
@@ -308,92 +313,143 @@ impl MachineProfile {
     pub fn to_toml(&self) -> Result<String, toml::ser::Error> {
         toml::to_string_pretty(self)
     }
-    /// Checks ranges; returns a message naming the first bad value.
-    pub fn validate(&self) -> Result<(), String> {
+    /// Checks ranges; the error names the first bad value in the GUI's words.
+    pub fn validate(&self) -> Result<(), InvalidValue> {
         if self.version == 0 || self.version > PROFILE_VERSION {
-            return Err(format!(
-                "version {} not supported (this build reads up to {PROFILE_VERSION})",
-                self.version
+            return Err(InvalidValue::new(
+                "Profile version",
+                "version",
+                self.version,
+                format!("between 1 and {PROFILE_VERSION} (this build)"),
             ));
         }
-        let positive = [
-            ("stroke_mm[0]", self.stroke_mm[0], true),
-            ("stroke_mm[1]", self.stroke_mm[1], true),
-            ("field_mm[0]", self.field_mm[0], false),
-            ("field_mm[1]", self.field_mm[1], false),
+        let (x, y) = (&self.axis_x, &self.axis_y);
+        for (what, key, v) in [
+            ("Field width (mm)", "field_mm[0]", self.field_mm[0]),
+            ("Field height (mm)", "field_mm[1]", self.field_mm[1]),
             (
+                "Base X max velocity (mm/s)",
                 "axis_x.max_velocity_mm_s",
-                self.axis_x.max_velocity_mm_s,
-                false,
+                x.max_velocity_mm_s,
             ),
-            ("axis_x.max_accel_mm_s2", self.axis_x.max_accel_mm_s2, false),
             (
+                "Base X max accel (mm/s²)",
+                "axis_x.max_accel_mm_s2",
+                x.max_accel_mm_s2,
+            ),
+            (
+                "Base Y max velocity (mm/s)",
                 "axis_y.max_velocity_mm_s",
-                self.axis_y.max_velocity_mm_s,
-                false,
+                y.max_velocity_mm_s,
             ),
-            ("axis_y.max_accel_mm_s2", self.axis_y.max_accel_mm_s2, false),
-            ("otf_margin_mm", self.otf_margin_mm, true),
-            ("axis_x.settle_s", self.axis_x.settle_s, true),
-            ("axis_y.settle_s", self.axis_y.settle_s, true),
             (
+                "Base Y max accel (mm/s²)",
+                "axis_y.max_accel_mm_s2",
+                y.max_accel_mm_s2,
+            ),
+            (
+                "Scanner jump speed (mm/s)",
                 "scanner.jump_speed_mm_s",
                 self.scanner.jump_speed_mm_s,
-                false,
             ),
             (
+                "Scanner mark speed (mm/s)",
                 "scanner.mark_speed_mm_s",
                 self.scanner.mark_speed_mm_s,
-                false,
             ),
-            ("gcode.feed_mm_min", self.gcode.feed_mm_min, false),
-        ];
-        for (name, v, zero_ok) in positive {
-            let ok = v.is_finite() && (v > 0.0 || (zero_ok && v == 0.0));
-            if !ok {
-                return Err(format!("{name} = {v} must be a positive number"));
-            }
-        }
-        for (name, v) in [
-            ("laser.on_delay_s", self.laser.on_delay_s),
-            ("laser.off_delay_s", self.laser.off_delay_s),
-            ("laser.jump_delay_s", self.laser.jump_delay_s),
+            ("Feed (mm/min)", "gcode.feed_mm_min", self.gcode.feed_mm_min),
         ] {
-            if !(v.is_finite() && v >= 0.0) {
-                return Err(format!("{name} = {v} must be zero or positive"));
-            }
+            positive(what, key, v)?;
         }
-        if self.gcode.decimals > 9 {
-            return Err("gcode.decimals must be at most 9".into());
+        for (what, key, v) in [
+            ("Stroke X (mm)", "stroke_mm[0]", self.stroke_mm[0]),
+            ("Stroke Y (mm)", "stroke_mm[1]", self.stroke_mm[1]),
+            (
+                "On-the-fly margin (mm)",
+                "otf_margin_mm",
+                self.otf_margin_mm,
+            ),
+            ("Base X settling time (s)", "axis_x.settle_s", x.settle_s),
+            ("Base Y settling time (s)", "axis_y.settle_s", y.settle_s),
+            (
+                "Laser on delay (s)",
+                "laser.on_delay_s",
+                self.laser.on_delay_s,
+            ),
+            (
+                "Laser off delay (s)",
+                "laser.off_delay_s",
+                self.laser.off_delay_s,
+            ),
+            (
+                "Jump delay (s)",
+                "laser.jump_delay_s",
+                self.laser.jump_delay_s,
+            ),
+        ] {
+            non_negative(what, key, v)?;
         }
-        for (name, w) in [
-            ("gcode.laser_on", &self.gcode.laser_on),
-            ("gcode.laser_off", &self.gcode.laser_off),
-            ("gcode.scanner_axes[0]", &self.gcode.scanner_axes[0]),
-            ("gcode.scanner_axes[1]", &self.gcode.scanner_axes[1]),
+        if let Some(power) = self.gcode.power {
+            non_negative("Power S", "gcode.power", power)?;
+        }
+        if self.gcode.decimals > MAX_DECIMALS {
+            return Err(InvalidValue::new(
+                "Decimals",
+                "gcode.decimals",
+                self.gcode.decimals,
+                format!("at most {MAX_DECIMALS}"),
+            ));
+        }
+        for (what, key, w) in [
+            ("Laser on word", "gcode.laser_on", &self.gcode.laser_on),
+            ("Laser off word", "gcode.laser_off", &self.gcode.laser_off),
+            ("Power word", "gcode.power_word", &self.gcode.power_word),
+            (
+                "Scanner X axis word",
+                "gcode.scanner_axes[0]",
+                &self.gcode.scanner_axes[0],
+            ),
+            (
+                "Scanner Y axis word",
+                "gcode.scanner_axes[1]",
+                &self.gcode.scanner_axes[1],
+            ),
         ] {
             if w.trim().is_empty() {
-                return Err(format!("{name} must not be empty"));
+                return Err(InvalidValue::new(
+                    what,
+                    key,
+                    "an empty word",
+                    "a G-code word",
+                ));
             }
         }
         let half_field_mm = self.field_mm[0].min(self.field_mm[1]) / 2.0;
         if self.otf_margin_mm >= half_field_mm {
-            return Err(format!(
-                "otf_margin_mm = {} must be less than half the field ({half_field_mm} mm)",
-                self.otf_margin_mm
+            return Err(InvalidValue::new(
+                "On-the-fly margin (mm)",
+                "otf_margin_mm",
+                self.otf_margin_mm,
+                format!("less than half the field ({half_field_mm} mm)"),
             ));
         }
         let [u, v] = &self.gcode.scanner_axes;
         if self.gcode.mode == GcodeMode::StageScanner
             && (u == v || [u, v].iter().any(|w| ["X", "Y"].contains(&w.trim())))
         {
-            return Err(format!(
-                "gcode.scanner_axes = [{u}, {v}] must be two words other than X and Y"
+            return Err(InvalidValue::new(
+                "Scanner axis words",
+                "gcode.scanner_axes",
+                format!("{u} and {v}"),
+                "two different words other than X and Y",
             ));
         }
         Ok(())
     }
 }
+
+/// The most decimal places a G-code number may have (below a nanometre is noise).
+pub const MAX_DECIMALS: usize = 9;
 
 #[cfg(test)]
 mod tests {
@@ -405,6 +461,8 @@ mod tests {
             MachineProfile::builtin(name).unwrap();
         }
         let p = MachineProfile::builtin("seed000").unwrap();
+        // the GUI's first-run profile is the default: the same machine
+        assert_eq!(p, MachineProfile::default());
         assert_eq!(p.stroke_mm, [300.0, 300.0]);
         assert_eq!(p.field_mm, [70.0, 70.0]);
         assert!(!p.gcode.flip_y);
@@ -430,6 +488,6 @@ mod tests {
         let e = MachineProfile::from_toml("version = 99\n", "p.toml")
             .unwrap_err()
             .to_string();
-        assert!(e.contains("version 99"), "{e}");
+        assert!(e.contains("Profile version") && e.contains("not 99"), "{e}");
     }
 }

@@ -1,13 +1,21 @@
 //! Project files: the whole [`Document`] as versioned JSON, written atomically.
 
-use super::Document;
+use super::validate::InvalidValue;
+use super::{sync_layers, DerivedKey, Document, Pen};
 use serde::{Deserialize, Serialize};
 use std::io::Write;
 use std::path::Path;
 use thiserror::Error;
 
 /// Current project format version.
-pub const PROJECT_VERSION: u32 = 1;
+///
+/// * 1: geometries, profile, settings, fields, plans.
+/// * 2: layers and pens (`layers`, each geometry's `layer`, each plan's `layers`), the
+///   imported `artwork` the geometries are made from, and `derived_with`. A version-1 project
+///   is upgraded on load: its geometries (without hatch output) become the artwork, on one
+///   default layer whose pen hatches as its settings' hatch did, and its geometries, fields
+///   and plans stay as they were.
+pub const PROJECT_VERSION: u32 = 2;
 const FORMAT: &str = "galvoplan-project";
 
 #[derive(Serialize, Deserialize)]
@@ -37,6 +45,14 @@ pub enum ProjectError {
         file: String,
         /// Parser message, with line and column.
         msg: String,
+    },
+    /// A value is out of range or the parts do not fit together.
+    #[error("{file}: invalid project: {}", .error.with_key())]
+    Invalid {
+        /// The file.
+        file: String,
+        /// The first bad value.
+        error: InvalidValue,
     },
     /// Written by a newer version.
     #[error(
@@ -124,13 +140,35 @@ pub fn parse_project(text: &str, file: &str) -> Result<Document, ProjectError> {
             found: version,
         });
     }
-    // Version 1 is the first format; later versions upgrade older values here before decoding.
     let pf: ProjectFile = serde_json::from_value(value).map_err(|e| corrupt(e.to_string()))?;
-    pf.document
-        .profile
-        .validate()
-        .map_err(|m| corrupt(format!("profile: {m}")))?;
-    Ok(pf.document)
+    let mut doc = pf.document;
+    if version == 1 {
+        upgrade_v1(&mut doc);
+    }
+    doc.validate().map_err(|error| ProjectError::Invalid {
+        file: file.into(),
+        error,
+    })?;
+    Ok(doc)
+}
+
+/// Version 1 → 2: the geometries (without hatch output) become the artwork on the default
+/// layer, whose pen hatches as the settings said; the geometries count as made from that
+/// table, so fields and plans stay valid.
+fn upgrade_v1(doc: &mut Document) {
+    doc.artwork = doc
+        .geometries
+        .iter()
+        .filter(|g| !crate::hatch::is_hatch_output(g))
+        .cloned()
+        .collect();
+    let default_pen = Pen {
+        hatch: doc.settings.hatch.clone(),
+        ..Pen::default()
+    };
+    sync_layers(&mut doc.layers, &doc.artwork, &default_pen);
+    sync_layers(&mut doc.layers, &doc.geometries, &default_pen);
+    doc.derived_with = Some(DerivedKey::of(&doc.layers, doc.profile.field_mm));
 }
 
 #[cfg(test)]

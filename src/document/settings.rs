@@ -1,5 +1,6 @@
 //! Solver settings: which field placement and ordering to run, seed, limits, GA parameters.
 
+use super::validate::{non_negative, positive, within, InvalidValue};
 use serde::{Deserialize, Serialize};
 
 /// How scan fields are placed.
@@ -210,5 +211,110 @@ impl Default for SolverSettings {
             ga: GaParams::default(),
             hatch: None,
         }
+    }
+}
+
+impl SolverSettings {
+    /// Checks ranges; the error names the first bad value in the GUI's words.
+    pub fn validate(&self) -> Result<(), InvalidValue> {
+        non_negative(
+            "Direction weight",
+            "direction_weight",
+            self.direction_weight,
+        )?;
+        if let Some(t) = self.time_limit_s {
+            positive("Time limit (s)", "time_limit_s", t)?;
+        }
+        let ga = &self.ga;
+        if ga.population_min < MIN_POPULATION {
+            return Err(InvalidValue::new(
+                "GA population min",
+                "ga.population_min",
+                ga.population_min,
+                format!("at least {MIN_POPULATION}"),
+            ));
+        }
+        if !(ga.population_min <= ga.population && ga.population <= ga.population_max) {
+            return Err(InvalidValue::new(
+                "GA population",
+                "ga.population",
+                ga.population,
+                format!(
+                    "between GA population min ({}) and max ({})",
+                    ga.population_min, ga.population_max
+                ),
+            ));
+        }
+        within(
+            "GA elite fraction",
+            "ga.elite_fraction",
+            ga.elite_fraction,
+            0.0,
+            1.0,
+        )?;
+        within(
+            "GA mutation rate",
+            "ga.mutation_rate",
+            ga.mutation_rate,
+            0.0,
+            1.0,
+        )?;
+        if ga.stall_generations == 0 {
+            return Err(InvalidValue::new(
+                "GA stall generations",
+                "ga.stall_generations",
+                0,
+                "at least 1",
+            ));
+        }
+        if let Some(h) = &self.hatch {
+            h.check().map_err(|e| e.within("Default hatch", "hatch"))?;
+        }
+        Ok(())
+    }
+}
+
+/// The smallest GA population: a crossover needs two parents.
+pub const MIN_POPULATION: usize = 2;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn settings_errors_are_worded() {
+        assert!(SolverSettings::default().validate().is_ok());
+        let mut s = SolverSettings {
+            direction_weight: -1.0,
+            ..SolverSettings::default()
+        };
+        let e = s.validate().unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "Direction weight must be zero or a positive number, not -1"
+        );
+        s.direction_weight = 0.5;
+        s.ga.population = 100;
+        assert!(s
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .starts_with("GA population must be between"));
+        s.ga.population = 32;
+        s.time_limit_s = Some(0.0);
+        assert_eq!(s.validate().unwrap_err().key, "time_limit_s");
+        s.time_limit_s = None;
+        s.ga.mutation_rate = 2.0;
+        assert_eq!(s.validate().unwrap_err().what, "GA mutation rate");
+        s.ga.mutation_rate = 0.3;
+        s.ga.stall_generations = 0;
+        assert!(s.validate().is_err());
+        s.ga.stall_generations = 5;
+        s.hatch = Some(crate::hatch::HatchSettings::new(
+            crate::hatch::HatchStyle::Lines,
+            0.0,
+        ));
+        let e = s.validate().unwrap_err().to_string();
+        assert!(e.starts_with("Default hatch: Hatch spacing (mm)"), "{e}");
     }
 }

@@ -6,7 +6,7 @@
 //!   centre; scanner jumps (`G0`) and marks (`G1`) are field-local offsets on the two scanner
 //!   axis words (default `U`, `V`), with the same laser words.
 
-use crate::document::{GcodeMode, MachineProfile, Plan};
+use crate::document::{GcodeMode, Layer, MachineProfile, Plan};
 use crate::geom::Pt;
 use crate::motion::Toolpath;
 use std::fmt::Write;
@@ -18,6 +18,58 @@ pub enum GcodeError {
     /// The stage moves while marking (on the fly): no per-field stage position to write.
     #[error("the stage-scanner G-code needs step-and-scan motion (the stage moves while marking on the fly): use the tcp dialect or the trajectory")]
     StageScannerOnTheFly,
+    /// A stroke without points (lowering never makes one).
+    #[error("stroke {stroke} of the toolpath has no points")]
+    EmptyStroke {
+        /// Stroke index in marking order.
+        stroke: usize,
+    },
+    /// A stroke names a layer the plan does not have (lowering never does).
+    #[error("stroke {stroke} of the toolpath names layer {layer}, which the plan does not have")]
+    NoLayer {
+        /// Stroke index in marking order.
+        stroke: usize,
+        /// Layer index.
+        layer: usize,
+    },
+}
+
+/// The laser-on line, feed and layer comment of one pen.
+struct PenWords {
+    on: String,
+    feed: String,
+    comment: Option<String>,
+}
+
+impl PenWords {
+    fn of(w: &Words<'_>, layer: Option<&Layer>) -> Self {
+        let profile = w.profile;
+        let d = &profile.gcode;
+        let pen = layer.map(|l| &l.pen);
+        let power = pen.map_or(d.power, |p| p.power(profile));
+        let feed = pen.map_or(d.feed_mm_min, |p| p.feed_mm_min(profile));
+        let on = match power {
+            Some(s) => format!("{} {}{}", d.laser_on, d.power_word, w.num(s)),
+            None => d.laser_on.clone(),
+        };
+        let comment = layer.map(|l| {
+            let speed = l.pen.mark_speed_mm_s(profile);
+            let freq = l.pen.frequency_khz.map_or(String::new(), |f| {
+                format!(", pulse frequency {} kHz", w.num(f))
+            });
+            format!(
+                "; layer {}: mark speed {} mm/s, passes {}{freq}",
+                l.name.replace('\n', " "),
+                w.num(speed),
+                l.pen.passes
+            )
+        });
+        Self {
+            on,
+            feed: w.num(feed),
+            comment,
+        }
+    }
 }
 
 /// Number formatting and the Y mirror of a dialect.
@@ -77,10 +129,16 @@ pub fn write_gcode(
         profile,
         page_height_mm,
     };
-    let on = match d.power {
-        Some(s) => format!("{} S{}", d.laser_on, w.num(s)),
-        None => d.laser_on.clone(),
-    };
+    // one set of words per layer of the plan, and the profile's for strokes without a pen
+    let pens: Vec<PenWords> = plan
+        .layers
+        .iter()
+        .map(|l| PenWords::of(&w, Some(l)))
+        .collect();
+    let profile_pen = PenWords::of(&w, None);
+    // a layer comment where the layer changes, when the plan's layers have pens of their own
+    let comment_layers = plan.layers.iter().any(|l| !l.pen.marks_as_profile());
+    let mut current_layer = None;
     let stage_scanner = d.mode == GcodeMode::StageScanner;
     if stage_scanner && toolpath.route.is_some() {
         return Err(GcodeError::StageScannerOnTheFly);
@@ -114,13 +172,26 @@ pub fn write_gcode(
             }
         };
         let Some((&first, rest)) = points.split_first() else {
-            continue;
+            return Err(GcodeError::EmptyStroke { stroke: k });
         };
+        let pen = match stroke.layer {
+            None => &profile_pen,
+            Some(l) => pens.get(l).ok_or(GcodeError::NoLayer {
+                stroke: k,
+                layer: l,
+            })?,
+        };
+        if comment_layers && current_layer != Some(stroke.layer) {
+            current_layer = Some(stroke.layer);
+            if let Some(c) = &pen.comment {
+                let _ = writeln!(out, "{c}");
+            }
+        }
         let _ = writeln!(out, "G0 {}", place(first));
-        let _ = writeln!(out, "{on}");
+        let _ = writeln!(out, "{}", pen.on);
         for (j, &p) in rest.iter().enumerate() {
             if j == 0 {
-                let _ = writeln!(out, "G1 {} F{}", place(p), w.num(d.feed_mm_min));
+                let _ = writeln!(out, "G1 {} F{}", place(p), pen.feed);
             } else {
                 let _ = writeln!(out, "G1 {}", place(p));
             }

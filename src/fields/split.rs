@@ -99,7 +99,7 @@ pub fn split_geometry(g: &Geometry, origin: Pt, pitch_mm: [f64; 2]) -> Vec<Geome
                 subpath: g.source.subpath,
                 layer: g.source.layer.clone(),
             };
-            Geometry::new(pts, closed_whole, source)
+            Geometry::new(pts, closed_whole, source).with_layer(&g.layer)
         })
         .collect()
 }

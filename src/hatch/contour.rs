@@ -17,7 +17,7 @@ use super::spots::{half_step_near_spots, MAX_BOX_SHARE};
 use crate::geom::Pt;
 use crate::job::{Cancelled, JobCtx};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use std::sync::{Arc, Mutex, OnceLock};
+use std::sync::{Arc, Mutex, OnceLock, PoisonError};
 
 /// The rings and gap strokes of one offset level.
 #[derive(Debug, Clone, Default)]
@@ -77,13 +77,24 @@ pub(crate) fn contour_levels(
     }
     // levels 0 .. first empty region
     let n = st.first_empty.load(Ordering::Relaxed);
-    let mut rings = st.rings.into_inner().unwrap_or_default().into_iter();
-    let mut gaps = st.gaps.into_inner().unwrap_or_default().into_iter();
+    // a lock is poisoned only by a panicking task, which rayon::scope has re-raised above: the
+    // data is whole (every critical section is a resize or a store)
+    let mut rings = st
+        .rings
+        .into_inner()
+        .unwrap_or_else(PoisonError::into_inner)
+        .into_iter();
+    let mut gaps = st
+        .gaps
+        .into_inner()
+        .unwrap_or_else(PoisonError::into_inner)
+        .into_iter();
     let mut levels: Vec<Level> = (0..n)
         .map(|_| Level {
             rings: rings
                 .next()
                 .flatten()
+                // `ring` fills a cell as soon as it makes it, so every cell here is filled
                 .map(|r| match Arc::try_unwrap(r) {
                     Ok(cell) => cell.into_inner().unwrap_or_default(),
                     Err(shared) => shared.get().cloned().unwrap_or_default(),
@@ -156,9 +167,7 @@ impl LevelState {
         if q.is_none() {
             self.first_empty.fetch_min(k, Ordering::Relaxed);
         }
-        let Ok(mut regions) = self.regions.lock() else {
-            return None;
-        };
+        let mut regions = self.regions.lock().unwrap_or_else(PoisonError::into_inner);
         if regions.len() <= k + 1 {
             regions.resize_with(k + 2, || None);
         }
@@ -175,14 +184,12 @@ impl LevelState {
 
     /// Ring `k` flattened (made on first use).
     fn ring(&self, k: usize, q: &Region) -> Arc<OnceLock<Vec<Vec<Pt>>>> {
-        let cell = match self.rings.lock() {
-            Ok(mut rings) => {
-                if rings.len() <= k {
-                    rings.resize_with(k + 1, || None);
-                }
-                rings[k].get_or_insert_with(Default::default).clone()
+        let cell = {
+            let mut rings = self.rings.lock().unwrap_or_else(PoisonError::into_inner);
+            if rings.len() <= k {
+                rings.resize_with(k + 1, || None);
             }
-            Err(_) => Arc::default(),
+            rings[k].get_or_insert_with(Default::default).clone()
         };
         cell.get_or_init(|| q.flatten(self.tol_mm));
         cell
@@ -256,12 +263,12 @@ type Slots<T> = Mutex<Vec<Option<T>>>;
 
 /// Puts `v` into slot `k`.
 fn store<T>(slots: &Slots<T>, k: usize, v: T) {
-    if let Ok(mut s) = slots.lock() {
-        if s.len() <= k {
-            s.resize_with(k + 1, || None);
-        }
-        s[k] = Some(v);
+    // see contour_levels: a poisoned lock still holds whole data
+    let mut s = slots.lock().unwrap_or_else(PoisonError::into_inner);
+    if s.len() <= k {
+        s.resize_with(k + 1, || None);
     }
+    s[k] = Some(v);
 }
 
 #[cfg(test)]

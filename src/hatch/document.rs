@@ -3,7 +3,7 @@
 
 use super::cut::{cut, fits, Grid};
 use super::{hatch_contours, HatchError, HatchSettings, OutlineMode};
-use crate::document::{Geometry, Source};
+use crate::document::{Geometry, Layer, Source};
 use crate::geom::{BBox, Pt};
 use crate::import::Warning;
 use crate::job::JobCtx;
@@ -69,7 +69,7 @@ pub fn hatch_geometries(
         regions: regions.len(),
         ..HatchedGeometries::default()
     };
-    let mut hatch_of: Vec<Option<Vec<Geometry>>> = Vec::with_capacity(regions.len());
+    let mut hatch_of: Vec<Vec<Geometry>> = Vec::with_capacity(regions.len());
     for (members, h) in regions.iter().zip(hatched) {
         let h = h?;
         if h.is_empty() {
@@ -84,7 +84,7 @@ pub fn hatch_geometries(
             });
         }
         out.hatch_geometries += h.len();
-        hatch_of.push(Some(h));
+        hatch_of.push(h);
     }
     let first_of: HashMap<usize, usize> =
         regions.iter().enumerate().map(|(r, m)| (m[0], r)).collect();
@@ -98,7 +98,8 @@ pub fn hatch_geometries(
             continue;
         };
         let outlines = regions[r].iter().map(|&k| geometries[k].clone());
-        let hatch = hatch_of[r].take().unwrap_or_default();
+        // each region is emitted once, at its first member
+        let hatch = std::mem::take(&mut hatch_of[r]);
         match settings.outline {
             OutlineMode::Before => {
                 out.geometries.extend(outlines);
@@ -115,6 +116,51 @@ pub fn hatch_geometries(
         return Err(HatchError::NothingLeft {
             edge_offset_mm: settings.edge_offset(),
         });
+    }
+    Ok(out)
+}
+
+/// The geometries to mark from the artwork and its layers: the geometries of disabled layers
+/// are left out; each hatched layer's closed geometries are hatched with its pen's settings
+/// ([`hatch_geometries`] on that layer alone), its output placed where the layer's first
+/// geometry was; everything else stays in artwork order. Layers not in the table are marked
+/// as they are.
+pub fn layer_geometries(
+    artwork: &[Geometry],
+    layers: &[Layer],
+    field_mm: [f64; 2],
+    ctx: &JobCtx,
+) -> Result<HatchedGeometries, HatchError> {
+    let mut out = HatchedGeometries::default();
+    let mut hatched: HashMap<&str, Vec<Geometry>> = HashMap::new();
+    for l in layers.iter().filter(|l| l.pen.enabled) {
+        let Some(settings) = &l.pen.hatch else {
+            continue;
+        };
+        let members: Vec<Geometry> = artwork
+            .iter()
+            .filter(|g| g.layer == l.name)
+            .cloned()
+            .collect();
+        if members.is_empty() {
+            continue;
+        }
+        let h = hatch_geometries(&members, settings, field_mm, ctx)?;
+        out.warnings.extend(h.warnings);
+        out.regions += h.regions;
+        out.hatch_geometries += h.hatch_geometries;
+        hatched.insert(l.name.as_str(), h.geometries);
+    }
+    for g in artwork {
+        let layer = layers.iter().find(|l| l.name == g.layer);
+        if layer.is_some_and(|l| !l.pen.enabled) {
+            continue;
+        }
+        match hatched.get_mut(g.layer.as_str()) {
+            // the layer's whole output goes where its first geometry was; later ones find it empty
+            Some(h) => out.geometries.append(h),
+            None => out.geometries.push(g.clone()),
+        }
     }
     Ok(out)
 }
@@ -165,15 +211,12 @@ fn hatch_region(
         .into_iter()
         .enumerate()
         .map(|(k, (points, closed))| {
-            Geometry::new(
-                points,
-                closed,
-                Source {
-                    element: first.source.element.clone(),
-                    subpath: k,
-                    layer: layer.clone(),
-                },
-            )
+            let source = Source {
+                element: first.source.element.clone(),
+                subpath: k,
+                layer: layer.clone(),
+            };
+            Geometry::new(points, closed, source).with_layer(&first.layer)
         })
         .collect())
 }

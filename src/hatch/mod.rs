@@ -34,7 +34,9 @@ mod settings;
 mod spots;
 mod zigzag;
 
-pub use document::{hatch_geometries, is_hatch_output, HatchedGeometries, HATCH_LAYER_PREFIX};
+pub use document::{
+    hatch_geometries, is_hatch_output, layer_geometries, HatchedGeometries, HATCH_LAYER_PREFIX,
+};
 pub use settings::{FillRule, HatchSettings, HatchStyle, OutlineMode, MIN_SPACING_MM};
 
 use crate::geom::{polyline_length, BBox, Pt};

@@ -2,6 +2,7 @@
 //! command-line form `STYLE:SPACING_MM[:ANGLE_DEG]`.
 
 use super::HatchError;
+use crate::document::validate::{non_negative, InvalidValue};
 use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::str::FromStr;
@@ -127,19 +128,29 @@ impl HatchSettings {
     }
     /// Checks that the numbers make sense.
     pub fn validate(&self) -> Result<(), HatchError> {
-        let bad = |m: String| Err(HatchError::Settings(m));
+        self.check()
+            .map_err(|e| HatchError::Settings(e.to_string()))
+    }
+    /// [`HatchSettings::validate`] as a value error naming the setting in the GUI's words.
+    pub fn check(&self) -> Result<(), InvalidValue> {
         if !(self.spacing_mm.is_finite() && self.spacing_mm >= MIN_SPACING_MM) {
-            return bad(format!(
-                "spacing must be a number of mm ≥ {MIN_SPACING_MM}, got {}",
-                self.spacing_mm
+            return Err(InvalidValue::new(
+                "Hatch spacing (mm)",
+                "spacing_mm",
+                self.spacing_mm,
+                format!("a number of mm of at least {MIN_SPACING_MM}"),
             ));
         }
         if !self.angle_deg.is_finite() {
-            return bad(format!("angle must be finite, got {}", self.angle_deg));
+            return Err(InvalidValue::new(
+                "Hatch angle (°)",
+                "angle_deg",
+                self.angle_deg,
+                "a finite number",
+            ));
         }
-        let d = self.edge_offset();
-        if !(d.is_finite() && d >= 0.0) {
-            return bad(format!("edge offset must be a number of mm ≥ 0, got {d}"));
+        if let Some(d) = self.edge_offset_mm {
+            non_negative("Hatch edge offset (mm)", "edge_offset_mm", d)?;
         }
         Ok(())
     }

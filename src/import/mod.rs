@@ -1,11 +1,127 @@
-//! Import of artwork into [`Geometry`](crate::document::Geometry) polylines in mm.
+//! Import of artwork (SVG, DXF) into [`Geometry`](crate::document::Geometry) polylines in mm.
+//!
+//! [`import_file`] is the one entry point for files: it chooses the format by extension (and by
+//! content when the extension says nothing) and every error names the file and the format.
 
+mod curves;
+mod dxf;
+mod dxf_text;
+mod fonts;
 mod svg;
 
-pub use svg::{import_svg, import_svg_file, ImportOptions, Imported};
+pub use self::dxf::import_dxf;
+pub use fonts::{BUNDLED_CAP_HEIGHT_EM, BUNDLED_FAMILY};
+pub use svg::{import_svg, import_svg_file};
 
+use crate::document::Geometry;
+use crate::geom::{polyline_length, Pt};
 use serde::{Deserialize, Serialize};
+use std::path::Path;
 use thiserror::Error;
+
+/// Subpaths shorter than this (mm) are degenerate: below the exported G-code's resolution.
+const MIN_LENGTH_MM: f64 = 1e-3;
+/// Points closer than this are one point (mm).
+const SAME_POINT_MM: f64 = 1e-6;
+
+/// Which fonts text is set in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum FontSource {
+    /// The bundled DejaVu Sans first, then the system's fonts (fontconfig).
+    #[default]
+    System,
+    /// Only the bundled DejaVu Sans: the same outlines on every machine (tests, fuzzing).
+    BundledOnly,
+}
+
+/// Import options.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ImportOptions {
+    /// Maximum distance between a curve and its flattened polyline, mm (the same guarantee for
+    /// SVG curves, text outlines and DXF arcs, ellipses and splines).
+    pub chord_tol_mm: f64,
+    /// Fonts for text.
+    pub fonts: FontSource,
+    /// Width and height of the area the artwork should lie in (the base stroke), mm. A DXF
+    /// drawing that lies outside it but would fit is moved to its corner (with a warning).
+    pub work_area_mm: Option<[f64; 2]>,
+}
+
+impl Default for ImportOptions {
+    fn default() -> Self {
+        Self {
+            chord_tol_mm: 0.01,
+            fonts: FontSource::System,
+            work_area_mm: None,
+        }
+    }
+}
+
+/// The result of an import.
+#[derive(Debug, Clone, Default)]
+pub struct Imported {
+    /// Geometries in document order.
+    pub geometries: Vec<Geometry>,
+    /// Skipped elements and degenerate paths.
+    pub warnings: Vec<Warning>,
+    /// Page size in mm (width, height).
+    pub page_mm: [f64; 2],
+}
+
+/// A file format [`import_file`] reads.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Format {
+    /// SVG or gzip-compressed SVGZ.
+    Svg,
+    /// DXF, ASCII or binary.
+    Dxf,
+}
+
+/// The format of a file: by extension (`.svg`, `.svgz`, `.dxf`, any case), else by content
+/// (XML or gzip → SVG; the binary DXF sentinel or a leading `0`/`SECTION` pair → DXF).
+pub fn detect_format(path: &Path, bytes: &[u8]) -> Option<Format> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    match ext.as_deref() {
+        Some("svg" | "svgz") => return Some(Format::Svg),
+        Some("dxf") => return Some(Format::Dxf),
+        _ => {}
+    }
+    let text = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
+    let start = text
+        .iter()
+        .position(|b| !b.is_ascii_whitespace())
+        .unwrap_or(0);
+    let text = &text[start..];
+    if text.starts_with(b"AutoCAD Binary DXF") {
+        return Some(Format::Dxf);
+    }
+    if text.starts_with(b"<") || text.starts_with(&[0x1f, 0x8b]) {
+        return Some(Format::Svg);
+    }
+    let head: Vec<&[u8]> = text
+        .split(|&b| b == b'\n')
+        .take(2)
+        .map(|l| l.trim_ascii())
+        .collect();
+    (head.len() == 2 && head[0] == b"0" && head[1] == b"SECTION").then_some(Format::Dxf)
+}
+
+/// Reads and imports an SVG or DXF file, choosing the format with [`detect_format`].
+pub fn import_file(path: &Path, opts: &ImportOptions) -> Result<Imported, ImportError> {
+    let file = path.display().to_string();
+    let bytes = std::fs::read(path).map_err(|source| ImportError::Io {
+        file: file.clone(),
+        source,
+    })?;
+    match detect_format(path, &bytes) {
+        Some(Format::Svg) => import_svg(&bytes, &file, opts),
+        Some(Format::Dxf) => import_dxf(&bytes, &file, opts),
+        None => Err(ImportError::UnknownFormat { file }),
+    }
+}
 
 /// Something the import skipped or changed, naming the element.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -52,7 +168,29 @@ pub enum ImportError {
         /// Parser message, with line and column where known.
         cause: String,
     },
-    /// The SVG holds nothing that can be marked.
+    /// The file is not a valid DXF.
+    #[error("{file}: not a valid DXF: {cause}")]
+    MalformedDxf {
+        /// The file.
+        file: String,
+        /// Parser message, with the line (ASCII) or byte offset (binary) where known.
+        cause: String,
+    },
+    /// Neither the extension nor the content says SVG or DXF.
+    #[error("{file}: unknown format (galvoplan reads SVG, SVGZ and DXF files)")]
+    UnknownFormat {
+        /// The file.
+        file: String,
+    },
+    /// The drawing expands to more than the import's budget (e.g. nested block arrays).
+    #[error("{file}: {detail}")]
+    TooLarge {
+        /// The file.
+        file: String,
+        /// What overflowed.
+        detail: String,
+    },
+    /// The file holds nothing that can be marked.
     #[error("{file}: no markable geometry ({detail})")]
     NothingToMark {
         /// The file.
@@ -60,4 +198,30 @@ pub enum ImportError {
         /// What was found instead.
         detail: String,
     },
+}
+
+/// Drops repeated points, detects implicit closing, rejects degenerate subpaths.
+fn normalise(pts: Vec<Pt>, closed: bool) -> Result<(Vec<Pt>, bool), &'static str> {
+    if pts.iter().any(|p| !p.is_finite()) {
+        return Err("non-finite coordinates (NaN or infinity)");
+    }
+    let mut out: Vec<Pt> = Vec::with_capacity(pts.len());
+    for p in pts {
+        if out.last().is_none_or(|q| q.dist(p) > SAME_POINT_MM) {
+            out.push(p);
+        }
+    }
+    let mut closed = closed;
+    if out.len() > 2 {
+        if let (Some(a), Some(b)) = (out.first(), out.last()) {
+            if a.dist(*b) <= SAME_POINT_MM {
+                out.pop();
+                closed = true;
+            }
+        }
+    }
+    if out.len() < 2 || polyline_length(&out, closed) < MIN_LENGTH_MM {
+        return Err("zero length (shorter than 1 µm)");
+    }
+    Ok((out, closed))
 }

@@ -1,13 +1,16 @@
-//! SVG import through `usvg`: shapes, groups, transforms and `use` resolved; curves flattened.
+//! SVG import through `usvg`: shapes, groups, transforms and `use` resolved; curves flattened;
+//! `<text>` laid out with the fonts of [`super::fonts`] and imported as glyph outlines.
 
-use super::{ImportError, Warning};
+use super::fonts::{family_list, miss_warnings, usvg_options, Misses};
+use super::{normalise, ImportError, ImportOptions, Imported, Warning};
 use crate::document::{Geometry, Source};
-use crate::geom::{flatten_cubic, flatten_quad, polyline_length, Pt};
+use crate::geom::{flatten_cubic, flatten_quad, Pt};
+use rustc_hash::FxHashMap;
 use usvg::roxmltree;
 use usvg::tiny_skia_path::PathSegment;
 
 /// CSS px (usvg's unit) to mm.
-const PX_TO_MM: f64 = 25.4 / 96.0;
+pub(super) const PX_TO_MM: f64 = 25.4 / 96.0;
 /// usvg works in f32 px (relative precision ~6e-8, i.e. ~2e-5 mm at 300 mm): coordinates are
 /// snapped to this grid (mm) so that "20" in the file reads as 20.0 and not 20.00000056.
 const SNAP_MM: f64 = 1e-5;
@@ -16,38 +19,8 @@ fn snap(v: f64) -> f64 {
     (v / SNAP_MM).round() * SNAP_MM
 }
 
-/// Subpaths shorter than this (mm) are degenerate: below the exported G-code's resolution.
-const MIN_LENGTH_MM: f64 = 1e-3;
-/// Points closer than this are one point (mm).
-const SAME_POINT_MM: f64 = 1e-6;
-
-/// Import options.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ImportOptions {
-    /// Maximum distance between a curve and its flattened polyline, mm.
-    pub chord_tol_mm: f64,
-}
-
-impl Default for ImportOptions {
-    fn default() -> Self {
-        Self { chord_tol_mm: 0.01 }
-    }
-}
-
-/// The result of an import.
-#[derive(Debug, Clone, Default)]
-pub struct Imported {
-    /// Geometries in document order.
-    pub geometries: Vec<Geometry>,
-    /// Skipped elements and degenerate paths.
-    pub warnings: Vec<Warning>,
-    /// Page size in mm (width, height).
-    pub page_mm: [f64; 2],
-}
-
 /// Elements that carry visible content galvoplan cannot mark.
 const UNSUPPORTED: &[&str] = &[
-    "text",
     "image",
     "foreignObject",
     "video",
@@ -107,19 +80,9 @@ pub fn import_svg(bytes: &[u8], file: &str, opts: &ImportOptions) -> Result<Impo
         )));
     }
     let mut warnings = unsupported_content(&xml);
-    let tree = usvg::Tree::from_xmltree(&xml, &usvg::Options::default())
-        .map_err(|e| malformed(e.to_string()))?;
-    // usvg stores sizes as f32 px: round to 0.1 µm so that "100mm" reads as 100
-    let round = |v: f32| (f64::from(v) * PX_TO_MM * 1e4).round() / 1e4;
-    let page_mm = [round(tree.size().width()), round(tree.size().height())];
-    let mut walker = Walker {
-        tol_px: opts.chord_tol_mm.max(1e-6) / PX_TO_MM,
-        geometries: Vec::new(),
-        warnings: &mut warnings,
-        path_count: 0,
-    };
-    walker.group(tree.root());
-    let geometries = walker.geometries;
+    let (geometries, page_mm, font_warnings) =
+        tree_geometries(&xml, opts, opts.chord_tol_mm).map_err(malformed)?;
+    warnings.extend(font_warnings);
     if geometries.is_empty() {
         let detail = if warnings.is_empty() {
             "the file has no paths or shapes".to_string()
@@ -146,6 +109,78 @@ pub fn import_svg(bytes: &[u8], file: &str, opts: &ImportOptions) -> Result<Impo
         warnings,
         page_mm,
     })
+}
+
+/// Geometries, page size in mm and font warnings of one usvg tree.
+type TreeGeometries = (Vec<Geometry>, [f64; 2], Vec<Warning>);
+
+/// A flattened subpath: points and whether it is closed.
+pub(super) type Outline = (Vec<Pt>, bool);
+
+/// Builds the usvg tree of `xml` (text laid out with the options' fonts) and flattens it within
+/// `tol_mm`: the geometries, the page size in mm and the font substitutions as warnings.
+fn tree_geometries(
+    xml: &roxmltree::Document,
+    opts: &ImportOptions,
+    tol_mm: f64,
+) -> Result<TreeGeometries, String> {
+    let misses = Misses::default();
+    let tree = usvg::Tree::from_xmltree(xml, &usvg_options(opts.fonts, &misses))
+        .map_err(|e| e.to_string())?;
+    // usvg stores sizes as f32 px: round to 0.1 µm so that "100mm" reads as 100
+    let round = |v: f32| (f64::from(v) * PX_TO_MM * 1e4).round() / 1e4;
+    let page_mm = [round(tree.size().width()), round(tree.size().height())];
+    let mut warnings = Vec::new();
+    let mut walker = Walker {
+        tol_px: tol_mm.max(1e-6) / PX_TO_MM,
+        geometries: Vec::new(),
+        warnings: &mut warnings,
+        path_count: 0,
+        text_count: 0,
+        layer_names: layer_names(xml),
+        text_families: FxHashMap::default(),
+    };
+    walker.group(tree.root(), None);
+    let geometries = std::mem::take(&mut walker.geometries);
+    let families = std::mem::take(&mut walker.text_families);
+    warnings.extend(miss_warnings(misses.take(), |requested| {
+        families
+            .get(requested)
+            .cloned()
+            .unwrap_or_else(|| "<text>".into())
+    }));
+    Ok((geometries, page_mm, warnings))
+}
+
+/// Glyph outlines of a small SVG made by the DXF text import: `(points, closed)` per subpath in
+/// the SVG's mm, flattened within `tol_mm`, with the font warnings.
+pub(super) fn text_outlines(
+    svg: &str,
+    opts: &ImportOptions,
+    tol_mm: f64,
+) -> Result<(Vec<Outline>, Vec<Warning>), String> {
+    let xml = roxmltree::Document::parse(svg).map_err(|e| e.to_string())?;
+    let (geometries, _, warnings) = tree_geometries(&xml, opts, tol_mm)?;
+    let outlines = geometries
+        .into_iter()
+        .map(|g| (g.points, g.closed))
+        .collect();
+    Ok((outlines, warnings))
+}
+
+/// Layer names of the top-level groups by their `id`: the `inkscape:label` when there is one,
+/// else the id itself.
+fn layer_names(xml: &roxmltree::Document) -> FxHashMap<String, String> {
+    const INKSCAPE: &str = "http://www.inkscape.org/namespaces/inkscape";
+    xml.root_element()
+        .children()
+        .filter(|n| n.is_element() && n.tag_name().name() == "g")
+        .filter_map(|n| {
+            let id = n.attribute("id")?;
+            let label = n.attribute((INKSCAPE, "label")).unwrap_or(id);
+            Some((id.to_string(), label.to_string()))
+        })
+        .collect()
 }
 
 fn describe(node: &roxmltree::Node) -> String {
@@ -188,6 +223,11 @@ struct Walker<'w> {
     geometries: Vec<Geometry>,
     warnings: &'w mut Vec<Warning>,
     path_count: usize,
+    text_count: usize,
+    /// Top-level group id → layer name.
+    layer_names: FxHashMap<String, String>,
+    /// Requested font family list → the first text element asking for it.
+    text_families: FxHashMap<String, String>,
 }
 
 fn paint_hex(paint: &usvg::Paint) -> String {
@@ -198,28 +238,55 @@ fn paint_hex(paint: &usvg::Paint) -> String {
 }
 
 impl Walker<'_> {
-    fn group(&mut self, g: &usvg::Group) {
+    /// Walks a group; `layer` is the layer name of the top-level group above, if any.
+    fn group(&mut self, g: &usvg::Group, layer: Option<&str>) {
+        let named = self.layer_names.get(g.id()).cloned();
+        let layer = named.as_deref().or(layer);
         for node in g.children() {
             match node {
-                usvg::Node::Group(child) => self.group(child),
-                usvg::Node::Path(p) => self.path(p),
-                // Text and images were reported from the XML scan, with their line numbers.
-                usvg::Node::Image(_) | usvg::Node::Text(_) => {}
+                usvg::Node::Group(child) => self.group(child, layer),
+                usvg::Node::Path(p) => {
+                    self.path_count += 1;
+                    let element = if p.id().is_empty() {
+                        format!("path #{}", self.path_count)
+                    } else {
+                        format!("#{}", p.id())
+                    };
+                    self.path(p, &element, layer);
+                }
+                usvg::Node::Text(t) => self.text(t, layer),
+                // Images were reported from the XML scan, with their line numbers.
+                usvg::Node::Image(_) => {}
             }
         }
     }
 
-    fn path(&mut self, p: &usvg::Path) {
-        self.path_count += 1;
-        let element = if p.id().is_empty() {
-            format!("path #{}", self.path_count)
+    /// A text element: its glyph outlines (closed subpaths) as paths named after the element.
+    fn text(&mut self, t: &usvg::Text, layer: Option<&str>) {
+        self.text_count += 1;
+        let element = if t.id().is_empty() {
+            format!("text #{}", self.text_count)
         } else {
-            format!("#{}", p.id())
+            format!("#{}", t.id())
         };
-        let layer = match (p.stroke(), p.fill()) {
-            (Some(s), _) => paint_hex(s.paint()),
-            (None, Some(f)) => format!("fill {}", paint_hex(f.paint())),
-            (None, None) => "none".into(),
+        for span in t.chunks().iter().flat_map(|c| c.spans()) {
+            self.text_families
+                .entry(family_list(span.font().families()))
+                .or_insert_with(|| format!("<text> {element}"));
+        }
+        for node in t.flattened().children() {
+            if let usvg::Node::Path(p) = node {
+                self.path(p, &element, layer);
+            }
+        }
+    }
+
+    fn path(&mut self, p: &usvg::Path, element: &str, layer: Option<&str>) {
+        let layer = match (layer, p.stroke(), p.fill()) {
+            (Some(name), _, _) => name.to_string(),
+            (None, Some(s), _) => paint_hex(s.paint()),
+            (None, None, Some(f)) => format!("fill {}", paint_hex(f.paint())),
+            (None, None, None) => "none".into(),
         };
         let t = p.abs_transform();
         let map = |q: usvg::tiny_skia_path::Point| -> Pt {
@@ -270,7 +337,7 @@ impl Walker<'_> {
         }
         for (sub_index, (pts, closed)) in subpaths.into_iter().enumerate() {
             let source = Source {
-                element: element.clone(),
+                element: element.to_string(),
                 subpath: sub_index,
                 layer: layer.clone(),
             };
@@ -284,30 +351,4 @@ impl Walker<'_> {
             }
         }
     }
-}
-
-/// Drops repeated points, detects implicit closing, rejects degenerate subpaths.
-fn normalise(pts: Vec<Pt>, closed: bool) -> Result<(Vec<Pt>, bool), &'static str> {
-    if pts.iter().any(|p| !p.is_finite()) {
-        return Err("non-finite coordinates (NaN or infinity)");
-    }
-    let mut out: Vec<Pt> = Vec::with_capacity(pts.len());
-    for p in pts {
-        if out.last().is_none_or(|q| q.dist(p) > SAME_POINT_MM) {
-            out.push(p);
-        }
-    }
-    let mut closed = closed;
-    if out.len() > 2 {
-        if let (Some(a), Some(b)) = (out.first(), out.last()) {
-            if a.dist(*b) <= SAME_POINT_MM {
-                out.pop();
-                closed = true;
-            }
-        }
-    }
-    if out.len() < 2 || polyline_length(&out, closed) < MIN_LENGTH_MM {
-        return Err("zero length (shorter than 1 µm)");
-    }
-    Ok((out, closed))
 }

@@ -29,6 +29,14 @@ pub enum LowerError {
         /// The field id.
         field: usize,
     },
+    /// A step names a geometry without points (the import and the hatch never make one).
+    #[error("plan step {step} names geometry {geometry}, which has no points")]
+    Empty {
+        /// Step index in marking order.
+        step: usize,
+        /// The geometry index.
+        geometry: usize,
+    },
     /// A geometry reaches outside its field.
     #[error("geometry {geometry} reaches {excess_mm:.4} mm outside scan field {field}")]
     OutOfReach {
@@ -45,7 +53,8 @@ pub enum LowerError {
 ///
 /// The stage starts at rest at the first field's centre with the scanner at the first stroke's
 /// start (no homing move). Per stroke: a scanner jump (laser off, jump speed) and the jump delay,
-/// the laser-on delay, the mark (mark speed), the laser-off delay. On a field change the stage
+/// the laser-on delay, the mark (at its pen's mark speed in the plan, else the profile's), the
+/// laser-off delay. On a field change the stage
 /// moves (both axes at once, trapezoids, the slower sets the time) and settles; the scanner jumps
 /// to the next start offset during the move when the jump and its delay fit in the move, after
 /// the settling otherwise. The job ends with the last laser-off delay.
@@ -79,13 +88,16 @@ pub fn lower(
             }
         })?;
         let Some(&start) = path.first() else {
-            continue;
+            return Err(LowerError::Empty {
+                step: k,
+                geometry: step.geometry,
+            });
         };
         b.go_to(field.center, start.minus(field.center), k == 0);
         let stroke = b
             .path
             .push_stroke(k, step.geometry, step.field, field.center, &path);
-        b.mark(stroke);
+        b.mark(stroke, plan.mark_speed_mm_s(g, profile));
     }
     Ok(b.path)
 }
@@ -209,13 +221,14 @@ impl<'a> Builder<'a> {
         }
     }
 
-    /// Marks stroke `stroke` from where the scanner stands: on delay, mark, off delay.
-    fn mark(&mut self, stroke: usize) {
+    /// Marks stroke `stroke` at `speed_mm_s` (its pen's) from where the scanner stands: on
+    /// delay, mark, off delay.
+    fn mark(&mut self, stroke: usize, speed_mm_s: f64) {
         let laser = &self.profile.laser;
         let (on_s, off_s) = (laser.on_delay_s, laser.off_delay_s);
         self.hold(SegmentKind::LaserOnDelay, on_s);
         let length_mm = self.path.strokes[stroke].length_mm;
-        let duration_s = length_mm / self.profile.scanner.mark_speed_mm_s;
+        let duration_s = length_mm / speed_mm_s;
         let stage = StageMotion::Hold(self.stage_at);
         self.push(
             SegmentKind::Mark,

@@ -60,7 +60,7 @@ pub fn lower_motion(
     clock_s: Option<f64>,
     ctx: &JobCtx,
 ) -> Result<Toolpath, MotionError> {
-    Ok(match plan.motion {
+    let mut path = match plan.motion {
         MotionMode::Step => {
             let path = lower(geometries, plan, profile)?;
             match clock_s {
@@ -69,7 +69,14 @@ pub fn lower_motion(
             }
         }
         MotionMode::OnTheFly => lower_on_the_fly(geometries, plan, profile, clock_s, ctx)?,
-    })
+    };
+    if !plan.layers.is_empty() {
+        for s in &mut path.strokes {
+            let layer = geometries.get(s.geometry).map(|g| &g.layer);
+            s.layer = layer.and_then(|name| plan.layers.iter().position(|l| &l.name == name));
+        }
+    }
+    Ok(path)
 }
 
 #[cfg(test)]

@@ -476,6 +476,7 @@ fn tool_pieces(
             laser.on_delay_s,
             Tool::Hold(start),
         );
+        let mark_speed_mm_s = plan.mark_speed_mm_s(g, profile);
         for (start_frac, end_frac) in stroke_parts(path, stroke) {
             let part_mm = (end_frac - start_frac) * path.strokes[stroke].length_mm;
             let tool = Tool::Stroke {
@@ -483,7 +484,7 @@ fn tool_pieces(
                 start_frac,
                 end_frac,
             };
-            piece(SegmentKind::Mark, part_mm / scanner.mark_speed_mm_s, tool);
+            piece(SegmentKind::Mark, part_mm / mark_speed_mm_s, tool);
         }
         piece(
             SegmentKind::LaserOffDelay,

@@ -38,6 +38,7 @@ fn plan(fields: Vec<ScanField>, order: Vec<Step>) -> Plan {
         history: vec![],
         motion: Default::default(),
         stage_route: None,
+        layers: vec![],
     }
 }
 

@@ -119,6 +119,8 @@ pub struct Stroke {
     pub points: Range<usize>,
     /// Marked length, mm.
     pub length_mm: f64,
+    /// Index of its geometry's layer in the plan's layers (none: the profile's pen).
+    pub layer: Option<usize>,
 }
 
 /// The machine's state at an instant.
@@ -180,6 +182,7 @@ impl Toolpath {
             stage,
             points: first..self.points.len(),
             length_mm: arc,
+            layer: None,
         });
         self.strokes.len() - 1
     }

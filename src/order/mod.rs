@@ -128,6 +128,7 @@ pub fn order_plan(
         history,
         motion: settings.motion,
         stage_route,
+        layers: Vec::new(),
     })
 }
 
@@ -248,6 +249,7 @@ fn plan_of(fields: &[ScanField], settings: &SolverSettings, ordering: &Ordering)
         history: Vec::new(),
         motion: settings.motion,
         stage_route: None,
+        layers: Vec::new(),
     }
 }
 

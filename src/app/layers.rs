@@ -1,0 +1,390 @@
+//! The layers panel: one block per layer (colour swatch, name, geometry count, whether it is
+//! marked, mark speed, power, passes, pulse frequency, hatch settings), validated when a value
+//! is committed, like the profile editor. A change that alters the geometries (enabled, hatch)
+//! is made in a background job by the caller.
+
+use super::prompts::PathAction;
+use crate::document::{Layer, MachineProfile, Pen};
+use crate::hatch::{HatchSettings, HatchStyle, OutlineMode};
+use egui::{Color32, RichText};
+
+/// Red of rejected values and their messages.
+const ERROR: Color32 = Color32::from_rgb(200, 30, 30);
+/// Lines reserved for the message above the layers, so that a message never moves the
+/// widgets under the pointer.
+const MESSAGE_LINES: f32 = 3.0;
+
+/// A text-edited number of a pen.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Col {
+    Speed,
+    Power,
+    Frequency,
+    Passes,
+    Spacing,
+    Angle,
+    Edge,
+}
+
+impl Col {
+    /// The label, as the pen's validation words it.
+    fn label(self) -> &'static str {
+        match self {
+            Col::Speed => "Mark speed (mm/s)",
+            Col::Power => "Power",
+            Col::Frequency => "Pulse frequency (kHz)",
+            Col::Passes => "Passes",
+            Col::Spacing => "Hatch spacing (mm)",
+            Col::Angle => "Hatch angle (°)",
+            Col::Edge => "Hatch edge offset (mm)",
+        }
+    }
+    fn get(self, p: &Pen) -> String {
+        let opt = |v: Option<f64>| v.map(|v| v.to_string()).unwrap_or_default();
+        let h = p.hatch.as_ref();
+        match self {
+            Col::Speed => opt(p.mark_speed_mm_s),
+            Col::Power => opt(p.power),
+            Col::Frequency => opt(p.frequency_khz),
+            Col::Passes => p.passes.to_string(),
+            Col::Spacing => opt(h.map(|h| h.spacing_mm)),
+            Col::Angle => opt(h.map(|h| h.angle_deg)),
+            Col::Edge => opt(h.and_then(|h| h.edge_offset_mm)),
+        }
+    }
+    /// Parses `text` into `p` (empty: unset, where a value may be unset).
+    fn set(self, p: &mut Pen, text: &str) -> Result<(), String> {
+        let t = text.trim();
+        let num = || -> Result<Option<f64>, String> {
+            if t.is_empty() {
+                return Ok(None);
+            }
+            match t.parse::<f64>() {
+                Ok(v) if v.is_finite() => Ok(Some(v)),
+                _ => Err(format!("{} must be a number, not '{t}'", self.label())),
+            }
+        };
+        let required = |v: Option<f64>| v.ok_or(format!("{} needs a value", self.label()));
+        match self {
+            Col::Speed => p.mark_speed_mm_s = num()?,
+            Col::Power => p.power = num()?,
+            Col::Frequency => p.frequency_khz = num()?,
+            Col::Passes => {
+                p.passes = t.parse().map_err(|_| {
+                    format!(
+                        "{} must be a whole number of 1 or more, not '{t}'",
+                        self.label()
+                    )
+                })?
+            }
+            Col::Spacing | Col::Angle | Col::Edge => {
+                let v = num()?;
+                if let Some(h) = &mut p.hatch {
+                    match self {
+                        Col::Spacing => h.spacing_mm = required(v)?,
+                        Col::Angle => h.angle_deg = required(v)?,
+                        _ => h.edge_offset_mm = v,
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// What the panel asks the window to do.
+#[derive(Debug, Clone, PartialEq)]
+pub enum LayerAction {
+    /// A new, valid layer table.
+    Set(Vec<Layer>),
+    /// Load or save a pen library.
+    File(PathAction),
+}
+
+/// Edit buffers of the layers panel.
+#[derive(Debug, Default)]
+pub struct LayerEditor {
+    synced: Option<Vec<Layer>>,
+    text: Vec<Vec<String>>,
+    /// The rejected value: (layer, column) and the message.
+    error: Option<(usize, Col, String)>,
+}
+
+const COLS: [Col; 7] = [
+    Col::Speed,
+    Col::Power,
+    Col::Passes,
+    Col::Frequency,
+    Col::Spacing,
+    Col::Angle,
+    Col::Edge,
+];
+
+impl LayerEditor {
+    /// Forgets a rejected value (the table changed).
+    pub fn clear_error(&mut self) {
+        self.error = None;
+    }
+
+    /// The message of the rejected value, if any.
+    pub fn error(&self) -> Option<&str> {
+        self.error.as_ref().map(|e| e.2.as_str())
+    }
+
+    /// Draws the panel; `counts` are (imported, marked) geometries per layer.
+    pub fn ui(
+        &mut self,
+        ui: &mut egui::Ui,
+        layers: &[Layer],
+        counts: &[(usize, usize)],
+        profile: &MachineProfile,
+        busy: Option<&str>,
+    ) -> Option<LayerAction> {
+        if self.synced.as_deref() != Some(layers) {
+            self.text = layers
+                .iter()
+                .map(|l| COLS.iter().map(|c| c.get(&l.pen)).collect())
+                .collect();
+            self.synced = Some(layers.to_vec());
+        }
+        let mut out = None;
+        ui.horizontal(|ui| {
+            if ui
+                .button("Load pens…")
+                .on_hover_text("Pens by layer name from a TOML file")
+                .clicked()
+            {
+                out = Some(LayerAction::File(PathAction::LoadPens));
+            }
+            if ui
+                .button("Save pens…")
+                .on_hover_text("The layers' pens as a TOML file")
+                .clicked()
+            {
+                out = Some(LayerAction::File(PathAction::SavePens));
+            }
+        });
+        self.message(ui, busy);
+        if layers.is_empty() {
+            ui.label("No layers: open an SVG or a project.");
+        }
+        for (k, layer) in layers.iter().enumerate() {
+            let count = counts.get(k).copied().unwrap_or((0, 0));
+            if let Some(new) = self.layer_ui(ui, k, layer, count, profile) {
+                let mut table = layers.to_vec();
+                table[k] = new;
+                out = Some(LayerAction::Set(table));
+            }
+            ui.separator();
+        }
+        out
+    }
+
+    /// The reserved message lines: the rejected value, the running job, or a hint.
+    fn message(&self, ui: &mut egui::Ui, busy: Option<&str>) {
+        let h = MESSAGE_LINES * ui.text_style_height(&egui::TextStyle::Body);
+        let w = ui.available_width();
+        let (rect, _) = ui.allocate_exact_size(egui::vec2(w, h), egui::Sense::hover());
+        let text = match (&self.error, busy) {
+            (Some(e), _) => RichText::new(&e.2).color(ERROR),
+            (None, Some(job)) => RichText::new(format!("{job}…")).italics(),
+            (None, None) => RichText::new(
+                "Values apply on Enter or when leaving a field; empty speed or power: the \
+                 profile's.",
+            )
+            .weak(),
+        };
+        ui.put(rect, egui::Label::new(text).wrap());
+    }
+
+    fn layer_ui(
+        &mut self,
+        ui: &mut egui::Ui,
+        k: usize,
+        layer: &Layer,
+        (imported, marked): (usize, usize),
+        profile: &MachineProfile,
+    ) -> Option<Layer> {
+        let mut out = None;
+        let [r, g, b] = layer.rgb();
+        let colour = Color32::from_rgb(r, g, b);
+        ui.horizontal(|ui| {
+            let (rect, _) = ui.allocate_exact_size(egui::vec2(14.0, 14.0), egui::Sense::hover());
+            ui.painter().rect_filled(rect, 2.0, colour);
+            let mut enabled = layer.pen.enabled;
+            let r = ui
+                .checkbox(&mut enabled, RichText::new(&layer.name).strong())
+                .on_hover_text("Marked: untick to leave this layer out of the job");
+            if r.changed() {
+                let mut l = layer.clone();
+                l.pen.enabled = enabled;
+                out = Some(l);
+            }
+            let words = if layer.pen.hatch.is_some() {
+                format!("{imported} shapes, {marked} strokes with the hatch")
+            } else {
+                format!("{imported} geometries")
+            };
+            ui.label(RichText::new(words).weak());
+        });
+        egui::Grid::new(("layer-grid", k))
+            .num_columns(4)
+            .spacing([6.0, 3.0])
+            .show(ui, |ui| {
+                let hint = |c: Col| match c {
+                    Col::Speed => format!("{}", profile.scanner.mark_speed_mm_s),
+                    Col::Power => profile.gcode.power.map_or("none".into(), |p| p.to_string()),
+                    Col::Edge => "spacing".into(),
+                    _ => String::new(),
+                };
+                let hatched = layer.pen.hatch.is_some();
+                for (n, &c) in COLS.iter().enumerate() {
+                    if matches!(c, Col::Spacing) {
+                        if let Some(l) = hatch_style_ui(ui, k, layer) {
+                            out = Some(l);
+                        }
+                        if !hatched {
+                            break;
+                        }
+                    }
+                    if let Some(l) = self.cell(ui, k, n, c, layer, &hint(c)) {
+                        out = Some(l);
+                    }
+                    if n % 2 == 1 {
+                        ui.end_row();
+                    }
+                }
+                if hatched {
+                    if let Some(l) = outline_ui(ui, k, layer) {
+                        out = Some(l);
+                    }
+                }
+                ui.end_row();
+            });
+        out
+    }
+
+    /// One labelled number; returns the changed layer when a valid value was committed.
+    fn cell(
+        &mut self,
+        ui: &mut egui::Ui,
+        k: usize,
+        n: usize,
+        c: Col,
+        layer: &Layer,
+        hint: &str,
+    ) -> Option<Layer> {
+        let label = ui.label(short_label(c));
+        let bad = self.error.as_ref().is_some_and(|e| e.0 == k && e.1 == c);
+        let mut edit = egui::TextEdit::singleline(&mut self.text[k][n])
+            .desired_width(60.0)
+            .hint_text(hint);
+        if bad {
+            edit = edit.text_color(ERROR);
+        }
+        let r = ui.add(edit).labelled_by(label.id).on_hover_text(format!(
+            "{} of layer '{}'",
+            c.label(),
+            layer.name
+        ));
+        if !(r.lost_focus() || (r.changed() && !r.has_focus())) {
+            return None;
+        }
+        let mut candidate = layer.clone();
+        let result = c
+            .set(&mut candidate.pen, &self.text[k][n])
+            .map_err(|e| format!("Layer '{}': {e}", layer.name))
+            .and_then(|()| candidate.validate().map_err(|e| e.to_string()));
+        match result {
+            Ok(()) => {
+                if self.error.as_ref().is_some_and(|e| e.0 == k && e.1 == c) {
+                    self.error = None;
+                }
+                (candidate != *layer).then_some(candidate)
+            }
+            Err(e) => {
+                self.error = Some((k, c, e));
+                None
+            }
+        }
+    }
+}
+
+/// The label in the grid (the layer's name is in the block's header).
+fn short_label(c: Col) -> &'static str {
+    match c {
+        Col::Speed => "Speed (mm/s)",
+        Col::Power => "Power",
+        Col::Frequency => "Freq. (kHz)",
+        Col::Passes => "Passes",
+        Col::Spacing => "Spacing (mm)",
+        Col::Angle => "Angle (°)",
+        Col::Edge => "Edge offset (mm)",
+    }
+}
+
+/// The hatch style combo (none or a style); returns the changed layer.
+fn hatch_style_ui(ui: &mut egui::Ui, k: usize, layer: &Layer) -> Option<Layer> {
+    let current = layer.pen.hatch.as_ref().map(|h| h.style);
+    let mut chosen = current;
+    let label = ui.label("Hatch");
+    egui::ComboBox::from_id_salt(("hatch-style", k))
+        .selected_text(current.map_or("none (outlines)", HatchStyle::name))
+        .show_ui(ui, |ui| {
+            ui.selectable_value(&mut chosen, None, "none (outlines)");
+            for s in HatchStyle::ALL {
+                ui.selectable_value(&mut chosen, Some(s), s.name());
+            }
+        })
+        .response
+        .labelled_by(label.id)
+        .on_hover_text(format!(
+            "Fill the closed shapes of layer '{}' with hatch lines",
+            layer.name
+        ));
+    ui.end_row();
+    if chosen == current {
+        return None;
+    }
+    let mut l = layer.clone();
+    l.pen.hatch = chosen.map(|style| HatchSettings {
+        style,
+        ..layer
+            .pen
+            .hatch
+            .clone()
+            .unwrap_or_else(|| HatchSettings::new(style, DEFAULT_SPACING_MM))
+    });
+    Some(l)
+}
+
+/// Spacing of a newly chosen hatch, mm: visible on screen and quick to make.
+const DEFAULT_SPACING_MM: f64 = 0.5;
+
+/// Where a hatched layer's outlines go; returns the changed layer.
+fn outline_ui(ui: &mut egui::Ui, k: usize, layer: &Layer) -> Option<Layer> {
+    let h = layer.pen.hatch.as_ref()?;
+    let mut outline = h.outline;
+    let label = ui.label("Outline");
+    let name = |o: OutlineMode| match o {
+        OutlineMode::Before => "before the hatch",
+        OutlineMode::After => "after the hatch",
+        OutlineMode::None => "not marked",
+    };
+    egui::ComboBox::from_id_salt(("hatch-outline", k))
+        .selected_text(name(outline))
+        .show_ui(ui, |ui| {
+            for o in [OutlineMode::Before, OutlineMode::After, OutlineMode::None] {
+                ui.selectable_value(&mut outline, o, name(o));
+            }
+        })
+        .response
+        .labelled_by(label.id);
+    (outline != h.outline).then(|| {
+        let mut l = layer.clone();
+        if let Some(h) = &mut l.pen.hatch {
+            h.outline = outline;
+        }
+        l
+    })
+}

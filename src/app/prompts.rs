@@ -1,0 +1,387 @@
+//! Questions and path fields: the unsaved-changes prompt (quit, open, new), the stale-export
+//! question, and the path field offered when no native file dialog can be shown. Every file
+//! action of the window (menus, toolbar, shortcuts) goes through here, so none of them can do
+//! nothing silently.
+
+use super::files::{self, ExportKind, PROJECT_EXT};
+use super::{is_stale, App};
+use crate::document::{Document, PenLibrary};
+use egui::RichText;
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+/// A dialog that returns "nothing chosen" faster than this was never shown (no desktop
+/// portal): no operator cancels a dialog within a fifth of a second.
+const NO_DIALOG_S: Duration = Duration::from_millis(200);
+
+/// What a prompt's answer does once the prompt is closed.
+type Continuation = Box<dyn FnOnce(&mut App, &egui::Context)>;
+
+/// A file action that needs a path.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PathAction {
+    /// Open an SVG or a project.
+    Open,
+    /// Save the project under a new name.
+    SaveProject,
+    /// Export the plan shown.
+    Export(ExportKind),
+    /// Load pens for the layers from a TOML library.
+    LoadPens,
+    /// Save the layers' pens as a TOML library.
+    SavePens,
+    /// Load a machine profile (TOML).
+    LoadProfile,
+    /// Save the machine profile (TOML).
+    SaveProfile,
+}
+
+impl PathAction {
+    /// (title, button, extension, dialog filter name).
+    fn words(self) -> (&'static str, &'static str, &'static str, &'static str) {
+        match self {
+            PathAction::Open => ("Open a file", "Open", "svg", "SVG or galvoplan project"),
+            PathAction::SaveProject => {
+                ("Save the project", "Save", PROJECT_EXT, "galvoplan project")
+            }
+            PathAction::Export(kind) => {
+                let (filter, ext) = kind.filter();
+                ("Export", "Export", ext, filter)
+            }
+            PathAction::LoadPens => ("Load pens", "Load", "toml", "pens"),
+            PathAction::SavePens => ("Save pens", "Save", "toml", "pens"),
+            PathAction::LoadProfile => ("Load a machine profile", "Load", "toml", "profile"),
+            PathAction::SaveProfile => ("Save the machine profile", "Save", "toml", "profile"),
+        }
+    }
+    fn saves(self) -> bool {
+        !matches!(
+            self,
+            PathAction::Open | PathAction::LoadPens | PathAction::LoadProfile
+        )
+    }
+}
+
+/// What to do once the unsaved changes are dealt with.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Then {
+    /// Close the window.
+    Quit,
+    /// Open a file (none: ask for one).
+    Open(Option<PathBuf>),
+    /// Start an empty document.
+    New,
+}
+
+/// A question or path field waiting for the operator.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Prompt {
+    /// Type a path (no native dialog could be shown).
+    Path {
+        /// What the path is for.
+        action: PathAction,
+        /// The path typed so far.
+        text: String,
+        /// Why the field is shown.
+        note: String,
+    },
+    /// The document has unsaved changes.
+    Unsaved(Then),
+    /// The plan to export is stale.
+    StaleExport(ExportKind),
+}
+
+impl App {
+    /// Open (a file, or ask for one), after asking about unsaved changes.
+    pub fn request_open(&mut self, path: Option<PathBuf>, ctx: &egui::Context) {
+        if self.has_unsaved_changes() {
+            self.prompt = Some(Prompt::Unsaved(Then::Open(path)));
+            return;
+        }
+        match path {
+            Some(p) => self.open_in_background(&p, ctx),
+            None => self.choose_path(PathAction::Open, ctx),
+        }
+    }
+
+    /// Start an empty document, after asking about unsaved changes.
+    pub fn request_new(&mut self) {
+        if self.has_unsaved_changes() {
+            self.prompt = Some(Prompt::Unsaved(Then::New));
+            return;
+        }
+        self.job = None;
+        self.doc = Document {
+            profile: self.doc.profile.clone(),
+            settings: self.doc.settings.clone(),
+            ..Document::default()
+        };
+        self.project_path = None;
+        self.history.clear();
+        self.problem = None;
+        self.active = None;
+        self.refresh();
+        self.changed();
+        self.saved_revision = self.revision;
+        self.set_status("new empty document: open an SVG or a project", false);
+    }
+
+    /// Close the window, after asking about unsaved changes.
+    pub fn request_quit(&mut self, ctx: &egui::Context) {
+        if self.has_unsaved_changes() && !self.quit_confirmed {
+            self.prompt = Some(Prompt::Unsaved(Then::Quit));
+            return;
+        }
+        self.quit_confirmed = true;
+        // eframe stores the preferences on the way out
+        ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+    }
+
+    /// Save the project (to its file, or ask where).
+    pub fn request_save(&mut self, save_as: bool, ctx: &egui::Context) {
+        if !self.has_document() {
+            self.set_status("nothing to save: open an SVG or a project first", true);
+            return;
+        }
+        match (&self.project_path, save_as) {
+            (Some(p), false) => {
+                let p = p.clone();
+                if let Err(e) = self.save_project(&p) {
+                    self.set_status(e, true);
+                }
+            }
+            _ => self.choose_path(PathAction::SaveProject, ctx),
+        }
+    }
+
+    /// Export the plan shown (asking first when it is stale).
+    pub fn request_export(&mut self, kind: ExportKind, ctx: &egui::Context) {
+        match self.active_plan() {
+            None => self.set_status("no plan to export: run a solver first (Run HHA)", true),
+            Some(p) if is_stale(p, &self.doc) => self.prompt = Some(Prompt::StaleExport(kind)),
+            Some(_) => self.choose_path(PathAction::Export(kind), ctx),
+        }
+    }
+
+    /// Asks for a path: the native dialog when one can be shown, else a path field.
+    pub fn choose_path(&mut self, action: PathAction, ctx: &egui::Context) {
+        let (title, _, ext, filter) = action.words();
+        let default_name = match action {
+            PathAction::SavePens => "pens.toml".to_string(),
+            PathAction::SaveProfile => "profile.toml".to_string(),
+            _ => files::default_name(&self.doc, ext),
+        };
+        if self.dialogs {
+            let t0 = Instant::now();
+            let picked = match action {
+                PathAction::Open => files::pick_open(),
+                a if a.saves() => files::pick_save(filter, ext, &default_name),
+                _ => files::pick_load(filter, ext),
+            };
+            if let Some(p) = picked {
+                self.perform(action, p, ctx);
+                return;
+            }
+            if t0.elapsed() >= NO_DIALOG_S {
+                // the operator closed the dialog
+                self.set_status(format!("{title}: cancelled"), false);
+                return;
+            }
+            self.dialogs = false;
+        }
+        let dir = self
+            .doc
+            .source
+            .as_deref()
+            .map(std::path::Path::new)
+            .and_then(std::path::Path::parent)
+            .map(|d| {
+                d.join(if action.saves() {
+                    default_name.as_str()
+                } else {
+                    ""
+                })
+            });
+        self.prompt = Some(Prompt::Path {
+            action,
+            text: dir.map(|d| d.display().to_string()).unwrap_or_default(),
+            note: "No file dialog can be shown on this desktop (no desktop portal is running). \
+                   Type the file's path instead:"
+                .into(),
+        });
+    }
+
+    /// Does a file action on a chosen path.
+    fn perform(&mut self, action: PathAction, path: PathBuf, ctx: &egui::Context) {
+        let result = match action {
+            PathAction::Open => {
+                self.open_in_background(&path, ctx);
+                Ok(())
+            }
+            PathAction::SaveProject => self.save_project(&path),
+            PathAction::Export(kind) => {
+                self.export_in_background(kind, &path, ctx);
+                Ok(())
+            }
+            PathAction::LoadPens => PenLibrary::load(&path)
+                .map_err(|e| e.to_string())
+                .map(|lib| {
+                    let mut layers = self.doc.layers.clone();
+                    let missing = lib.apply(&mut layers);
+                    self.set_layers(layers, ctx);
+                    if !missing.is_empty() {
+                        let msg = format!(
+                            "loaded pens from {}; layers it names that the document lacks: {}",
+                            path.display(),
+                            missing.join(", ")
+                        );
+                        self.set_status(msg, false);
+                    }
+                }),
+            PathAction::SavePens => PenLibrary::of(&self.doc.layers)
+                .save(&path)
+                .map_err(|e| e.to_string())
+                .map(|()| self.set_status(format!("saved pens to {}", path.display()), false)),
+            PathAction::LoadProfile => {
+                crate::document::MachineProfile::load(&path.display().to_string())
+                    .map_err(|e| e.to_string())
+                    .and_then(|p| {
+                        self.execute(super::Command::SetProfile(Box::new(p)))
+                            .map(|_| ())
+                    })
+            }
+            PathAction::SaveProfile => self
+                .doc
+                .profile
+                .to_toml()
+                .map_err(|e| format!("the profile cannot be written as TOML: {e}"))
+                .and_then(|text| {
+                    crate::document::write_atomic(&path, text.as_bytes())
+                        .map_err(|e| format!("{}: cannot write: {e}", path.display()))
+                })
+                .map(|()| self.set_status(format!("saved {}", path.display()), false)),
+        };
+        if let Err(e) = result {
+            self.set_status(e, true);
+        }
+    }
+
+    /// Continues what the unsaved-changes prompt held back.
+    fn then(&mut self, then: Then, ctx: &egui::Context) {
+        // the operator has answered for the current changes
+        self.saved_revision = self.revision;
+        match then {
+            Then::Quit => self.request_quit(ctx),
+            Then::Open(p) => self.request_open(p, ctx),
+            Then::New => self.request_new(),
+        }
+    }
+
+    /// Draws the prompt, if any, as a modal window.
+    pub(super) fn prompt_ui(&mut self, ui: &mut egui::Ui) {
+        let Some(prompt) = self.prompt.take() else {
+            return;
+        };
+        let ctx = ui.ctx().clone();
+        let mut keep = true;
+        let mut next: Option<Continuation> = None;
+        let mut shown = prompt.clone();
+        egui::Modal::new(egui::Id::unique("galvoplan-prompt")).show(&ctx, |ui| {
+            ui.set_max_width(460.0);
+            match &mut shown {
+                Prompt::Path { action, text, note } => {
+                    let (title, button, _, _) = action.words();
+                    ui.heading(title);
+                    ui.add(egui::Label::new(note.as_str()).wrap());
+                    let l = ui.label("File path");
+                    let r = ui
+                        .add(
+                            egui::TextEdit::singleline(text)
+                                .desired_width(440.0)
+                                .hint_text("/path/to/file"),
+                        )
+                        .labelled_by(l.id);
+                    let enter = r.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
+                    ui.horizontal(|ui| {
+                        let go = ui.button(button).clicked() || enter;
+                        if go && !text.trim().is_empty() {
+                            let (a, p) = (*action, PathBuf::from(text.trim()));
+                            next = Some(Box::new(move |app: &mut App, ctx: &egui::Context| {
+                                app.perform(a, p, ctx)
+                            }));
+                            keep = false;
+                        }
+                        if ui.button("Cancel").clicked() {
+                            keep = false;
+                        }
+                    });
+                }
+                Prompt::Unsaved(then) => {
+                    ui.heading("Unsaved changes");
+                    ui.add(
+                        egui::Label::new(
+                            "The document has changes that are not saved in a project file \
+                             (scan fields, layers, plans). They are lost unless you save them.",
+                        )
+                        .wrap(),
+                    );
+                    ui.horizontal(|ui| {
+                        if ui.button("Save project").clicked() {
+                            keep = false;
+                            let then = then.clone();
+                            next = Some(Box::new(move |app: &mut App, ctx: &egui::Context| {
+                                app.request_save(false, ctx);
+                                if !app.has_unsaved_changes() {
+                                    app.then(then, ctx);
+                                }
+                            }));
+                        }
+                        if ui.button("Discard changes").clicked() {
+                            keep = false;
+                            let then = then.clone();
+                            next = Some(Box::new(move |app: &mut App, ctx: &egui::Context| {
+                                app.then(then, ctx)
+                            }));
+                        }
+                        if ui.button("Cancel").clicked() {
+                            keep = false;
+                        }
+                    });
+                }
+                Prompt::StaleExport(kind) => {
+                    ui.heading("Export a stale plan?");
+                    ui.add(
+                        egui::Label::new(
+                            "The plan shown was made on other scan fields than the current ones \
+                             (fields were moved, added or re-placed since). Its G-code marks the \
+                             old fields. Run a solver again to plan the current fields.",
+                        )
+                        .wrap(),
+                    );
+                    ui.horizontal(|ui| {
+                        if ui.button("Export anyway").clicked() {
+                            keep = false;
+                            let a = PathAction::Export(*kind);
+                            next = Some(Box::new(move |app: &mut App, ctx: &egui::Context| {
+                                app.choose_path(a, ctx)
+                            }));
+                        }
+                        if ui.button("Cancel").clicked() {
+                            keep = false;
+                        }
+                    });
+                }
+            }
+            ui.label(RichText::new("Esc closes this window.").small().weak());
+        });
+        if ui.input(|i| i.key_pressed(egui::Key::Escape)) {
+            keep = false;
+        }
+        if keep {
+            self.prompt = Some(shown);
+        }
+        if let Some(f) = next {
+            f(self, &ctx);
+        }
+    }
+}

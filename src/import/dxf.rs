@@ -1,0 +1,754 @@
+//! DXF import through the `dxf` crate (ixmilia): lines, polylines with bulges, arcs, circles,
+//! ellipses, splines, nested block inserts with arrays, and TEXT/MTEXT as glyph outlines.
+//!
+//! Coordinates: DXF units (`$INSUNITS`) become mm; DXF's y axis points up, galvoplan's down, so
+//! y is flipped about the drawing's top edge (`y_mm = top − y`): the drawing looks as in CAD,
+//! never mirrored, and a profile with the G-code Y flip writes the DXF's own coordinates. A
+//! drawing in the first quadrant keeps its position relative to the DXF origin (the page's
+//! bottom-left corner); one with negative coordinates, or outside the work area although it
+//! would fit, is moved so that its bounding box starts at the corner (with a warning).
+
+use super::curves::{bulge_arc, fit_point_spline, Affine, ConicArc, Nurbs};
+use super::dxf_text::{self, TextRun};
+use super::svg::Outline;
+use super::{normalise, ImportError, ImportOptions, Imported, Warning};
+use crate::document::{Geometry, Source};
+use crate::geom::{flatten_cubic, BBox, Pt};
+use ::dxf::entities::{Entity, EntityType};
+use ::dxf::enums::Units;
+use ::dxf::{Block, Drawing};
+use rustc_hash::FxHashMap;
+use std::f64::consts::TAU;
+
+/// Output budget: more vertices than this is an error, not an hour of flattening (80 MB).
+const MAX_POINTS: usize = 5_000_000;
+/// Budget of block instances (nested arrays multiply).
+const MAX_INSTANCES: usize = 1_000_000;
+/// Deepest block nesting followed (a block inserting itself is caught earlier).
+const MAX_INSERT_DEPTH: usize = 32;
+/// Coordinates beyond 1 km are not artwork (and would make arcs need millions of chords).
+const MAX_COORD_MM: f64 = 1.0e6;
+/// Why an entity off the XY plane is skipped.
+const OFF_PLANE: &str = "not parallel to the XY plane (3D)";
+/// A normal counts as ±Z when its x and y parts are below this (DXF writes unit vectors).
+const NORMAL_TOL: f64 = 1e-9;
+
+/// The entity types the `dxf` crate parses (everything else it skips without a word, so the
+/// import scans the file for them to report them).
+const PARSED_TYPES: &[&str] = &[
+    "3DFACE",
+    "3DSOLID",
+    "ACAD_PROXY_ENTITY",
+    "ARC",
+    "ARCALIGNEDTEXT",
+    "ATTDEF",
+    "ATTRIB",
+    "BODY",
+    "CIRCLE",
+    "DIMENSION",
+    "ELLIPSE",
+    "HELIX",
+    "IMAGE",
+    "INSERT",
+    "LEADER",
+    "LIGHT",
+    "LINE",
+    "3DLINE",
+    "LWPOLYLINE",
+    "MLINE",
+    "MTEXT",
+    "OLEFRAME",
+    "OLE2FRAME",
+    "POINT",
+    "POLYLINE",
+    "RAY",
+    "REGION",
+    "RTEXT",
+    "SECTION",
+    "SEQEND",
+    "SHAPE",
+    "SOLID",
+    "SPLINE",
+    "TEXT",
+    "TOLERANCE",
+    "TRACE",
+    "DGNUNDERLAY",
+    "DWFUNDERLAY",
+    "PDFUNDERLAY",
+    "VERTEX",
+    "WIPEOUT",
+    "XLINE",
+    "ENDSEC",
+    "BLOCK",
+    "ENDBLK",
+    "EOF",
+];
+
+/// Imports DXF bytes (ASCII or binary); `file` names the source in errors and warnings.
+pub fn import_dxf(bytes: &[u8], file: &str, opts: &ImportOptions) -> Result<Imported, ImportError> {
+    if bytes.iter().all(|b| b.is_ascii_whitespace()) {
+        return Err(ImportError::Empty { file: file.into() });
+    }
+    let drawing =
+        Drawing::load(&mut std::io::Cursor::new(bytes)).map_err(|e| ImportError::MalformedDxf {
+            file: file.into(),
+            cause: one_line(&e.to_string()),
+        })?;
+    let mut warnings = skipped_types(bytes);
+    let unit_mm = units_mm(drawing.header.default_drawing_units, &mut warnings);
+    let mut walk = Walk {
+        file,
+        opts,
+        blocks: drawing.blocks().map(|b| (b.name.as_str(), b)).collect(),
+        drawing: &drawing,
+        raw: Vec::new(),
+        warnings,
+        points: 0,
+        instances: 0,
+        stack: Vec::new(),
+    };
+    let to_mm = Affine::scale(unit_mm, unit_mm);
+    for e in drawing.entities() {
+        walk.entity(e, &to_mm, None)?;
+    }
+    let Walk {
+        raw, mut warnings, ..
+    } = walk;
+    if raw.is_empty() {
+        return Err(nothing_to_mark(file, &warnings));
+    }
+    let (geometries, page_mm) = place(raw, opts.work_area_mm, &mut warnings);
+    Ok(Imported {
+        geometries,
+        warnings,
+        page_mm,
+    })
+}
+
+fn one_line(s: &str) -> String {
+    s.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+fn nothing_to_mark(file: &str, warnings: &[Warning]) -> ImportError {
+    let detail = if warnings.is_empty() {
+        "the drawing has no entities".to_string()
+    } else {
+        let listed: Vec<String> = warnings.iter().take(3).map(|w| w.to_string()).collect();
+        let more = warnings.len().saturating_sub(3);
+        let tail = if more > 0 {
+            format!("; and {more} more")
+        } else {
+            String::new()
+        };
+        format!("only skipped content: {}{tail}", listed.join("; "))
+    };
+    ImportError::NothingToMark {
+        file: file.into(),
+        detail,
+    }
+}
+
+/// mm per drawing unit from `$INSUNITS`; unitless and unknown units read as mm with a warning.
+fn units_mm(units: Units, warnings: &mut Vec<Warning>) -> f64 {
+    let known = match units {
+        Units::Millimeters => Some(1.0),
+        Units::Centimeters => Some(10.0),
+        Units::Meters => Some(1000.0),
+        Units::Decimeters => Some(100.0),
+        Units::Microns => Some(1e-3),
+        Units::Inches => Some(25.4),
+        Units::Feet => Some(304.8),
+        Units::Mils => Some(0.0254),
+        Units::Yards => Some(914.4),
+        _ => None,
+    };
+    known.unwrap_or_else(|| {
+        let why = if units == Units::Unitless {
+            "the drawing has no units ($INSUNITS unitless)".to_string()
+        } else {
+            format!("drawing units {units:?} ($INSUNITS) are not supported")
+        };
+        warnings.push(Warning {
+            element: "$INSUNITS".into(),
+            line: None,
+            message: format!("{why}; read as millimetres"),
+        });
+        1.0
+    })
+}
+
+/// Entities the `dxf` crate skips silently (HATCH, MTEXT's cousins, MESH, …): found by scanning
+/// the ASCII code pairs of the ENTITIES and BLOCKS sections. Binary files are not scanned.
+fn skipped_types(bytes: &[u8]) -> Vec<Warning> {
+    let Ok(text) = std::str::from_utf8(bytes) else {
+        return Vec::new();
+    };
+    let lines: Vec<&str> = text.lines().map(str::trim).collect();
+    let mut out = Vec::new();
+    let mut in_geometry = false;
+    let mut i = 0;
+    while i + 1 < lines.len() {
+        let (code, value) = (lines[i], lines[i + 1]);
+        if code == "2" && i >= 2 && lines[i - 1] == "SECTION" {
+            in_geometry = value == "ENTITIES" || value == "BLOCKS";
+        } else if code == "0" && in_geometry && !PARSED_TYPES.contains(&value) {
+            let (handle, layer) = handle_and_layer(&lines[i + 2..]);
+            out.push(Warning {
+                element: format!("{value} (handle {handle}) (layer {layer})"),
+                line: u32::try_from(i + 2).ok(),
+                message: format!("{value} entities are not supported; skipped"),
+            });
+        }
+        i += 2;
+    }
+    out
+}
+
+fn handle_and_layer<'a>(pairs: &[&'a str]) -> (&'a str, &'a str) {
+    let (mut handle, mut layer) = ("?", "?");
+    for p in pairs.chunks(2).take_while(|p| p.first() != Some(&"0")) {
+        match p {
+            ["5", h] => handle = h,
+            ["8", l] => layer = l,
+            _ => {}
+        }
+    }
+    (handle, layer)
+}
+
+/// A flattened path in mm, y up, before placement.
+struct Raw {
+    points: Vec<Pt>,
+    closed: bool,
+    source: Source,
+}
+
+struct Walk<'d> {
+    file: &'d str,
+    opts: &'d ImportOptions,
+    blocks: FxHashMap<&'d str, &'d Block>,
+    drawing: &'d Drawing,
+    raw: Vec<Raw>,
+    warnings: Vec<Warning>,
+    points: usize,
+    instances: usize,
+    /// Names of the blocks being inserted, outermost first.
+    stack: Vec<&'d str>,
+}
+
+/// The DXF name of an entity type (its variant name in capitals for the rare ones).
+fn type_name(t: &EntityType) -> String {
+    let name = match t {
+        EntityType::Line(_) => "LINE",
+        EntityType::LwPolyline(_) => "LWPOLYLINE",
+        EntityType::Polyline(_) => "POLYLINE",
+        EntityType::Arc(_) => "ARC",
+        EntityType::Circle(_) => "CIRCLE",
+        EntityType::Ellipse(_) => "ELLIPSE",
+        EntityType::Spline(_) => "SPLINE",
+        EntityType::Insert(_) => "INSERT",
+        EntityType::Text(_) => "TEXT",
+        EntityType::MText(_) => "MTEXT",
+        EntityType::ModelPoint(_) => "POINT",
+        EntityType::Image(_) => "IMAGE",
+        EntityType::Solid(_) => "SOLID",
+        EntityType::Face3D(_) => "3DFACE",
+        EntityType::Solid3D(_) => "3DSOLID",
+        other => {
+            let debug = format!("{other:?}");
+            return debug
+                .split(['(', ' ', '{'])
+                .next()
+                .unwrap_or("entity")
+                .to_ascii_uppercase();
+        }
+    };
+    name.to_string()
+}
+
+/// The map from an entity's object coordinate system to world coordinates: identity for a +Z
+/// normal, a mirror in x for −Z (DXF's arbitrary axis algorithm); `None` off the XY plane.
+fn ocs(normal: &::dxf::Vector) -> Option<Affine> {
+    if normal.x.abs() > NORMAL_TOL || normal.y.abs() > NORMAL_TOL || !normal.z.is_finite() {
+        return None;
+    }
+    Some(if normal.z < 0.0 {
+        Affine::scale(-1.0, 1.0)
+    } else {
+        Affine::IDENTITY
+    })
+}
+
+fn pt(p: &::dxf::Point) -> Pt {
+    Pt::new(p.x, p.y)
+}
+
+impl<'d> Walk<'d> {
+    fn element(&self, kind: &str, e: &Entity) -> String {
+        let mut s = format!("{kind} (handle {:X})", e.common.handle.0);
+        if let Some(block) = self.stack.last() {
+            s.push_str(&format!(" in block {block}"));
+        }
+        s
+    }
+
+    fn warn(&mut self, element: String, layer: &str, message: impl Into<String>) {
+        self.warnings.push(Warning {
+            element: format!("{element} (layer {layer})"),
+            line: None,
+            message: message.into(),
+        });
+    }
+
+    /// Imports one entity under the map `m` (entity coordinates → mm, y up); `parent_layer` is
+    /// the layer of the insert above (block entities on layer 0 take it, as in CAD).
+    fn entity(
+        &mut self,
+        e: &'d Entity,
+        m: &Affine,
+        parent_layer: Option<&str>,
+    ) -> Result<(), ImportError> {
+        let layer = match parent_layer {
+            Some(p) if e.common.layer == "0" => p.to_string(),
+            _ => e.common.layer.clone(),
+        };
+        let kind = type_name(&e.specific);
+        let element = self.element(&kind, e);
+        if e.common.is_in_paper_space {
+            let why = "paper-space entity; skipped (only model space is marked)";
+            self.warn(element, &layer, why);
+            return Ok(());
+        }
+        let tol = self.opts.chord_tol_mm.max(1e-6);
+        match curve_paths(&e.specific, m, tol) {
+            Ok(Some(paths)) => return self.push_paths(paths, &element, &layer),
+            Err(why) => {
+                self.warn(element, &layer, format!("{why}; skipped"));
+                return Ok(());
+            }
+            Ok(None) => {}
+        }
+        let mut paths = Vec::new();
+        match &e.specific {
+            EntityType::Polyline(p) => self.polyline(e, p, m, tol, &layer, &mut paths),
+            EntityType::Insert(ins) => return self.insert(e, ins, m, &layer),
+            EntityType::Text(t) => {
+                let run = dxf_text::text_run(t, self.drawing, self.opts);
+                self.text(run, ocs(&t.normal), m, &element, &layer, &mut paths);
+            }
+            EntityType::MText(t) => {
+                let run = dxf_text::mtext_run(t, self.drawing, self.opts);
+                let o = ocs(&t.extrusion_direction);
+                self.text(run, o, m, &element, &layer, &mut paths);
+            }
+            EntityType::ModelPoint(_) => {
+                self.warn(element, &layer, "a point has nothing to mark; skipped");
+                return Ok(());
+            }
+            _ => {
+                let why = format!("{kind} entities are not supported; skipped");
+                self.warn(element, &layer, why);
+                return Ok(());
+            }
+        }
+        self.push_paths(paths, &element, &layer)
+    }
+
+    fn polyline(
+        &mut self,
+        e: &Entity,
+        p: &::dxf::entities::Polyline,
+        m: &Affine,
+        tol: f64,
+        layer: &str,
+        paths: &mut Vec<Outline>,
+    ) {
+        const CLOSED: i32 = 1;
+        const IS_3D: i32 = 8;
+        const MESH: i32 = 16 | 64;
+        const FRAME_CONTROL_POINT: i32 = 16;
+        let element = self.element("POLYLINE", e);
+        if p.flags & MESH != 0 {
+            self.warn(
+                element,
+                layer,
+                "polygon and polyface meshes (3D) are not supported; skipped",
+            );
+            return;
+        }
+        let m = if p.flags & IS_3D != 0 {
+            if p.vertices().any(|v| v.location.z != 0.0) {
+                self.warn(
+                    element.clone(),
+                    layer,
+                    "3D polyline projected onto the XY plane",
+                );
+            }
+            *m
+        } else {
+            match ocs(&p.normal) {
+                Some(o) => m.then(o),
+                None => {
+                    self.warn(element, layer, "not parallel to the XY plane (3D); skipped");
+                    return;
+                }
+            }
+        };
+        let v: Vec<(Pt, f64)> = p
+            .vertices()
+            .filter(|v| v.flags & FRAME_CONTROL_POINT == 0)
+            .map(|v| (pt(&v.location), v.bulge))
+            .collect();
+        paths.push(bulge_path(&v, p.flags & CLOSED != 0, &m, tol));
+    }
+
+    fn insert(
+        &mut self,
+        e: &'d Entity,
+        ins: &'d ::dxf::entities::Insert,
+        m: &Affine,
+        layer: &str,
+    ) -> Result<(), ImportError> {
+        let element = self.element("INSERT", e);
+        let Some(&block) = self.blocks.get(ins.name.as_str()) else {
+            self.warn(
+                element,
+                layer,
+                format!("block '{}' is not defined; skipped", ins.name),
+            );
+            return Ok(());
+        };
+        if self.stack.contains(&block.name.as_str()) || self.stack.len() >= MAX_INSERT_DEPTH {
+            self.warn(
+                element,
+                layer,
+                format!(
+                    "block '{}' inserts itself (or nests deeper than {MAX_INSERT_DEPTH}); skipped",
+                    ins.name
+                ),
+            );
+            return Ok(());
+        }
+        let Some(o) = ocs(&ins.extrusion_direction) else {
+            self.warn(element, layer, "not parallel to the XY plane (3D); skipped");
+            return Ok(());
+        };
+        if ins.attributes().next().is_some() {
+            self.warn(
+                element.clone(),
+                layer,
+                "block attributes (ATTRIB) are not imported",
+            );
+        }
+        let place = m
+            .then(o)
+            .then(Affine::translate(ins.location.x, ins.location.y))
+            .then(Affine::rotate(ins.rotation.to_radians()));
+        let scale = Affine::scale(ins.x_scale_factor, ins.y_scale_factor)
+            .then(Affine::translate(-block.base_point.x, -block.base_point.y));
+        let (cols, rows) = (ins.column_count.max(1), ins.row_count.max(1));
+        self.stack.push(block.name.as_str());
+        for row in 0..rows {
+            for col in 0..cols {
+                self.instances += 1;
+                if self.instances > MAX_INSTANCES {
+                    return Err(ImportError::TooLarge {
+                        file: self.file.into(),
+                        detail: format!(
+                            "more than {MAX_INSTANCES} block instances (nested INSERT arrays)"
+                        ),
+                    });
+                }
+                let cell = Affine::translate(
+                    f64::from(col) * ins.column_spacing,
+                    f64::from(row) * ins.row_spacing,
+                );
+                let inner = place.then(cell).then(scale);
+                for child in &block.entities {
+                    self.entity(child, &inner, Some(layer))?;
+                }
+            }
+        }
+        self.stack.pop();
+        Ok(())
+    }
+
+    fn text(
+        &mut self,
+        run: TextRun,
+        ocs: Option<Affine>,
+        m: &Affine,
+        element: &str,
+        layer: &str,
+        paths: &mut Vec<Outline>,
+    ) {
+        let Some(o) = ocs else {
+            self.warn(element.to_string(), layer, OFF_PLANE);
+            return;
+        };
+        let frame = m.then(o).then(run.frame);
+        let scale = frame_scale(&frame);
+        let tol_local = self.opts.chord_tol_mm.max(1e-6) / scale.max(1e-12);
+        match dxf_text::outlines(&run, self.opts, tol_local) {
+            Ok((outlines, warnings)) => {
+                for w in warnings {
+                    self.warn(element.to_string(), layer, w.message);
+                }
+                paths.extend(
+                    outlines
+                        .into_iter()
+                        .map(|(p, closed)| (p.iter().map(|&q| frame.apply(q)).collect(), closed)),
+                );
+            }
+            Err(why) => self.warn(
+                element.to_string(),
+                layer,
+                format!("text not laid out: {why}; skipped"),
+            ),
+        }
+    }
+
+    fn push_paths(
+        &mut self,
+        paths: Vec<(Vec<Pt>, bool)>,
+        element: &str,
+        layer: &str,
+    ) -> Result<(), ImportError> {
+        for (subpath, (points, closed)) in paths.into_iter().enumerate() {
+            self.points += points.len();
+            if self.points > MAX_POINTS {
+                return Err(ImportError::TooLarge {
+                    file: self.file.into(),
+                    detail: format!("the drawing flattens to more than {MAX_POINTS} vertices"),
+                });
+            }
+            let absurd = points
+                .iter()
+                .any(|p| p.x.abs() > MAX_COORD_MM || p.y.abs() > MAX_COORD_MM);
+            let normalised = if absurd {
+                Err("coordinates beyond 1 km")
+            } else {
+                normalise(points, closed)
+            };
+            match normalised {
+                Ok((points, closed)) => self.raw.push(Raw {
+                    points,
+                    closed,
+                    source: Source {
+                        element: element.to_string(),
+                        subpath,
+                        layer: layer.to_string(),
+                    },
+                }),
+                Err(why) => self.warn(
+                    format!("{element} subpath {subpath}"),
+                    layer,
+                    format!("{why}; skipped"),
+                ),
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The paths of a curve entity (LINE, LWPOLYLINE, ARC, CIRCLE, ELLIPSE, SPLINE) under `m`,
+/// flattened within `tol` mm; `Ok(None)` for other entities, `Err` with the reason to skip one.
+fn curve_paths(t: &EntityType, m: &Affine, tol: f64) -> Result<Option<Vec<Outline>>, String> {
+    let planar = |n: &::dxf::Vector| ocs(n).map(|o| m.then(o)).ok_or(OFF_PLANE);
+    let path = match t {
+        EntityType::Line(l) => (vec![m.apply(pt(&l.p1)), m.apply(pt(&l.p2))], false),
+        EntityType::LwPolyline(p) => {
+            let m = planar(&p.extrusion_direction)?;
+            let v: Vec<(Pt, f64)> = p
+                .vertices
+                .iter()
+                .map(|v| (Pt::new(v.x, v.y), v.bulge))
+                .collect();
+            bulge_path(&v, p.flags & 1 != 0, &m, tol)
+        }
+        EntityType::Arc(a) => {
+            let m = planar(&a.normal)?;
+            let mut sweep = (a.end_angle - a.start_angle).rem_euclid(360.0);
+            if sweep == 0.0 {
+                sweep = 360.0;
+            }
+            let (a0, sweep) = (a.start_angle.to_radians(), sweep.to_radians());
+            let arc = ConicArc::circle(pt(&a.center), a.radius, a0, sweep);
+            (conic_path(&bounded_arc(arc.mapped(&m))?, tol), false)
+        }
+        EntityType::Circle(c) => {
+            let arc = ConicArc::circle(pt(&c.center), c.radius, 0.0, TAU);
+            (
+                closed_conic(&bounded_arc(arc.mapped(&planar(&c.normal)?))?, tol),
+                true,
+            )
+        }
+        EntityType::Ellipse(el) => ellipse_path(el, m, tol)?,
+        EntityType::Spline(s) => return spline_paths(s, m, tol).map(Some),
+        _ => return Ok(None),
+    };
+    Ok(Some(vec![path]))
+}
+
+/// An ELLIPSE (WCS centre and major axis; the normal's sign sets the direction).
+fn ellipse_path(el: &::dxf::entities::Ellipse, m: &Affine, tol: f64) -> Result<Outline, String> {
+    ocs(&el.normal).ok_or(OFF_PLANE)?;
+    let major = Pt::new(el.major_axis.x, el.major_axis.y);
+    let side = if el.normal.z < 0.0 { -1.0 } else { 1.0 };
+    let minor = Pt::new(-major.y, major.x).scale(el.minor_axis_ratio * side);
+    let mut sweep = (el.end_parameter - el.start_parameter).rem_euclid(TAU);
+    if sweep < 1e-12 {
+        sweep = TAU;
+    }
+    let arc = ConicArc {
+        c: pt(&el.center),
+        u: major,
+        v: minor,
+        t0: el.start_parameter,
+        t1: el.start_parameter + sweep,
+    }
+    .mapped(m);
+    let arc = bounded_arc(arc)?;
+    Ok(if sweep == TAU {
+        (closed_conic(&arc, tol), true)
+    } else {
+        (conic_path(&arc, tol), false)
+    })
+}
+
+/// Largest stretch of an affine map's linear part.
+fn frame_scale(a: &Affine) -> f64 {
+    let u = a.apply_vec(Pt::new(1.0, 0.0));
+    let v = a.apply_vec(Pt::new(0.0, 1.0));
+    u.norm() + v.norm()
+}
+
+/// A polyline with bulges (each vertex's bulge bends the segment to the next one).
+fn bulge_path(v: &[(Pt, f64)], closed: bool, m: &Affine, tol: f64) -> Outline {
+    let mut out = Vec::with_capacity(v.len());
+    let Some(&(first, _)) = v.first() else {
+        return (out, closed);
+    };
+    out.push(m.apply(first));
+    let n = v.len();
+    let segments = if closed { n } else { n.saturating_sub(1) };
+    for i in 0..segments {
+        let (p0, bulge) = v[i];
+        let p1 = v[(i + 1) % n].0;
+        // an arc beyond the coordinate limit is not flattened: normalise rejects the path
+        match bulge_arc(p0, p1, bulge).and_then(|a| bounded_arc(a.mapped(m)).ok()) {
+            Some(arc) => arc.flatten(tol, &mut out),
+            None => out.push(m.apply(p1)),
+        }
+    }
+    if closed && n > 1 {
+        // the closing segment ends on the first vertex, which the geometry does not repeat
+        out.pop();
+    }
+    (out, closed)
+}
+
+const BEYOND: &str = "coordinates beyond 1 km";
+
+fn bounded(p: Pt) -> bool {
+    p.x.abs() <= MAX_COORD_MM && p.y.abs() <= MAX_COORD_MM
+}
+
+/// The arc when it lies within the coordinate limit (checked before it is flattened).
+fn bounded_arc(arc: ConicArc) -> Result<ConicArc, String> {
+    let reach = arc.u.norm() + arc.v.norm();
+    let ok = arc.t0.is_finite() && arc.t1.is_finite() && reach <= MAX_COORD_MM && bounded(arc.c);
+    if ok {
+        Ok(arc)
+    } else {
+        Err(BEYOND.into())
+    }
+}
+
+fn conic_path(arc: &ConicArc, tol: f64) -> Vec<Pt> {
+    let mut out = vec![arc.at(arc.t0)];
+    arc.flatten(tol, &mut out);
+    out
+}
+
+fn closed_conic(arc: &ConicArc, tol: f64) -> Vec<Pt> {
+    let mut out = conic_path(arc, tol);
+    out.pop();
+    out
+}
+
+fn spline_paths(s: &::dxf::entities::Spline, m: &Affine, tol: f64) -> Result<Vec<Outline>, String> {
+    if s.normal.x.abs() > NORMAL_TOL || s.normal.y.abs() > NORMAL_TOL {
+        return Err("not parallel to the XY plane (3D)".into());
+    }
+    let closed = s.flags & 1 != 0;
+    if !s.control_points.is_empty() {
+        let degree =
+            usize::try_from(s.degree_of_curve).map_err(|_| "negative degree".to_string())?;
+        let ctrl: Vec<Pt> = s.control_points.iter().map(|p| m.apply(pt(p))).collect();
+        if !ctrl.iter().all(|&p| bounded(p)) {
+            return Err(BEYOND.into());
+        }
+        let nurbs = Nurbs::new(degree, s.knot_values.clone(), &ctrl, &s.weight_values)
+            .map_err(|why| format!("invalid spline: {why}"))?;
+        let paths = nurbs.flatten(tol, MAX_POINTS)?;
+        let closed = closed && paths.len() == 1;
+        Ok(paths.into_iter().map(|p| (p, closed)).collect())
+    } else if s.fit_points.len() >= 2 {
+        let fit: Vec<Pt> = s.fit_points.iter().map(pt).collect();
+        let tangent = |t: &::dxf::Point| {
+            let v = pt(t);
+            (v.norm() > 0.0).then_some(v)
+        };
+        let spans = fit_point_spline(&fit, tangent(&s.start_tangent), tangent(&s.end_tangent));
+        let mapped: Vec<[Pt; 4]> = spans.iter().map(|b| b.map(|p| m.apply(p))).collect();
+        if !mapped.iter().flatten().all(|&p| bounded(p)) {
+            return Err(BEYOND.into());
+        }
+        let mut out = vec![m.apply(fit[0])];
+        for [p0, p1, p2, p3] in mapped {
+            flatten_cubic(p0, p1, p2, p3, tol, &mut out);
+        }
+        Ok(vec![(out, closed)])
+    } else {
+        Err("spline without control points or fit points".into())
+    }
+}
+
+/// Flips y (up → down) about the drawing's top and places it (see the module docs).
+fn place(
+    raw: Vec<Raw>,
+    work_area: Option<[f64; 2]>,
+    warnings: &mut Vec<Warning>,
+) -> (Vec<Geometry>, [f64; 2]) {
+    let b = raw
+        .iter()
+        .fold(BBox::EMPTY, |b, r| b.union(BBox::of(&r.points)));
+    let fits_area = work_area.is_none_or(|[w, h]| b.max_x <= w && b.max_y <= h);
+    let keep = b.min_x >= 0.0 && b.min_y >= 0.0 && fits_area;
+    let dx = if keep { 0.0 } else { -b.min_x };
+    if !keep {
+        warnings.push(Warning {
+            element: "drawing".into(),
+            line: None,
+            message: format!(
+                "moved by ({:.3}, {:.3}) mm so that its bounding box starts at the work area's corner \
+                 (it lies at x {:.3}…{:.3}, y {:.3}…{:.3} mm in the DXF)",
+                -b.min_x, -b.min_y, b.min_x, b.max_x, b.min_y, b.max_y
+            ),
+        });
+    }
+    let page_mm = [b.max_x + dx, b.max_y - if keep { 0.0 } else { b.min_y }];
+    let geometries = raw
+        .into_iter()
+        .map(|r| {
+            let pts = r
+                .points
+                .iter()
+                .map(|p| Pt::new(p.x + dx, b.max_y - p.y))
+                .collect();
+            Geometry::new(pts, r.closed, r.source)
+        })
+        .collect();
+    (geometries, page_mm)
+}
