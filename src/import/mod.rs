@@ -7,6 +7,7 @@ mod curves;
 mod dxf;
 mod dxf_text;
 mod fonts;
+mod guard;
 mod svg;
 
 pub use self::dxf::import_dxf;
@@ -19,6 +20,9 @@ use serde::{Deserialize, Serialize};
 use std::path::Path;
 use thiserror::Error;
 
+/// Output budget of one import: more vertices than this is an error, not minutes of flattening
+/// and gigabytes of memory (80 MB of points).
+const MAX_POINTS: usize = 5_000_000;
 /// Subpaths shorter than this (mm) are degenerate: below the exported G-code's resolution.
 const MIN_LENGTH_MM: f64 = 1e-3;
 /// Points closer than this are one point (mm).
