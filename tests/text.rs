@@ -125,6 +125,11 @@ fn huge_text_at_a_fine_tolerance_is_an_error_not_gigabytes() {
         chord_tol_mm: 1e-4,
         ..opts()
     };
-    let e = import_svg(svg.as_bytes(), "big.svg", &o).unwrap_err().to_string();
-    assert!(e.starts_with("big.svg: the drawing flattens to more than"), "{e}");
+    let e = import_svg(svg.as_bytes(), "big.svg", &o)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with("big.svg: the drawing flattens to more than"),
+        "{e}"
+    );
 }

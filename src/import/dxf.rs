@@ -12,7 +12,9 @@ use super::curves::{bulge_arc, fit_point_spline, Affine, ConicArc, Nurbs};
 use super::dxf_text::{self, TextRun};
 use super::svg::too_many_points;
 use super::svg::Outline;
-use super::{guard, normalise, ImportError, ImportOptions, Imported, Warning, MAX_POINTS};
+use super::{
+    guard, normalise, nothing_to_mark, ImportError, ImportOptions, Imported, Warning, MAX_POINTS,
+};
 use crate::document::{Geometry, Source};
 use crate::geom::{flatten_cubic, BBox, Pt};
 use ::dxf::entities::{Entity, EntityType};
@@ -114,7 +116,11 @@ pub fn import_dxf(bytes: &[u8], file: &str, opts: &ImportOptions) -> Result<Impo
         raw, mut warnings, ..
     } = walk;
     if raw.is_empty() {
-        return Err(nothing_to_mark(file, &warnings));
+        return Err(nothing_to_mark(
+            file,
+            &warnings,
+            "the drawing has no entities",
+        ));
     }
     let (geometries, page_mm) = place(raw, opts.work_area_mm, &mut warnings);
     Ok(Imported {
@@ -168,25 +174,6 @@ impl std::io::Read for Counting<'_> {
 
 fn one_line(s: &str) -> String {
     s.split_whitespace().collect::<Vec<_>>().join(" ")
-}
-
-fn nothing_to_mark(file: &str, warnings: &[Warning]) -> ImportError {
-    let detail = if warnings.is_empty() {
-        "the drawing has no entities".to_string()
-    } else {
-        let listed: Vec<String> = warnings.iter().take(3).map(|w| w.to_string()).collect();
-        let more = warnings.len().saturating_sub(3);
-        let tail = if more > 0 {
-            format!("; and {more} more")
-        } else {
-            String::new()
-        };
-        format!("only skipped content: {}{tail}", listed.join("; "))
-    };
-    ImportError::NothingToMark {
-        file: file.into(),
-        detail,
-    }
 }
 
 /// mm per drawing unit from `$INSUNITS`; unitless and unknown units read as mm with a warning.

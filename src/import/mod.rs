@@ -229,3 +229,24 @@ fn normalise(pts: Vec<Pt>, closed: bool) -> Result<(Vec<Pt>, bool), &'static str
     }
     Ok((out, closed))
 }
+
+/// The error for a file with nothing to mark: what was skipped (the first three warnings), or
+/// `empty` when nothing was.
+fn nothing_to_mark(file: &str, warnings: &[Warning], empty: &str) -> ImportError {
+    let detail = if warnings.is_empty() {
+        empty.to_string()
+    } else {
+        let listed: Vec<String> = warnings.iter().take(3).map(|w| w.to_string()).collect();
+        let more = warnings.len().saturating_sub(3);
+        let tail = if more > 0 {
+            format!("; and {more} more")
+        } else {
+            String::new()
+        };
+        format!("only skipped content: {}{tail}", listed.join("; "))
+    };
+    ImportError::NothingToMark {
+        file: file.into(),
+        detail,
+    }
+}

@@ -2,7 +2,9 @@
 //! `<text>` laid out with the fonts of [`super::fonts`] and imported as glyph outlines.
 
 use super::fonts::{family_list, miss_warnings, usvg_options, Misses};
-use super::{normalise, ImportError, ImportOptions, Imported, Warning, MAX_POINTS};
+use super::{
+    normalise, nothing_to_mark, ImportError, ImportOptions, Imported, Warning, MAX_POINTS,
+};
 use crate::document::{Geometry, Source};
 use crate::geom::{flatten_cubic, flatten_quad, Pt};
 use rustc_hash::FxHashMap;
@@ -90,25 +92,11 @@ pub fn import_svg(bytes: &[u8], file: &str, opts: &ImportOptions) -> Result<Impo
         })?;
     warnings.extend(font_warnings);
     if geometries.is_empty() {
-        let detail = if warnings.is_empty() {
-            "the file has no paths or shapes".to_string()
-        } else {
-            let listed: Vec<String> = warnings.iter().take(3).map(|w| w.to_string()).collect();
-            let more = warnings.len().saturating_sub(3);
-            format!(
-                "only skipped content: {}{}",
-                listed.join("; "),
-                if more > 0 {
-                    format!("; and {more} more")
-                } else {
-                    String::new()
-                }
-            )
-        };
-        return Err(ImportError::NothingToMark {
-            file: file.into(),
-            detail,
-        });
+        return Err(nothing_to_mark(
+            file,
+            &warnings,
+            "the file has no paths or shapes",
+        ));
     }
     Ok(Imported {
         geometries,
