@@ -462,7 +462,7 @@ fn import_warnings_are_listed() {
         &svg,
         r#"<svg xmlns="http://www.w3.org/2000/svg" width="100mm" height="100mm" viewBox="0 0 100 100">
 <rect x="10" y="10" width="5" height="5" fill="none" stroke="black"/>
-<text id="caption" x="20" y="20">hello</text></svg>"#,
+<image id="caption" x="20" y="20" width="5" height="5" href="photo.png"/></svg>"#,
     )
     .unwrap();
     let h = opened(&svg);
@@ -761,15 +761,27 @@ fn motion_plots_show_an_on_the_fly_plan() {
     assert!(h.query_by_label_contains("Motion plots").is_none());
 }
 
+/// A file dropped on the window, as an integration hands it to egui.
+#[derive(Debug)]
+struct Dropped(PathBuf);
+
+impl egui::DroppedFile for Dropped {
+    fn path(&self) -> &Path {
+        &self.0
+    }
+    fn bytes(&self) -> Result<Vec<u8>, String> {
+        std::fs::read(&self.0).map_err(|e| e.to_string())
+    }
+}
+
 #[test]
 fn a_dropped_dxf_opens_with_its_layers() {
     let mut h = harness(App::default());
     h.run();
     let path = common::root().join("tests/data/dxf/entities-inch.dxf");
-    h.input_mut().dropped_files.push(egui::DroppedFile {
-        path: Some(path),
-        ..Default::default()
-    });
+    h.input_mut()
+        .dropped_files
+        .push(std::sync::Arc::new(Dropped(path)));
     h.run();
     let doc = &h.state().doc;
     assert_eq!(doc.geometries.len(), 26, "{}", h.state().status());
