@@ -311,3 +311,40 @@ fn import_file_chooses_by_extension_then_content() {
     let e = import_file(&unknown, &opts(0.01)).unwrap_err().to_string();
     assert!(e.contains("unknown format"), "{e}");
 }
+
+/// Inputs the fuzzer (docs/FUZZING.md) found making the reader panic: each must be an error.
+#[test]
+fn fuzz_regressions_are_errors() {
+    let header = |var: &str, value: &str| {
+        format!("0\nSECTION\n2\nHEADER\n9\n{var}\n40\n{value}\n0\nENDSEC\n0\nEOF\n")
+    };
+    // a creation date beyond chrono's range: the dxf crate panics in TimeDelta::seconds
+    for (var, value) in [
+        ("$TDCREATE", "1e300"),
+        ("$TDUPDATE", "-1e300"),
+        ("$TDUCREATE", "1e17"),
+    ] {
+        let e = import_text(&header(var, value)).unwrap_err().to_string();
+        assert!(
+            e.starts_with("t.dxf: not a valid DXF: the DXF reader failed near line"),
+            "{e}"
+        );
+        assert!(!e.contains('\n'), "{e}");
+    }
+}
+
+/// The fuzzer's crash files themselves (tests/data/dxf/fuzz/): errors, no panic.
+#[test]
+fn fuzz_crash_files_are_errors() {
+    let dir = Path::new(DATA).join("fuzz");
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        let bytes = std::fs::read(&path).unwrap();
+        let t0 = std::time::Instant::now();
+        if let Err(e) = import_dxf(&bytes, "crash.dxf", &opts(0.01)) {
+            assert!(!e.to_string().contains('\n'), "{}: {e}", path.display());
+        }
+        // the slow-unit and oom files took 10 s and 2.4 GB before the text size check
+        assert!(t0.elapsed().as_secs_f64() < 5.0, "{}", path.display());
+    }
+}

@@ -114,3 +114,22 @@ fn label_example_plans_with_every_glyph_outlined() {
         .collect();
     assert_eq!(layers.into_iter().collect::<Vec<_>>(), ["Frame", "Text"]);
 }
+
+#[test]
+fn huge_text_at_a_fine_tolerance_is_an_error_not_gigabytes() {
+    let words = "WMB".repeat(200);
+    let svg = format!(
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="100mm" height="40mm"><text x="0" y="0" font-size="100000">{words}</text></svg>"#
+    );
+    let o = ImportOptions {
+        chord_tol_mm: 1e-4,
+        ..opts()
+    };
+    let e = import_svg(svg.as_bytes(), "big.svg", &o)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with("big.svg: the drawing flattens to more than"),
+        "{e}"
+    );
+}

@@ -10,18 +10,21 @@
 
 use super::curves::{bulge_arc, fit_point_spline, Affine, ConicArc, Nurbs};
 use super::dxf_text::{self, TextRun};
+use super::svg::too_many_points;
 use super::svg::Outline;
-use super::{normalise, ImportError, ImportOptions, Imported, Warning};
+use super::{
+    guard, normalise, nothing_to_mark, ImportError, ImportOptions, Imported, Warning, MAX_POINTS,
+};
 use crate::document::{Geometry, Source};
 use crate::geom::{flatten_cubic, BBox, Pt};
 use ::dxf::entities::{Entity, EntityType};
 use ::dxf::enums::Units;
 use ::dxf::{Block, Drawing};
-use rustc_hash::FxHashMap;
+use rustc_hash::{FxHashMap, FxHashSet};
 use std::f64::consts::TAU;
 
-/// Output budget: more vertices than this is an error, not an hour of flattening (80 MB).
-const MAX_POINTS: usize = 5_000_000;
+/// Budget of entities visited (block instances multiply a block's entities).
+const MAX_VISITS: usize = 2_000_000;
 /// Budget of block instances (nested arrays multiply).
 const MAX_INSTANCES: usize = 1_000_000;
 /// Deepest block nesting followed (a block inserting itself is caught earlier).
@@ -89,11 +92,7 @@ pub fn import_dxf(bytes: &[u8], file: &str, opts: &ImportOptions) -> Result<Impo
     if bytes.iter().all(|b| b.is_ascii_whitespace()) {
         return Err(ImportError::Empty { file: file.into() });
     }
-    let drawing =
-        Drawing::load(&mut std::io::Cursor::new(bytes)).map_err(|e| ImportError::MalformedDxf {
-            file: file.into(),
-            cause: one_line(&e.to_string()),
-        })?;
+    let drawing = load(bytes, file)?;
     let mut warnings = skipped_types(bytes);
     let unit_mm = units_mm(drawing.header.default_drawing_units, &mut warnings);
     let mut walk = Walk {
@@ -106,6 +105,8 @@ pub fn import_dxf(bytes: &[u8], file: &str, opts: &ImportOptions) -> Result<Impo
         points: 0,
         instances: 0,
         stack: Vec::new(),
+        visits: 0,
+        warned: FxHashSet::default(),
     };
     let to_mm = Affine::scale(unit_mm, unit_mm);
     for e in drawing.entities() {
@@ -115,7 +116,11 @@ pub fn import_dxf(bytes: &[u8], file: &str, opts: &ImportOptions) -> Result<Impo
         raw, mut warnings, ..
     } = walk;
     if raw.is_empty() {
-        return Err(nothing_to_mark(file, &warnings));
+        return Err(nothing_to_mark(
+            file,
+            &warnings,
+            "the drawing has no entities",
+        ));
     }
     let (geometries, page_mm) = place(raw, opts.work_area_mm, &mut warnings);
     Ok(Imported {
@@ -125,27 +130,50 @@ pub fn import_dxf(bytes: &[u8], file: &str, opts: &ImportOptions) -> Result<Impo
     })
 }
 
-fn one_line(s: &str) -> String {
-    s.split_whitespace().collect::<Vec<_>>().join(" ")
+/// Parses the drawing; the reader's errors and panics (it has some on malformed headers) become
+/// one-line errors with the position: the reader's own, or the line (ASCII) or byte (binary) it
+/// had read up to when it failed.
+fn load(bytes: &[u8], file: &str) -> Result<Drawing, ImportError> {
+    let mut reader = Counting { bytes, pos: 0 };
+    let malformed = |cause: String| ImportError::MalformedDxf {
+        file: file.into(),
+        cause: one_line(&cause),
+    };
+    match guard::catch_quietly(|| Drawing::load(&mut reader)) {
+        Ok(Ok(drawing)) => Ok(drawing),
+        Ok(Err(e)) => Err(malformed(e.to_string())),
+        Err(panic) => {
+            let read = &bytes[..reader.pos.min(bytes.len())];
+            let at = if read.starts_with(b"AutoCAD Binary DXF") {
+                format!("byte {}", reader.pos)
+            } else {
+                format!("line {}", read.iter().filter(|&&b| b == b'\n').count() + 1)
+            };
+            Err(malformed(format!(
+                "the DXF reader failed near {at} ({panic})"
+            )))
+        }
+    }
 }
 
-fn nothing_to_mark(file: &str, warnings: &[Warning]) -> ImportError {
-    let detail = if warnings.is_empty() {
-        "the drawing has no entities".to_string()
-    } else {
-        let listed: Vec<String> = warnings.iter().take(3).map(|w| w.to_string()).collect();
-        let more = warnings.len().saturating_sub(3);
-        let tail = if more > 0 {
-            format!("; and {more} more")
-        } else {
-            String::new()
-        };
-        format!("only skipped content: {}{tail}", listed.join("; "))
-    };
-    ImportError::NothingToMark {
-        file: file.into(),
-        detail,
+/// A reader over bytes that knows how far it has been read.
+struct Counting<'b> {
+    bytes: &'b [u8],
+    pos: usize,
+}
+
+impl std::io::Read for Counting<'_> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let rest = self.bytes.get(self.pos..).unwrap_or_default();
+        let n = rest.len().min(buf.len());
+        buf[..n].copy_from_slice(&rest[..n]);
+        self.pos += n;
+        Ok(n)
     }
+}
+
+fn one_line(s: &str) -> String {
+    s.split_whitespace().collect::<Vec<_>>().join(" ")
 }
 
 /// mm per drawing unit from `$INSUNITS`; unitless and unknown units read as mm with a warning.
@@ -234,6 +262,10 @@ struct Walk<'d> {
     instances: usize,
     /// Names of the blocks being inserted, outermost first.
     stack: Vec<&'d str>,
+    /// Entities visited (instances count again).
+    visits: usize,
+    /// Warnings given, by element and message.
+    warned: FxHashSet<(String, String)>,
 }
 
 /// The DXF name of an entity type (its variant name in capitals for the rare ones).
@@ -292,12 +324,16 @@ impl<'d> Walk<'d> {
         s
     }
 
+    /// Adds a warning once (a block's entity warns once, not once per insert).
     fn warn(&mut self, element: String, layer: &str, message: impl Into<String>) {
-        self.warnings.push(Warning {
+        let w = Warning {
             element: format!("{element} (layer {layer})"),
             line: None,
             message: message.into(),
-        });
+        };
+        if self.warned.insert((w.element.clone(), w.message.clone())) {
+            self.warnings.push(w);
+        }
     }
 
     /// Imports one entity under the map `m` (entity coordinates → mm, y up); `parent_layer` is
@@ -312,6 +348,13 @@ impl<'d> Walk<'d> {
             Some(p) if e.common.layer == "0" => p.to_string(),
             _ => e.common.layer.clone(),
         };
+        self.visits += 1;
+        if self.visits > MAX_VISITS {
+            return Err(ImportError::TooLarge {
+                file: self.file.into(),
+                detail: format!("more than {MAX_VISITS} entities with the blocks expanded"),
+            });
+        }
         let kind = type_name(&e.specific);
         let element = self.element(&kind, e);
         if e.common.is_in_paper_space {
@@ -488,8 +531,18 @@ impl<'d> Walk<'d> {
         };
         let frame = m.then(o).then(run.frame);
         let scale = frame_scale(&frame);
+        let height_mm = run.height * scale;
+        if !height_mm.is_finite() || height_mm > MAX_COORD_MM {
+            self.warn(
+                element.to_string(),
+                layer,
+                format!("text height {height_mm} mm: {BEYOND}; skipped"),
+            );
+            return;
+        }
         let tol_local = self.opts.chord_tol_mm.max(1e-6) / scale.max(1e-12);
-        match dxf_text::outlines(&run, self.opts, tol_local) {
+        let budget = MAX_POINTS.saturating_sub(self.points);
+        match dxf_text::outlines(&run, self.opts, tol_local, budget) {
             Ok((outlines, warnings)) => {
                 for w in warnings {
                     self.warn(element.to_string(), layer, w.message);
@@ -519,7 +572,7 @@ impl<'d> Walk<'d> {
             if self.points > MAX_POINTS {
                 return Err(ImportError::TooLarge {
                     file: self.file.into(),
-                    detail: format!("the drawing flattens to more than {MAX_POINTS} vertices"),
+                    detail: too_many_points(self.opts.chord_tol_mm),
                 });
             }
             let absurd = points

@@ -263,11 +263,13 @@ fn xml_escape(s: &str) -> String {
 }
 
 /// The run's glyph outlines in its text frame (x along the baseline, y up, origin at the
-/// anchor), flattened within `tol` drawing units, with the font warnings.
+/// anchor), flattened within `tol` drawing units into at most `budget` vertices, with the font
+/// warnings.
 pub fn outlines(
     run: &TextRun,
     opts: &ImportOptions,
     tol: f64,
+    budget: usize,
 ) -> Result<(Vec<Outline>, Vec<Warning>), String> {
     if !(run.height.is_finite() && run.height > 0.0) {
         return Err(format!(
@@ -309,7 +311,7 @@ pub fn outlines(
         ));
     }
     svg.push_str("</text></svg>");
-    let (outlines, warnings) = text_outlines(&svg, opts, tol)?;
+    let (outlines, warnings) = text_outlines(&svg, opts, tol, budget)?;
     let flipped = outlines
         .into_iter()
         .map(|(p, closed)| (p.into_iter().map(|q| Pt::new(q.x, -q.y)).collect(), closed))

@@ -7,6 +7,7 @@ mod curves;
 mod dxf;
 mod dxf_text;
 mod fonts;
+mod guard;
 mod svg;
 
 pub use self::dxf::import_dxf;
@@ -19,6 +20,9 @@ use serde::{Deserialize, Serialize};
 use std::path::Path;
 use thiserror::Error;
 
+/// Output budget of one import: more vertices than this is an error, not minutes of flattening
+/// and gigabytes of memory (80 MB of points).
+const MAX_POINTS: usize = 5_000_000;
 /// Subpaths shorter than this (mm) are degenerate: below the exported G-code's resolution.
 const MIN_LENGTH_MM: f64 = 1e-3;
 /// Points closer than this are one point (mm).
@@ -224,4 +228,25 @@ fn normalise(pts: Vec<Pt>, closed: bool) -> Result<(Vec<Pt>, bool), &'static str
         return Err("zero length (shorter than 1 µm)");
     }
     Ok((out, closed))
+}
+
+/// The error for a file with nothing to mark: what was skipped (the first three warnings), or
+/// `empty` when nothing was.
+fn nothing_to_mark(file: &str, warnings: &[Warning], empty: &str) -> ImportError {
+    let detail = if warnings.is_empty() {
+        empty.to_string()
+    } else {
+        let listed: Vec<String> = warnings.iter().take(3).map(|w| w.to_string()).collect();
+        let more = warnings.len().saturating_sub(3);
+        let tail = if more > 0 {
+            format!("; and {more} more")
+        } else {
+            String::new()
+        };
+        format!("only skipped content: {}{tail}", listed.join("; "))
+    };
+    ImportError::NothingToMark {
+        file: file.into(),
+        detail,
+    }
 }

@@ -2,7 +2,9 @@
 //! `<text>` laid out with the fonts of [`super::fonts`] and imported as glyph outlines.
 
 use super::fonts::{family_list, miss_warnings, usvg_options, Misses};
-use super::{normalise, ImportError, ImportOptions, Imported, Warning};
+use super::{
+    normalise, nothing_to_mark, ImportError, ImportOptions, Imported, Warning, MAX_POINTS,
+};
 use crate::document::{Geometry, Source};
 use crate::geom::{flatten_cubic, flatten_quad, Pt};
 use rustc_hash::FxHashMap;
@@ -81,28 +83,20 @@ pub fn import_svg(bytes: &[u8], file: &str, opts: &ImportOptions) -> Result<Impo
     }
     let mut warnings = unsupported_content(&xml);
     let (geometries, page_mm, font_warnings) =
-        tree_geometries(&xml, opts, opts.chord_tol_mm).map_err(malformed)?;
+        tree_geometries(&xml, opts, opts.chord_tol_mm, MAX_POINTS).map_err(|e| match e {
+            TreeError::Malformed(cause) => malformed(cause),
+            TreeError::TooLarge => ImportError::TooLarge {
+                file: file.into(),
+                detail: too_many_points(opts.chord_tol_mm),
+            },
+        })?;
     warnings.extend(font_warnings);
     if geometries.is_empty() {
-        let detail = if warnings.is_empty() {
-            "the file has no paths or shapes".to_string()
-        } else {
-            let listed: Vec<String> = warnings.iter().take(3).map(|w| w.to_string()).collect();
-            let more = warnings.len().saturating_sub(3);
-            format!(
-                "only skipped content: {}{}",
-                listed.join("; "),
-                if more > 0 {
-                    format!("; and {more} more")
-                } else {
-                    String::new()
-                }
-            )
-        };
-        return Err(ImportError::NothingToMark {
-            file: file.into(),
-            detail,
-        });
+        return Err(nothing_to_mark(
+            file,
+            &warnings,
+            "the file has no paths or shapes",
+        ));
     }
     Ok(Imported {
         geometries,
@@ -117,16 +111,26 @@ type TreeGeometries = (Vec<Geometry>, [f64; 2], Vec<Warning>);
 /// A flattened subpath: points and whether it is closed.
 pub(super) type Outline = (Vec<Pt>, bool);
 
+/// Why a usvg tree gave no geometries.
+enum TreeError {
+    /// usvg's own error.
+    Malformed(String),
+    /// More vertices than the budget.
+    TooLarge,
+}
+
 /// Builds the usvg tree of `xml` (text laid out with the options' fonts) and flattens it within
-/// `tol_mm`: the geometries, the page size in mm and the font substitutions as warnings.
+/// `tol_mm` into at most `budget` vertices: the geometries, the page size in mm and the font
+/// substitutions as warnings.
 fn tree_geometries(
     xml: &roxmltree::Document,
     opts: &ImportOptions,
     tol_mm: f64,
-) -> Result<TreeGeometries, String> {
+    budget: usize,
+) -> Result<TreeGeometries, TreeError> {
     let misses = Misses::default();
     let tree = usvg::Tree::from_xmltree(xml, &usvg_options(opts.fonts, &misses))
-        .map_err(|e| e.to_string())?;
+        .map_err(|e| TreeError::Malformed(e.to_string()))?;
     // usvg stores sizes as f32 px: round to 0.1 µm so that "100mm" reads as 100
     let round = |v: f32| (f64::from(v) * PX_TO_MM * 1e4).round() / 1e4;
     let page_mm = [round(tree.size().width()), round(tree.size().height())];
@@ -139,8 +143,13 @@ fn tree_geometries(
         text_count: 0,
         layer_names: layer_names(xml),
         text_families: FxHashMap::default(),
+        budget,
+        overflow: false,
     };
     walker.group(tree.root(), None);
+    if walker.overflow {
+        return Err(TreeError::TooLarge);
+    }
     let geometries = std::mem::take(&mut walker.geometries);
     let families = std::mem::take(&mut walker.text_families);
     warnings.extend(miss_warnings(misses.take(), |requested| {
@@ -152,15 +161,26 @@ fn tree_geometries(
     Ok((geometries, page_mm, warnings))
 }
 
+/// The error text of an import beyond [`MAX_POINTS`].
+pub(super) fn too_many_points(tol_mm: f64) -> String {
+    format!("the drawing flattens to more than {MAX_POINTS} vertices at a chord tolerance of {tol_mm} mm")
+}
+
 /// Glyph outlines of a small SVG made by the DXF text import: `(points, closed)` per subpath in
-/// the SVG's mm, flattened within `tol_mm`, with the font warnings.
+/// the SVG's mm, flattened within `tol_mm` into at most `budget` vertices, with the font
+/// warnings.
 pub(super) fn text_outlines(
     svg: &str,
     opts: &ImportOptions,
     tol_mm: f64,
+    budget: usize,
 ) -> Result<(Vec<Outline>, Vec<Warning>), String> {
     let xml = roxmltree::Document::parse(svg).map_err(|e| e.to_string())?;
-    let (geometries, _, warnings) = tree_geometries(&xml, opts, tol_mm)?;
+    let (geometries, _, warnings) =
+        tree_geometries(&xml, opts, tol_mm, budget).map_err(|e| match e {
+            TreeError::Malformed(cause) => cause,
+            TreeError::TooLarge => format!("more than {budget} vertices"),
+        })?;
     let outlines = geometries
         .into_iter()
         .map(|g| (g.points, g.closed))
@@ -228,6 +248,10 @@ struct Walker<'w> {
     layer_names: FxHashMap<String, String>,
     /// Requested font family list → the first text element asking for it.
     text_families: FxHashMap<String, String>,
+    /// Vertices the walk may still produce.
+    budget: usize,
+    /// Set when the budget ran out (the walk then stops adding geometry).
+    overflow: bool,
 }
 
 fn paint_hex(paint: &usvg::Paint) -> String {
@@ -281,31 +305,24 @@ impl Walker<'_> {
         }
     }
 
-    fn path(&mut self, p: &usvg::Path, element: &str, layer: Option<&str>) {
-        let layer = match (layer, p.stroke(), p.fill()) {
-            (Some(name), _, _) => name.to_string(),
-            (None, Some(s), _) => paint_hex(s.paint()),
-            (None, None, Some(f)) => format!("fill {}", paint_hex(f.paint())),
-            (None, None, None) => "none".into(),
-        };
-        let t = p.abs_transform();
-        let map = |q: usvg::tiny_skia_path::Point| -> Pt {
-            let (x, y) = (f64::from(q.x), f64::from(q.y));
-            Pt::new(
-                snap((f64::from(t.sx) * x + f64::from(t.kx) * y + f64::from(t.tx)) * PX_TO_MM),
-                snap((f64::from(t.ky) * x + f64::from(t.sy) * y + f64::from(t.ty)) * PX_TO_MM),
-            )
-        };
+    /// The flattened subpaths of a path, `None` when the vertex budget ran out.
+    fn subpaths(
+        &mut self,
+        p: &usvg::Path,
+        map: impl Fn(usvg::tiny_skia_path::Point) -> Pt,
+    ) -> Option<Vec<Outline>> {
         // chord tolerance in mm, applied after the transform
         let tol_mm = self.tol_px * PX_TO_MM;
-        let mut subpaths: Vec<(Vec<Pt>, bool)> = Vec::new();
+        let mut subpaths: Vec<Outline> = Vec::new();
         let mut cur: Vec<Pt> = Vec::new();
         let mut closed = false;
+        let mut done = 0;
         for seg in p.data().segments() {
             match seg {
                 PathSegment::MoveTo(q) => {
                     // a lone point (e.g. the start left behind by Z) is not a subpath
                     if cur.len() > 1 {
+                        done += cur.len();
                         subpaths.push((std::mem::take(&mut cur), closed));
                     }
                     cur.clear();
@@ -324,6 +341,7 @@ impl Walker<'_> {
                 PathSegment::Close => {
                     closed = true;
                     if let Some(&first) = cur.first() {
+                        done += cur.len();
                         subpaths.push((std::mem::take(&mut cur), true));
                         // a segment after Z starts at the subpath's first point
                         cur.push(first);
@@ -331,10 +349,40 @@ impl Walker<'_> {
                     }
                 }
             }
+            if done + cur.len() > self.budget {
+                self.overflow = true;
+                return None;
+            }
         }
         if cur.len() > 1 {
+            done += cur.len();
             subpaths.push((cur, closed));
         }
+        self.budget -= done;
+        Some(subpaths)
+    }
+
+    fn path(&mut self, p: &usvg::Path, element: &str, layer: Option<&str>) {
+        if self.overflow {
+            return;
+        }
+        let layer = match (layer, p.stroke(), p.fill()) {
+            (Some(name), _, _) => name.to_string(),
+            (None, Some(s), _) => paint_hex(s.paint()),
+            (None, None, Some(f)) => format!("fill {}", paint_hex(f.paint())),
+            (None, None, None) => "none".into(),
+        };
+        let t = p.abs_transform();
+        let map = |q: usvg::tiny_skia_path::Point| -> Pt {
+            let (x, y) = (f64::from(q.x), f64::from(q.y));
+            Pt::new(
+                snap((f64::from(t.sx) * x + f64::from(t.kx) * y + f64::from(t.tx)) * PX_TO_MM),
+                snap((f64::from(t.ky) * x + f64::from(t.sy) * y + f64::from(t.ty)) * PX_TO_MM),
+            )
+        };
+        let Some(subpaths) = self.subpaths(p, map) else {
+            return;
+        };
         for (sub_index, (pts, closed)) in subpaths.into_iter().enumerate() {
             let source = Source {
                 element: element.to_string(),
