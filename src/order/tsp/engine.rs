@@ -77,7 +77,7 @@ impl<'p> Engine<'p> {
         }
         let lo = usize::from(prob.fixed_first);
         let hi = if prob.fixed_last { n - 2 } else { n - 1 };
-        if lo >= hi {
+        if lo > hi {
             return None;
         }
         Some(Engine {

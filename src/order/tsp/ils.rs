@@ -56,13 +56,15 @@ impl IlsBudget {
         Self::kicks(kicks.unwrap_or_else(|| default_kicks(n)))
     }
 
-    /// The same budget with its kick count (when finite) divided by `d` (at least 8 kicks).
+    /// The same budget with its kick count (when finite) divided by `d`, but not below
+    /// [`DIVIDED_KICKS_MIN`] (small paths keep their whole budget: their kicks are cheap, and a
+    /// few kicks leave a small path far from its optimum).
     pub fn divided(self, d: usize) -> Self {
         Self {
             kicks: if self.kicks == usize::MAX {
                 self.kicks
             } else {
-                (self.kicks / d.max(1)).max(8)
+                (self.kicks / d.max(1)).max(self.kicks.min(DIVIDED_KICKS_MIN))
             },
             ..self
         }
@@ -98,6 +100,9 @@ pub const STALL_PER_NODE: usize = 50;
 
 /// Least stall bound of a search with a deadline.
 pub const STALL_MIN: usize = 1000;
+
+/// Fewest kicks of a divided budget ([`IlsBudget::divided`]).
+pub const DIVIDED_KICKS_MIN: usize = 200;
 
 /// Kicks per node of the default budget.
 const KICKS_PER_NODE: usize = 2;
