@@ -39,7 +39,8 @@ pub struct TspArgs {
     /// Seeds per instance (from --seed on).
     #[arg(long, default_value_t = 1)]
     seeds: u64,
-    /// Stop the search after this many seconds (default: the kick budget alone, deterministic).
+    /// Search for this many seconds instead of the kick budget (stops earlier after a long
+    /// stall; default: the kick budget alone, deterministic).
     #[arg(long)]
     time_limit: Option<f64>,
     /// Kicks of the iterated local search (default: as many as the ordering uses for a field of
@@ -82,13 +83,14 @@ pub fn run(a: &TspArgs) -> Result<()> {
             path.display()
         );
         for seed in a.seed..a.seed + a.seeds {
-            let budget = IlsBudget {
-                deadline: a
-                    .time_limit
-                    .map(|t| Instant::now() + Duration::from_secs_f64(t)),
-                ..IlsBudget::for_nodes(points.len(), a.kicks)
-            };
             let t = Instant::now();
+            // a time limit replaces the kick budget (kicks until it, or until a long stall)
+            let budget = match a.time_limit {
+                Some(limit) => {
+                    IlsBudget::until(points.len(), Some(t + Duration::from_secs_f64(limit)))
+                }
+                None => IlsBudget::for_nodes(points.len(), a.kicks),
+            };
             let order = open_path(&points, budget, seed, &ctx)?;
             let ms = t.elapsed().as_secs_f64() * 1e3;
             let length: f64 = order
