@@ -4,6 +4,7 @@ mod bench;
 mod hatch_bench;
 mod plan;
 mod progress;
+mod tsp;
 
 use anyhow::Result;
 use clap::{Args, Parser, Subcommand, ValueEnum};
@@ -33,6 +34,9 @@ enum Command {
     Bench(BenchArgs),
     /// Seed 003's hatch experiment: counts, lengths and times of zigzag and contour fills.
     HatchBench(hatch_bench::HatchBenchArgs),
+    /// Order plain point sets (TSPLIB or SVG) with the ordering engine, for comparison with
+    /// LKH or Concorde; or write the random point sets the benchmarks use.
+    Tsp(tsp::TspArgs),
 }
 
 /// Field placement, as on the command line.
@@ -352,6 +356,7 @@ pub fn main() -> std::process::ExitCode {
         Some(Command::Plan(a)) => plan::run(&a),
         Some(Command::Bench(a)) => bench::run(&a),
         Some(Command::HatchBench(a)) => hatch_bench::run(&a),
+        Some(Command::Tsp(a)) => tsp::run(&a),
         None => open_gui(cli.file),
     };
     match result {

@@ -73,10 +73,14 @@ pub fn order_plan(
         && settings.motion == MotionMode::Step
     {
         let t = std::time::Instant::now();
-        let mut best = time_ordering(geometries, fields, profile, settings, ordering, ctx)?;
+        // under HHA a time limit ends the last search (HGA spends it on its generations)
+        let until = (settings.algo == Algo::Hha)
+            .then(|| hha::deadline(settings, t0, hha::LAST_SEARCH_SHARE))
+            .flatten();
+        let mut best = time_ordering(geometries, fields, profile, settings, ordering, until, ctx)?;
         if let Some(seed) = seed_ordering {
             // HGA's own objective is idle travel: on time, its HHA seed may still be faster
-            let other = time_ordering(geometries, fields, profile, settings, seed, ctx)?;
+            let other = time_ordering(geometries, fields, profile, settings, seed, until, ctx)?;
             if other.1.duration_s() < best.1.duration_s() {
                 best = other;
             }
@@ -279,14 +283,22 @@ fn time_ordering(
     profile: &MachineProfile,
     settings: &SolverSettings,
     ordering: Ordering,
+    until: Option<std::time::Instant>,
     ctx: &JobCtx,
 ) -> Result<(Ordering, Toolpath), OrderError> {
     let by_distance = lower_ordering(geometries, fields, profile, settings, &ordering, ctx)?;
-    let refined =
-        match time::refine_for_time(geometries, fields, &ordering, profile, settings.seed, ctx) {
-            Ok(refined) => refined,
-            Err(Cancelled) => return Ok((ordering, by_distance)),
-        };
+    let refined = match time::refine_for_time(
+        geometries,
+        fields,
+        &ordering,
+        profile,
+        settings.seed,
+        until,
+        ctx,
+    ) {
+        Ok(refined) => refined,
+        Err(Cancelled) => return Ok((ordering, by_distance)),
+    };
     let by_time = lower_ordering(geometries, fields, profile, settings, &refined, ctx)?;
     Ok(if by_time.duration_s() <= by_distance.duration_s() {
         (refined, by_time)

@@ -12,7 +12,7 @@
 use super::cost::TravelCost;
 use super::hha::{field_runs, refine_field};
 use super::metrics::idle_mm;
-use super::tsp::{LocalSearch, LsOptions, PathProblem, Tour};
+use super::tsp::{IlsBudget, LocalSearch, LsOptions, PathProblem, Tour};
 use super::vertex::optimal_vertices;
 use super::Ordering;
 use crate::document::{Geometry, MachineProfile, ScanField, Step};
@@ -21,6 +21,7 @@ use crate::job::{Cancelled, JobCtx};
 use crate::motion::StageDynamics;
 use rayon::prelude::*;
 use std::collections::HashMap;
+use std::time::Instant;
 
 /// Fewest iterated-local-search kicks on the field path.
 const STAGE_KICKS_MIN: usize = 32;
@@ -30,13 +31,15 @@ const STAGE_KICKS_MIN: usize = 32;
 /// only to 420.6 s at 5,000 (1.2 s).
 const STAGE_KICKS_MAX: usize = 1000;
 
-/// Improves `ordering` for job time; never makes it slower.
+/// Improves `ordering` for job time; never makes it slower. The per-field searches stop at
+/// `until` (when given) instead of after their default kicks.
 pub fn refine_for_time(
     geometries: &[Geometry],
     fields: &[ScanField],
     ordering: &Ordering,
     profile: &MachineProfile,
     seed: u64,
+    until: Option<Instant>,
     ctx: &JobCtx,
 ) -> Result<Ordering, Cancelled> {
     let runs: Vec<&[Step]> = field_runs(&ordering.steps)
@@ -56,7 +59,7 @@ pub fn refine_for_time(
     let refined: Vec<Result<Vec<Step>, Cancelled>> = visit
         .par_iter()
         .enumerate()
-        .map(|(j, &r)| free_field_path(geometries, runs[r], seed ^ ((j as u64) << 32), ctx))
+        .map(|(j, &r)| free_field_path(geometries, runs[r], seed ^ ((j as u64) << 32), until, ctx))
         .collect();
     let mut steps = Vec::with_capacity(ordering.steps.len());
     for r in refined {
@@ -95,6 +98,7 @@ fn free_field_path(
     geometries: &[Geometry],
     run: &[Step],
     seed: u64,
+    until: Option<Instant>,
     ctx: &JobCtx,
 ) -> Result<Vec<Step>, Cancelled> {
     if run.len() < 2 {
@@ -108,6 +112,7 @@ fn free_field_path(
         Pt::new(1.0, 0.0),
         0.0,
         seed,
+        IlsBudget::until(run.len(), until),
         ctx,
     )?;
     let idle = optimal_vertices(geometries, &mut next, ctx)?;

@@ -20,7 +20,8 @@
 //! alternate while the idle travel falls.
 
 use super::tsp::{
-    cheapest_arc, exact_path, local_search, LocalSearch, LsOptions, Node, PathProblem, Tour,
+    cheapest_arc, exact_path, local_search, space_filling_order, IlsBudget, LocalSearch, LsOptions,
+    Node, PathProblem, Tour,
 };
 use super::vertex::{optimal_vertices, vea};
 use super::{OrderError, Ordering};
@@ -29,15 +30,40 @@ use crate::geom::Pt;
 use crate::job::{Cancelled, JobCtx};
 use crate::order::cost::TravelCost;
 use rayon::prelude::*;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 /// Fields up to this count are ordered exactly.
 pub const EXACT_FIELDS: usize = 12;
 
-/// Iterated-local-search kicks for a path of `m` nodes: two per node, at least 32, at most 1000,
-/// and at most 300,000 / m so that the work (each kick costs O(m)) stays bounded on huge fields.
-pub fn ils_kicks(m: usize) -> usize {
-    (2 * m).clamp(32, 1000).min(300_000 / m.max(1)).max(8)
+/// Fields with more geometries than this start from a Hilbert-curve order instead of the seed's
+/// cheapest arc (quadratic: 0.3 s at 10⁴ geometries) when the local search follows.
+pub const CHEAPEST_ARC_MAX: usize = 2000;
+
+/// Shares of `--time-limit` (from the start of the ordering) at which HHA's per-field searches,
+/// its refinement rounds (when the time objective follows) and the time objective's searches
+/// stop. The last search gets the most: its result is the plan.
+const FIELD_PATHS_SHARE: f64 = 0.25;
+const REFINE_SHARE: f64 = 0.5;
+/// The rest is left for lowering the plan and comparing it.
+pub const LAST_SEARCH_SHARE: f64 = 0.95;
+
+/// Kick budgets of searches whose result a later search of the same nodes improves again (the
+/// per-field paths before the refinement, refinement rounds after the first) are divided by
+/// this: the later search starts from their tour, so their last kicks gain little.
+const PRELIMINARY_KICK_DIVISOR: usize = 8;
+
+/// Most refinement rounds (each: every field's path between its neighbours' ends, then the exact
+/// vertices); they stop earlier once a round gains less than 0.1 %.
+const REFINE_ROUNDS: usize = 6;
+
+/// Refinement rounds when the time objective follows: it searches every field's path again
+/// (free ends, full budget) and keeps the faster plan, so one round gives it its start.
+const REFINE_ROUNDS_BEFORE_TIME: usize = 1;
+
+/// The instant `share` of the settings' time limit after `t0` (none without a limit).
+pub fn deadline(settings: &SolverSettings, t0: Instant, share: f64) -> Option<Instant> {
+    let limit = settings.time_limit_s?;
+    Some(t0 + Duration::from_secs_f64((limit * share).max(0.0)))
 }
 
 fn unit(v: Pt) -> Option<Pt> {
@@ -239,6 +265,7 @@ fn order_field(
     diag: f64,
     improve: bool,
     seed: u64,
+    until: Option<Instant>,
     ctx: &JobCtx,
 ) -> Result<Vec<usize>, Cancelled> {
     let m = members.len();
@@ -254,7 +281,21 @@ fn order_field(
     // line through the field along the sweep direction
     let ab: Vec<f64> = pts.iter().map(|p| p.minus(exit).dot(dir).abs()).collect();
     let arc = |i: usize, j: usize| pts[i].dist(pts[j]) + weight * (diag - ab[j]);
-    let order = cheapest_arc(m, s, (e != s).then_some(e), &arc);
+    let order = if improve && m > CHEAPEST_ARC_MAX {
+        // the start first, the end last, the rest along a Hilbert curve
+        let mut order = vec![s];
+        order.extend(
+            space_filling_order(&pts)
+                .into_iter()
+                .filter(|&k| k != s && k != e),
+        );
+        if e != s {
+            order.push(e);
+        }
+        order
+    } else {
+        cheapest_arc(m, s, (e != s).then_some(e), &arc)
+    };
     let order = if improve {
         let proj: Vec<f64> = pts.iter().map(|p| p.dot(dir)).collect();
         let mut prob = PathProblem::points(&pts, &proj, weight);
@@ -264,12 +305,10 @@ fn order_field(
             order,
             flipped: vec![false; m],
         };
-        LocalSearch::new(&prob, LsOptions::default()).iterated(
-            &mut tour,
-            ils_kicks(m),
-            seed,
-            ctx,
-        )?;
+        // the refinement rounds go on from here: a fraction of the kicks
+        let budget = IlsBudget::until(m, until).divided(PRELIMINARY_KICK_DIVISOR);
+        LocalSearch::new(&prob, LsOptions::default())
+            .iterated_within(&mut tour, budget, seed, ctx)?;
         tour.order
     } else {
         order
@@ -287,6 +326,7 @@ pub(crate) fn refine_field(
     dir: Pt,
     lambda: f64,
     seed: u64,
+    budget: IlsBudget,
     ctx: &JobCtx,
 ) -> Result<Vec<Step>, Cancelled> {
     let mut nodes = Vec::with_capacity(run.len() + 2);
@@ -343,12 +383,7 @@ pub(crate) fn refine_field(
         order: (0..n).collect(),
         flipped,
     };
-    LocalSearch::new(&prob, LsOptions::default()).iterated(
-        &mut tour,
-        ils_kicks(run.len()),
-        seed,
-        ctx,
-    )?;
+    LocalSearch::new(&prob, LsOptions::default()).iterated_within(&mut tour, budget, seed, ctx)?;
     Ok(tour
         .order
         .iter()
@@ -375,6 +410,29 @@ pub fn hha_order(
     stage_s: &mut Vec<(String, f64)>,
 ) -> Result<Ordering, OrderError> {
     let t = Instant::now();
+    // a time limit is HHA's own only when HHA is the algorithm (HGA spends it on generations)
+    let t0 = t;
+    let limited = |share: f64| {
+        (settings.algo == crate::document::Algo::Hha)
+            .then(|| deadline(settings, t0, share))
+            .flatten()
+    };
+    // under the time objective the refinement is preliminary too: the time objective's search
+    // of each field's path comes last and gets the full budget
+    let time_follows = settings.cost_model == crate::document::CostModel::Time;
+    let refine_share = if time_follows {
+        REFINE_SHARE
+    } else {
+        LAST_SEARCH_SHARE
+    };
+    let refine_budget = |m: usize, round: usize, until: Option<Instant>| {
+        let budget = IlsBudget::until(m, until);
+        if round > 0 || time_follows {
+            budget.divided(PRELIMINARY_KICK_DIVISOR)
+        } else {
+            budget
+        }
+    };
     let live: Vec<&ScanField> = fields.iter().filter(|f| !f.geometries.is_empty()).collect();
     let live_owned: Vec<ScanField> = live.iter().map(|f| (*f).clone()).collect();
     let fo = field_order(&live_owned, profile, ctx)?;
@@ -416,6 +474,7 @@ pub fn hha_order(
                 diag,
                 improve,
                 seed,
+                limited(FIELD_PATHS_SHARE),
                 ctx,
             )
         })
@@ -459,7 +518,12 @@ pub fn hha_order(
                     .sum::<f64>()
         };
         let mut best = objective(&steps, super::metrics::idle_mm(geometries, &steps));
-        for round in 0..6 {
+        let rounds = if time_follows {
+            REFINE_ROUNDS_BEFORE_TIME
+        } else {
+            REFINE_ROUNDS
+        };
+        for round in 0..rounds {
             let mut next = steps.clone();
             for parity in 0..2 {
                 let runs = field_runs(&next);
@@ -481,6 +545,7 @@ pub fn hha_order(
                             dirs[j],
                             lambda,
                             seed,
+                            refine_budget(b - a, round, limited(refine_share)),
                             ctx,
                         )
                         .map(|r| (a, r))

@@ -104,6 +104,7 @@ fn eq7_construction_sweeps_towards_the_exit() {
         diag,
         false,
         1,
+        None,
         &JobCtx::default(),
     )
     .unwrap();

@@ -1,4 +1,6 @@
 use super::*;
+use crate::geom::Pt;
+use crate::job::JobCtx;
 use proptest::prelude::*;
 
 fn rnd_points(seed: u64, n: usize) -> Vec<Pt> {
@@ -143,6 +145,29 @@ fn directional_penalty_prefers_a_sweep() {
     );
 }
 
+/// The result of a search: its cost as reported and not above `before`, a permutation, fixed
+/// ends kept, only flippable nodes flipped.
+fn check_result(prob: &PathProblem, t: &Tour, c: f64, before: f64) -> Result<(), TestCaseError> {
+    let n = prob.nodes.len();
+    prop_assert!((c - prob.tour_cost(t)).abs() < 1e-6);
+    prop_assert!(c <= before + 1e-9);
+    let mut s = t.order.clone();
+    s.sort();
+    prop_assert_eq!(s, (0..n).collect::<Vec<_>>());
+    if prob.fixed_first {
+        prop_assert_eq!(t.order[0], 0);
+    }
+    if prob.fixed_last {
+        prop_assert_eq!(t.order[n - 1], n - 1);
+    }
+    for v in 0..n {
+        if !prob.flippable[v] {
+            prop_assert!(!t.flipped[v]);
+        }
+    }
+    Ok(())
+}
+
 proptest! {
     #[test]
     fn local_search_is_consistent(
@@ -163,15 +188,223 @@ proptest! {
         let mut t = Tour { order: (0..n).collect(), flipped: vec![false; n] };
         let before = prob.tour_cost(&t);
         let c = local_search(&prob, &mut t, LsOptions::default(), &JobCtx::default()).unwrap();
-        prop_assert!((c - prob.tour_cost(&t)).abs() < 1e-6);
-        prop_assert!(c <= before + 1e-9);
-        let mut s = t.order.clone();
-        s.sort();
-        prop_assert_eq!(s, (0..n).collect::<Vec<_>>());
-        if fixed_first { prop_assert_eq!(t.order[0], 0); }
-        if fixed_last { prop_assert_eq!(t.order[n - 1], n - 1); }
-        for v in 0..n {
-            if !prob.flippable[v] { prop_assert!(!t.flipped[v]); }
+        check_result(&prob, &t, c, before)?;
+    }
+}
+
+/// The exact optimum over every order and every orientation of the flippable nodes.
+fn brute_force_oriented(prob: &PathProblem) -> f64 {
+    let n = prob.nodes.len();
+    let flippable: Vec<usize> = (0..n).filter(|&v| prob.flippable[v]).collect();
+    let mut best = f64::INFINITY;
+    let mut order: Vec<usize> = (0..n).collect();
+    permute(&mut order, 0, &mut |o| {
+        if (prob.fixed_first && o[0] != 0) || (prob.fixed_last && o[n - 1] != n - 1) {
+            return;
         }
+        for mask in 0..1u32 << flippable.len() {
+            let mut flipped = vec![false; n];
+            for (b, &v) in flippable.iter().enumerate() {
+                flipped[v] = mask >> b & 1 == 1;
+            }
+            let t = Tour {
+                order: o.to_vec(),
+                flipped,
+            };
+            best = best.min(prob.tour_cost(&t));
+        }
+    });
+    best
+}
+
+fn permute(v: &mut Vec<usize>, k: usize, f: &mut dyn FnMut(&[usize])) {
+    if k == v.len() {
+        f(v);
+        return;
+    }
+    for i in k..v.len() {
+        v.swap(k, i);
+        permute(v, k + 1, f);
+        v.swap(k, i);
+    }
+}
+
+/// A small random problem: `n` nodes, every third one an open (flippable) stroke.
+fn small_problem(
+    seed: u64,
+    n: usize,
+    lambda: f64,
+    fixed_first: bool,
+    fixed_last: bool,
+) -> PathProblem {
+    let a = rnd_points(seed, n);
+    let b = rnd_points(seed + 11, n);
+    let nodes: Vec<Node> = (0..n)
+        .map(|i| {
+            if i % 3 == 1 {
+                Node {
+                    s: a[i],
+                    e: a[i].plus(b[i].minus(a[i]).scale(0.2)),
+                    p: a[i].x,
+                }
+            } else {
+                Node::point(a[i], a[i].x)
+            }
+        })
+        .collect();
+    let flippable = nodes.iter().map(|q| q.s != q.e).collect();
+    PathProblem {
+        nodes,
+        lambda,
+        fixed_first,
+        fixed_last,
+        flippable,
+        cluster: Vec::new(),
+        cluster_penalty: 0.0,
+        metric: Default::default(),
+    }
+}
+
+#[test]
+fn iterated_search_finds_the_exact_optimum_on_small_cases() {
+    // golden: brute force over all orders and orientations, with and without fixed ends and
+    // the directional penalty
+    for seed in 0..12u64 {
+        let ends = [(false, false), (true, false), (false, true), (true, true)][seed as usize % 4];
+        let lambda = [0.0, 0.7][seed as usize / 4 % 2];
+        let prob = small_problem(200 + seed, 7, lambda, ends.0, ends.1);
+        let mut t = Tour {
+            order: (0..7).collect(),
+            flipped: vec![false; 7],
+        };
+        let ls = LocalSearch::new(&prob, LsOptions::default());
+        let c = ls.iterated(&mut t, 300, seed, &JobCtx::default()).unwrap();
+        let opt = brute_force_oriented(&prob);
+        assert!(
+            (c - opt).abs() < 1e-9,
+            "seed {seed} ends {ends:?} λ {lambda}: {c} vs optimum {opt}"
+        );
+    }
+}
+
+#[test]
+fn iterated_search_is_deterministic_for_a_seed() {
+    let pts = rnd_points(5, 300);
+    let prob = PathProblem::points(&pts, &[0.0; 300], 0.0);
+    let run = |seed: u64| {
+        let mut t = Tour {
+            order: (0..300).collect(),
+            flipped: vec![false; 300],
+        };
+        LocalSearch::new(&prob, LsOptions::default())
+            .iterated(&mut t, 200, seed, &JobCtx::default())
+            .unwrap();
+        t
+    };
+    assert_eq!(run(3), run(3));
+}
+
+#[test]
+fn a_cancelled_search_returns_an_error_and_a_valid_tour() {
+    let pts = rnd_points(6, 200);
+    let prob = PathProblem::points(&pts, &[0.0; 200], 0.0);
+    let ctx = JobCtx::default();
+    ctx.cancel_token().cancel();
+    let mut t = Tour {
+        order: (0..200).collect(),
+        flipped: vec![false; 200],
+    };
+    let r = LocalSearch::new(&prob, LsOptions::default()).iterated(&mut t, 1_000_000, 1, &ctx);
+    assert!(r.is_err());
+    let mut s = t.order.clone();
+    s.sort();
+    assert_eq!(s, (0..200).collect::<Vec<_>>());
+}
+
+#[test]
+fn a_past_deadline_ends_the_kicks_with_a_local_optimum() {
+    let pts = rnd_points(7, 200);
+    let prob = PathProblem::points(&pts, &[0.0; 200], 0.0);
+    let mut t = Tour {
+        order: (0..200).collect(),
+        flipped: vec![false; 200],
+    };
+    let budget = IlsBudget::until(200, Some(std::time::Instant::now()));
+    let c = LocalSearch::new(&prob, LsOptions::default())
+        .iterated_within(&mut t, budget, 1, &JobCtx::default())
+        .unwrap();
+    assert!((c - prob.tour_cost(&t)).abs() < 1e-6);
+    let mut s = t.order.clone();
+    s.sort();
+    assert_eq!(s, (0..200).collect::<Vec<_>>());
+}
+
+#[test]
+fn open_path_on_a_grid_is_near_the_optimum() {
+    // a 12 × 12 grid of 1 mm spacing: the optimal open path has 143 unit edges
+    let pts: Vec<Pt> = (0..144)
+        .map(|k| Pt::new((k % 12) as f64, (k / 12) as f64))
+        .collect();
+    let order = open_path(&pts, IlsBudget::kicks(500), 1, &JobCtx::default()).unwrap();
+    let mut s = order.clone();
+    s.sort();
+    assert_eq!(s, (0..144).collect::<Vec<_>>());
+    let len: f64 = order.windows(2).map(|w| pts[w[0]].dist(pts[w[1]])).sum();
+    assert!(len < 143.0 * 1.02, "{len} mm for an optimum of 143 mm");
+}
+
+#[test]
+fn hilbert_order_is_a_permutation() {
+    let pts = rnd_points(8, 500);
+    let mut o = space_filling_order(&pts);
+    o.sort();
+    assert_eq!(o, (0..500).collect::<Vec<_>>());
+}
+
+proptest! {
+    #[test]
+    fn ring_reversals_match_a_plain_vector(
+        n in 3usize..40,
+        ops in proptest::collection::vec((0usize..1000, 0usize..1000), 1..60),
+        flip_mask in any::<u64>(),
+    ) {
+        let flippable: Vec<bool> = (0..n).map(|v| flip_mask >> (v % 64) & 1 == 1).collect();
+        let start = Tour { order: (0..n).rev().collect(), flipped: vec![false; n] };
+        let mut ring = super::ring::Ring::new(&start, &flippable);
+        let mut model = start.clone();
+        for (a, b) in ops {
+            let (i, j) = ((a % n).min(b % n), (a % n).max(b % n));
+            ring.reverse(i, j);
+            model.order[i..=j].reverse();
+            for k in i..=j {
+                let v = model.order[k];
+                if flippable[v] {
+                    model.flipped[v] = !model.flipped[v];
+                }
+            }
+            let mut got = start.clone();
+            ring.write(&mut got);
+            prop_assert_eq!(&got, &model);
+            for (k, &v) in model.order.iter().enumerate() {
+                prop_assert_eq!(ring.position(v), k);
+            }
+        }
+    }
+
+    #[test]
+    fn iterated_search_keeps_a_permutation_and_fixed_ends(
+        seed in 0u64..10_000,
+        n in 3usize..60,
+        lambda in 0.0f64..2.0,
+        fixed_first in any::<bool>(),
+        fixed_last in any::<bool>(),
+    ) {
+        let prob = small_problem(seed, n, lambda, fixed_first, fixed_last);
+        let mut t = Tour { order: (0..n).collect(), flipped: vec![false; n] };
+        let before = prob.tour_cost(&t);
+        let c = LocalSearch::new(&prob, LsOptions::default())
+            .iterated(&mut t, 50, seed, &JobCtx::default())
+            .unwrap();
+        check_result(&prob, &t, c, before)?;
     }
 }
