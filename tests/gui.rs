@@ -800,19 +800,6 @@ fn motion_plots_show_an_on_the_fly_plan() {
     assert!(h.query_by_label_contains("Motion plots").is_none());
 }
 
-/// A file dropped on the window, as an integration hands it to egui.
-#[derive(Debug)]
-struct Dropped(PathBuf);
-
-impl egui::DroppedFile for Dropped {
-    fn path(&self) -> &Path {
-        &self.0
-    }
-    fn bytes(&self) -> Result<Vec<u8>, String> {
-        std::fs::read(&self.0).map_err(|e| e.to_string())
-    }
-}
-
 #[test]
 fn the_stage_route_switch_plans_seed001_routes() {
     use galvoplan::document::StageRouteKind;
