@@ -43,8 +43,8 @@ use thiserror::Error;
 /// Share of the scanner's reach kept for smoothing the route by the guaranteed fallback.
 pub const SMOOTHING_SHARE: f64 = 0.5;
 
-/// Share of the reach the tube leaves free: the check allows [`CHECK_SLACK`], the string
-/// touches the tube at its contacts, and the blends cut corners inwards.
+/// Share of the reach the tube leaves free: the string touches the tube at its contacts, and
+/// the check allows only [`CHECK_SLACK`] beyond the reach.
 const TUBE_SLACK: f64 = 2.0 * CHECK_SLACK;
 
 /// How closely the stage follows a seed 001 route (`lsa`, `cetsp-ga`), per axis, mm: the
@@ -368,21 +368,11 @@ fn overshoot_spans(path: &Toolpath, reach_mm: f64, profile: &MachineProfile) -> 
 /// by [`SLOW_FACTOR`] (their corners' speed changes, hence blend widths and departures, shrink
 /// while the time between corners grows).
 fn repair(pieces: &mut [Piece], run: &[Piece], trouble: &[Trouble], reach_mm: f64) {
-    let mut starts = Vec::with_capacity(run.len());
-    let mut t_s = 0.0;
-    for p in run {
-        starts.push(t_s);
-        t_s += p.duration_s;
-    }
+    let starts = piece_starts(run);
     let mut narrow_mm = vec![0.0f64; pieces.len()];
     let mut slow = vec![false; pieces.len()];
     for t in trouble {
-        let (lo, hi) = t.span;
-        let first = starts.partition_point(|&s| s <= lo).saturating_sub(1);
-        for j in first..run.len() {
-            if starts[j] > hi {
-                break;
-            }
+        for j in pieces_under(&starts, t.span) {
             let k = run[j].origin;
             match t.excess_mm {
                 Some(e)
@@ -599,15 +589,20 @@ pub fn nominal_tool_knots(
 fn stroke_parts(path: &Toolpath, stroke: usize) -> Vec<(f64, f64)> {
     let length_mm = path.strokes[stroke].length_mm;
     let mut parts = Vec::new();
-    let mut start = 0.0;
-    for (u, _) in stroke_knots(path, stroke) {
-        if (u - start) * length_mm >= PART_MM {
-            parts.push((start, u));
-            start = u;
+    let mut start_mm = 0.0;
+    for &arc_mm in path.stroke_arc_mm(stroke) {
+        if arc_mm - start_mm >= PART_MM {
+            parts.push((start_mm / length_mm, arc_mm / length_mm));
+            start_mm = arc_mm;
         }
     }
-    if start < 1.0 || parts.is_empty() {
-        parts.push((start, 1.0));
+    if start_mm < length_mm || parts.is_empty() {
+        let start_frac = if length_mm > 0.0 {
+            start_mm / length_mm
+        } else {
+            0.0
+        };
+        parts.push((start_frac, 1.0));
     }
     parts
 }
@@ -635,19 +630,6 @@ fn part_knots(path: &Toolpath, s: usize, start_frac: f64, end_frac: f64) -> Vec<
     out
 }
 
-/// The vertices of stroke `s` with their fraction of its length.
-fn stroke_knots(path: &Toolpath, s: usize) -> Vec<(f64, Pt)> {
-    let length_mm = path.strokes[s].length_mm;
-    path.stroke_arc_mm(s)
-        .iter()
-        .zip(path.stroke_points(s))
-        .map(|(&a, &p)| {
-            let u = if length_mm > 0.0 { a / length_mm } else { 1.0 };
-            (u, p)
-        })
-        .collect()
-}
-
 /// The taut string of each axis through the tube around the tool (each piece's half-width),
 /// clipped to the stage's stroke.
 fn routes(
@@ -669,12 +651,12 @@ fn routes(
     for (k, axis) in ['x', 'y'].into_iter().enumerate() {
         let coord = |p: &Pt| if k == 0 { p.x } else { p.y };
         let stroke_mm = profile.stroke_mm[k];
-        let lower: Vec<f64> = points
+        let mut lower: Vec<f64> = points
             .iter()
             .zip(&tube_mm)
             .map(|(p, h)| (coord(p) - h).max(0.0))
             .collect();
-        let upper: Vec<f64> = points
+        let mut upper: Vec<f64> = points
             .iter()
             .zip(&tube_mm)
             .map(|(p, h)| (coord(p) + h).min(stroke_mm))
@@ -685,7 +667,6 @@ fn routes(
                 axis,
             });
         }
-        let (mut lower, mut upper) = (lower, upper);
         if let Some(targets) = &targets {
             follow_band(&mut lower, &mut upper, targets.iter().map(coord));
         }
@@ -765,6 +746,14 @@ fn piece_starts(pieces: &[Piece]) -> Vec<f64> {
     starts
 }
 
+/// The pieces (starting at `starts`, in time order) that run during `(lo, hi)`: from the one
+/// running at `lo` to the last starting before `hi`.
+fn pieces_under(starts: &[f64], (lo, hi): (f64, f64)) -> std::ops::Range<usize> {
+    let first = starts.partition_point(|&s| s <= lo).saturating_sub(1);
+    let end = starts.partition_point(|&s| s < hi).max(first);
+    first..end
+}
+
 /// Raises `factors` (per piece, starting at `starts`) under every corner of `route` whose
 /// blend at `accel_mm_s2` would depart from it by more than `corner_mm`: a corner's speed
 /// change `Δv` departs by `Δv² / (8 a)` over `|Δv| / a` around it, and slowing the pieces
@@ -791,13 +780,7 @@ fn corner_factors(
         }
         let f = (departure_mm / corner_mm).sqrt() * (1.0 + RETIME_OVERSHOOT);
         let half_s = dv / (2.0 * accel_mm_s2);
-        let first = starts
-            .partition_point(|&s| s <= t_s - half_s)
-            .saturating_sub(1);
-        for j in first..starts.len() {
-            if starts[j] >= t_s + half_s {
-                break;
-            }
+        for j in pieces_under(starts, (t_s - half_s, t_s + half_s)) {
             factors[j] = factors[j].max(f);
         }
     }
@@ -818,11 +801,7 @@ fn stretch_factors(
             if slope <= cap * (1.0 + SPEED_TOLERANCE) {
                 continue;
             }
-            let first = starts.partition_point(|&s| s <= ta).saturating_sub(1);
-            for j in first..pieces.len() {
-                if starts[j] >= tb {
-                    break;
-                }
+            for j in pieces_under(&starts, (ta, tb)) {
                 factors[j] = factors[j].max(slope / cap * (1.0 + RETIME_OVERSHOOT));
             }
         }
