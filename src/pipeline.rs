@@ -2,13 +2,13 @@
 
 use crate::document::{
     pen_of, sync_layers, DerivedKey, Document, Geometry, Layer, MachineProfile, MotionMode, Pen,
-    PenLibrary, Plan, ScanField, SolverSettings, Step,
+    PenLibrary, Plan, ScanField, SolverSettings, StageRouteKind, Step,
 };
 use crate::fields::{place_fields, split_oversize, FieldError, Placement};
 use crate::hatch::{is_hatch_output, layer_geometries, HatchError};
 use crate::import::{import_file, ImportError, ImportOptions};
 use crate::job::JobCtx;
-use crate::motion::{lower_motion, MotionError, Toolpath};
+use crate::motion::{lower_motion, plan_stage_route, MotionError, OtfError, Toolpath};
 use crate::order::{order_plan, OrderError};
 use std::path::Path;
 use std::time::Instant;
@@ -209,9 +209,8 @@ pub fn expand_passes(order: &[Step], geometries: &[Geometry], layers: &[Layer]) 
 
 /// Gives a fresh plan the document's layers (its pens: mark speeds, powers, passes): repeats
 /// strokes for passes, and when a pen changes speed or passes lowers it again and computes its
-/// metrics on that toolpath. A seed 001 stage route (planned on the profile's speeds) is
-/// planned again on the pens' time law.
-fn apply_pens(doc: &Document, plan: &mut Plan, ctx: &JobCtx) -> Result<(), PipelineError> {
+/// metrics on that toolpath.
+fn apply_pens(doc: &Document, plan: &mut Plan) -> Result<(), PipelineError> {
     plan.layers = doc.layers.clone();
     let timed = plan
         .layers
@@ -221,22 +220,50 @@ fn apply_pens(doc: &Document, plan: &mut Plan, ctx: &JobCtx) -> Result<(), Pipel
         return Ok(());
     }
     plan.order = expand_passes(&plan.order, &doc.geometries, &plan.layers);
-    if plan.stage_route.is_some() {
-        let s = &doc.settings;
-        plan.stage_route = crate::motion::plan_stage_route(
-            &doc.geometries,
-            plan,
-            &doc.profile,
-            s.stage_route,
-            &s.route_ga,
-            s.seed,
-            ctx,
-        )
-        .map_err(|e| PipelineError::Lower {
-            file: doc.source.clone().unwrap_or_else(|| "document".into()),
-            source: MotionError::OnTheFly(e),
-        })?;
+    relower(doc, plan)
+}
+
+/// On the fly with seed 001's routes (`lsa`, `cetsp-ga`): plans the stage route on the plan's
+/// final time law (its pens' speeds and passes, hence after [`apply_pens`], so that the GA runs
+/// once), lowers the plan along it and adds the route's planning time to the order stage.
+fn plan_seed_route(doc: &Document, plan: &mut Plan, ctx: &JobCtx) -> Result<(), PipelineError> {
+    let s = &doc.settings;
+    if plan.motion != MotionMode::OnTheFly || s.stage_route == StageRouteKind::Taut {
+        return Ok(());
     }
+    let t = Instant::now();
+    let file = || doc.source.clone().unwrap_or_else(|| "document".into());
+    let route = plan_stage_route(
+        &doc.geometries,
+        plan,
+        &doc.profile,
+        s.stage_route,
+        &s.route_ga,
+        s.seed,
+        ctx,
+    )
+    .map_err(|e| match e {
+        OtfError::Cancelled(c) => PipelineError::Order {
+            file: file(),
+            source: OrderError::Cancelled(c),
+        },
+        other => PipelineError::Lower {
+            file: file(),
+            source: MotionError::OnTheFly(other),
+        },
+    })?;
+    plan.stage_route = route;
+    let route_s = t.elapsed().as_secs_f64();
+    let solve = &mut plan.metrics.solve_s;
+    solve.order += route_s;
+    solve.total += route_s;
+    solve.order_detail.push(("route".into(), route_s));
+    relower(doc, plan)
+}
+
+/// Lowers `plan` again and computes its metrics on that toolpath (keeping its solve times and
+/// field lower bound).
+fn relower(doc: &Document, plan: &mut Plan) -> Result<(), PipelineError> {
     let toolpath = lower_plan(doc, plan)?;
     let m = crate::order::metrics::compute(
         &doc.geometries,
@@ -324,7 +351,8 @@ pub fn order_document(doc: &Document, ctx: &JobCtx) -> Result<Plan, PipelineErro
     )
     .map_err(|source| PipelineError::Order { file, source })?;
     plan.metrics.solve_s.total = plan.metrics.solve_s.order;
-    apply_pens(doc, &mut plan, ctx)?;
+    apply_pens(doc, &mut plan)?;
+    plan_seed_route(doc, &mut plan, ctx)?;
     if let Some(r) = ctx.recorder() {
         r.plan(&plan, &lower_plan(doc, &plan)?);
     }

@@ -19,7 +19,7 @@ use crate::document::{
     SolverSettings, Step,
 };
 use crate::job::{Cancelled, JobCtx};
-use crate::motion::{lower_motion, plan_stage_route, MotionError, OtfError, Toolpath};
+use crate::motion::{lower_motion, MotionError, OtfError, Toolpath};
 use thiserror::Error;
 
 /// Why ordering failed.
@@ -68,7 +68,7 @@ pub fn order_plan(
     } else {
         (ordering, None)
     };
-    let (ordering, toolpath, stage_route) = if settings.cost_model == CostModel::Time
+    let (ordering, toolpath) = if settings.cost_model == CostModel::Time
         && settings.algo != Algo::AsIs
         && settings.motion == MotionMode::Step
     {
@@ -86,31 +86,13 @@ pub fn order_plan(
             }
         }
         detail.push(("time".into(), t.elapsed().as_secs_f64()));
-        (best.0, best.1, None)
+        best
     } else {
-        let t = std::time::Instant::now();
-        let mut plan = plan_of(fields, settings, &ordering);
-        plan.stage_route = plan_stage_route(
-            geometries,
-            &plan,
-            profile,
-            settings.stage_route,
-            &settings.route_ga,
-            settings.seed,
-            ctx,
-        )
-        .map_err(|e| match e {
-            OtfError::Cancelled(c) => OrderError::Cancelled(c),
-            other => OrderError::Lower(MotionError::OnTheFly(other)),
-        })?;
-        if plan.stage_route.is_some() {
-            detail.push(("route".into(), t.elapsed().as_secs_f64()));
-        }
-        let toolpath = match (taut, &plan.stage_route) {
-            (Some(toolpath), None) => toolpath,
-            _ => lower_unless_cancelled(geometries, profile, &plan, ctx)?,
+        let toolpath = match taut {
+            Some(toolpath) => toolpath,
+            None => lower_ordering(geometries, fields, profile, settings, &ordering, ctx)?,
         };
-        (ordering, toolpath, plan.stage_route)
+        (ordering, toolpath)
     };
     let order_s = t0.elapsed().as_secs_f64();
     let plan_fields = fields_in_order(fields, &ordering.field_order);
@@ -131,7 +113,7 @@ pub fn order_plan(
         metrics: m,
         history,
         motion: settings.motion,
-        stage_route,
+        stage_route: None,
         layers: Vec::new(),
     })
 }
