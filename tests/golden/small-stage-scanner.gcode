@@ -1,21 +1,24 @@
 ; galvoplan 0.1.0 — small.svg
-; 6 strokes in 3 fields, marked 261.876 mm, idle 255.282 mm, base 191.390 mm, job time 0.845 s
+; 6 strokes in 3 fields, marked 261.876 mm, idle 206.608 mm, base 191.390 mm, job time 0.845 s
 G21
 G90
 M5
 ; field 2 centre 20 95
 G0 X20 Y95
-G0 U0 V-5
+G0 U10 V5
 M3
-G1 U10 V5 F60000
-G1 U-10 V5
+G1 U-10 V5 F60000
 G1 U0 V-5
+G1 U10 V5
 M5
 ; field 0 centre 45 22.5
 G0 X45 Y22.5
-G0 U35 V12.5
+G0 U-15 V-2.5
 M3
-G1 U15 V7.5 F60000
+G1 U-35 V-2.5 F60000
+G1 U-35 V-12.5
+G1 U-15 V-12.5
+G1 U-15 V-2.5
 M5
 G0 U3.3137 V-2.7915
 M3
@@ -76,12 +79,9 @@ G1 U4.4169 V-2.5336
 G1 U3.8535 V-2.6321
 G1 U3.3137 V-2.7915
 M5
-G0 U-15 V-2.5
+G0 U15 V7.5
 M3
-G1 U-35 V-2.5 F60000
-G1 U-35 V-12.5
-G1 U-15 V-12.5
-G1 U-15 V-2.5
+G1 U35 V12.5 F60000
 M5
 ; field 1 centre 155 55
 G0 X155 Y55

@@ -1,19 +1,22 @@
 ; galvoplan 0.1.0 — small.svg
-; 6 strokes in 3 fields, marked 261.876 mm, idle 255.282 mm, base 191.390 mm, job time 0.845 s
+; 6 strokes in 3 fields, marked 261.876 mm, idle 206.608 mm, base 191.390 mm, job time 0.845 s
 G21
 G90
 M5
 ; field 2 centre 20 95
-G0 X20 Y90
+G0 X30 Y100
 M3
-G1 X30 Y100 F60000
-G1 X10 Y100
+G1 X10 Y100 F60000
 G1 X20 Y90
+G1 X30 Y100
 M5
 ; field 0 centre 45 22.5
-G0 X80 Y35
+G0 X30 Y20
 M3
-G1 X60 Y30 F60000
+G1 X10 Y20 F60000
+G1 X10 Y10
+G1 X30 Y10
+G1 X30 Y20
 M5
 G0 X48.3137 Y19.7085
 M3
@@ -74,12 +77,9 @@ G1 X49.4169 Y19.9664
 G1 X48.8536 Y19.8679
 G1 X48.3137 Y19.7085
 M5
-G0 X30 Y20
+G0 X60 Y30
 M3
-G1 X10 Y20 F60000
-G1 X10 Y10
-G1 X30 Y10
-G1 X30 Y20
+G1 X80 Y35 F60000
 M5
 ; field 1 centre 155 55
 G0 X120 Y20

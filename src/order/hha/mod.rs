@@ -2,7 +2,9 @@
 //!
 //! 1. Fields: an open path over the field centres from the field nearest the work area's top-left
 //!    corner, free end (a virtual end node at zero cost) — exact (Held–Karp) up to 12 fields,
-//!    cheapest arc plus 2-opt/Or-opt beyond.
+//!    cheapest arc plus 2-opt/Or-opt beyond. Beyond the seed, up to 16 fields also try the exact
+//!    path over the gaps between the fields' nearest geometries; both go through steps 2–4 and
+//!    the lower idle is kept.
 //! 2. Per field, a start and an end geometry: nearest the previous / next field's geometries; the
 //!    first field starts with the geometry farthest from where the line to the second field leaves
 //!    it, the last ends with the one farthest from where the line from the previous field enters
@@ -86,7 +88,28 @@ fn exit_point(c: Pt, u: Pt, f: [f64; 2]) -> Pt {
     c.plus(u.scale(tx.min(ty)))
 }
 
-/// Field visiting order (field slots): open path from the field nearest the work area's top-left.
+/// Fields up to this count also try the exact field path over the gaps between the fields'
+/// nearest geometries (see [`field_order_candidates`]): Held–Karp over 15 free fields is
+/// 2¹⁵ · 15² ≈ 7 · 10⁶ steps (tens of ms); beyond it a field path is a sweep over many fields,
+/// where the centre distance decides well.
+pub const GAP_PATH_MAX_FIELDS: usize = 16;
+
+/// The field nearest the work area's top-left corner: where every field path starts.
+fn top_left_field(fields: &[ScanField], profile: &MachineProfile) -> usize {
+    let corner = Pt::new(-profile.field_mm[0] / 2.0, -profile.field_mm[1] / 2.0);
+    (0..fields.len())
+        .min_by(|&a, &b| {
+            fields[a]
+                .center
+                .dist2(corner)
+                .total_cmp(&fields[b].center.dist2(corner))
+                .then(a.cmp(&b))
+        })
+        .unwrap_or(0)
+}
+
+/// Field visiting order (field slots): open path over the field centres from the field nearest
+/// the work area's top-left (seed 000 §3.2.1).
 pub fn field_order(
     fields: &[ScanField],
     profile: &MachineProfile,
@@ -96,16 +119,7 @@ pub fn field_order(
     if n == 0 {
         return Ok(Vec::new());
     }
-    let corner = Pt::new(-profile.field_mm[0] / 2.0, -profile.field_mm[1] / 2.0);
-    let first = (0..n)
-        .min_by(|&a, &b| {
-            fields[a]
-                .center
-                .dist2(corner)
-                .total_cmp(&fields[b].center.dist2(corner))
-                .then(a.cmp(&b))
-        })
-        .unwrap_or(0);
+    let first = top_left_field(fields, profile);
     let c: Vec<Pt> = fields.iter().map(|f| f.center).collect();
     let dist = |i: usize, j: usize| c[i].dist(c[j]);
     if n <= EXACT_FIELDS {
@@ -120,6 +134,42 @@ pub fn field_order(
     };
     local_search(&prob, &mut tour, LsOptions::default(), ctx)?;
     Ok(tour.order)
+}
+
+/// The field paths HHA carries through its per-field stages: the seed's path over the field
+/// centres, and (up to [`GAP_PATH_MAX_FIELDS`] fields, when it differs) the exact path over the
+/// gaps between the fields' nearest geometries. The centre distance is what the
+/// laser jumps when fields are full and even; when they are sparse or uneven (mix-120: 16 fields
+/// of 1–30 geometries), the shortest centre path can cross between fields far from where their
+/// geometries meet, and the gap path follows the geometries instead.
+fn field_order_candidates(
+    fields: &[ScanField],
+    cent: &[Pt],
+    profile: &MachineProfile,
+    ctx: &JobCtx,
+) -> Result<(Vec<usize>, Option<Vec<usize>>), Cancelled> {
+    let by_centre = field_order(fields, profile, ctx)?;
+    let n = fields.len();
+    if !(3..=GAP_PATH_MAX_FIELDS).contains(&n) {
+        return Ok((by_centre, None));
+    }
+    let mut gap = vec![0.0; n * n];
+    for a in 0..n {
+        for b in a + 1..n {
+            let (fa, fb) = (&fields[a], &fields[b]);
+            let (x, y) = closest_pair(&fa.geometries, &fb.geometries, cent, fa.center, fb.center);
+            gap[a * n + b] = cent[x].dist(cent[y]);
+            gap[b * n + a] = gap[a * n + b];
+        }
+    }
+    let by_gap = exact_path(
+        &|i, j| gap[i * n + j],
+        n,
+        top_left_field(fields, profile),
+        None,
+    );
+    let differs = by_gap != by_centre;
+    Ok((by_centre, differs.then_some(by_gap)))
 }
 
 /// The sweep direction of each field in visiting order: towards the next field (the last field:
@@ -400,6 +450,109 @@ pub(crate) fn refine_field(
         .collect())
 }
 
+/// One field path carried through HHA's per-field stages.
+struct Routed<'f> {
+    /// The fields in visiting order.
+    ordered: Vec<&'f ScanField>,
+    /// Each field's sweep direction.
+    dirs: Vec<Pt>,
+    /// The strokes with their start vertices.
+    steps: Vec<Step>,
+    /// Their idle travel, mm.
+    idle_mm: f64,
+    /// Time spent on the per-field paths and on the vertices, s.
+    paths_s: f64,
+    vertices_s: f64,
+}
+
+/// What HHA's per-field stages (seed 000 §3.2.2–3.2.3) share.
+struct Stages<'a> {
+    geometries: &'a [Geometry],
+    cent: &'a [Pt],
+    profile: &'a MachineProfile,
+    settings: &'a SolverSettings,
+    /// When the per-field searches stop (a share of `--time-limit`).
+    until: Option<Instant>,
+}
+
+impl Stages<'_> {
+    /// Eq. 7's direction weight: the settings' for several fields, 0.1 for a lone field.
+    fn weight(&self, single: bool) -> f64 {
+        if single {
+            0.1
+        } else {
+            self.settings.direction_weight
+        }
+    }
+
+    /// Start and end geometries, each field's path (in parallel) and the start vertices of the
+    /// fields in `ordered`.
+    fn route<'f>(
+        &self,
+        ordered: Vec<&'f ScanField>,
+        ctx: &JobCtx,
+    ) -> Result<Routed<'f>, Cancelled> {
+        let (geometries, cent, profile) = (self.geometries, self.cent, self.profile);
+        let t = Instant::now();
+        let centers: Vec<Pt> = ordered.iter().map(|f| f.center).collect();
+        let dirs = sweep_dirs(&centers);
+        let se = start_end(&ordered, cent, profile);
+        let single = ordered.len() == 1;
+        let weight = self.weight(single);
+        let diag = profile.field_mm[0].hypot(profile.field_mm[1]);
+        let improve = self.settings.hha_improve || single;
+        let per_field: Vec<Result<Vec<usize>, Cancelled>> = ordered
+            .par_iter()
+            .enumerate()
+            .map(|(j, f)| {
+                let exit = if single {
+                    cent[se[0].1]
+                } else {
+                    exit_point(f.center, dirs[j], profile.field_mm)
+                };
+                let seed = self.settings.seed ^ ((j as u64) << 32);
+                order_field(
+                    &f.geometries,
+                    se[j].0,
+                    se[j].1,
+                    cent,
+                    exit,
+                    dirs[j],
+                    weight,
+                    diag,
+                    improve,
+                    seed,
+                    self.until,
+                    ctx,
+                )
+            })
+            .collect();
+        let mut steps = Vec::with_capacity(geometries.len());
+        for (j, r) in per_field.into_iter().enumerate() {
+            for g in r? {
+                steps.push(Step::from_choice(g, ordered[j].id, &geometries[g], 0));
+            }
+        }
+        let paths_s = t.elapsed().as_secs_f64();
+        ctx.progress("order", 2, 4, "HHA: vertices");
+        let t = Instant::now();
+        vea(geometries, &mut steps, ctx)?;
+        let idle_mm = if self.settings.vertex == VertexMode::Exact {
+            optimal_vertices(geometries, &mut steps, ctx)?
+        } else {
+            super::metrics::idle_mm(geometries, &steps)
+        };
+        Ok(Routed {
+            ordered,
+            dirs,
+            steps,
+            idle_mm,
+            paths_s,
+            vertices_s: t.elapsed().as_secs_f64(),
+        })
+    }
+}
+
 /// Runs HHA on allocated fields. `stage_s` receives the time of each sub-stage.
 pub fn hha_order(
     geometries: &[Geometry],
@@ -435,66 +588,41 @@ pub fn hha_order(
     };
     let live: Vec<&ScanField> = fields.iter().filter(|f| !f.geometries.is_empty()).collect();
     let live_owned: Vec<ScanField> = live.iter().map(|f| (*f).clone()).collect();
-    let fo = field_order(&live_owned, profile, ctx)?;
-    let ordered: Vec<&ScanField> = fo.iter().map(|&k| live[k]).collect();
+    let cent: Vec<Pt> = geometries.iter().map(Geometry::centroid).collect();
+    let (by_centre, by_gap) = field_order_candidates(&live_owned, &cent, profile, ctx)?;
     stage_s.push(("field_order".into(), t.elapsed().as_secs_f64()));
     ctx.progress("order", 1, 4, "HHA: field order");
 
-    let t = Instant::now();
-    let cent: Vec<Pt> = geometries.iter().map(Geometry::centroid).collect();
-    let centers: Vec<Pt> = ordered.iter().map(|f| f.center).collect();
-    let dirs = sweep_dirs(&centers);
-    let se = start_end(&ordered, &cent, profile);
-    let single = ordered.len() == 1;
-    let weight = if single {
-        0.1
-    } else {
-        settings.direction_weight
+    // every candidate field path through the per-field paths and vertices; the lowest idle wins
+    let stages = Stages {
+        geometries,
+        cent: &cent,
+        profile,
+        settings,
+        until: limited(FIELD_PATHS_SHARE),
     };
-    let diag = profile.field_mm[0].hypot(profile.field_mm[1]);
-    let improve = settings.hha_improve || single;
-    let per_field: Vec<Result<Vec<usize>, Cancelled>> = ordered
-        .par_iter()
-        .enumerate()
-        .map(|(j, f)| {
-            let (exit, dir) = if single {
-                (cent[se[0].1], dirs[0])
-            } else {
-                (exit_point(f.center, dirs[j], profile.field_mm), dirs[j])
-            };
-            let seed = settings.seed ^ ((j as u64) << 32);
-            order_field(
-                &f.geometries,
-                se[j].0,
-                se[j].1,
-                &cent,
-                exit,
-                dir,
-                weight,
-                diag,
-                improve,
-                seed,
-                limited(FIELD_PATHS_SHARE),
-                ctx,
-            )
-        })
-        .collect();
-    let mut steps = Vec::with_capacity(geometries.len());
-    for (j, r) in per_field.into_iter().enumerate() {
-        for g in r? {
-            steps.push(Step::from_choice(g, ordered[j].id, &geometries[g], 0));
+    let slots = |fo: &[usize]| -> Vec<&ScanField> { fo.iter().map(|&k| live[k]).collect() };
+    let mut best = stages.route(slots(&by_centre), ctx)?;
+    let (mut paths_s, mut vertices_s) = (best.paths_s, best.vertices_s);
+    if let Some(fo) = by_gap {
+        let routed = stages.route(slots(&fo), ctx)?;
+        paths_s += routed.paths_s;
+        vertices_s += routed.vertices_s;
+        if routed.idle_mm < best.idle_mm - 1e-9 {
+            best = routed;
         }
     }
-    stage_s.push(("field_paths".into(), t.elapsed().as_secs_f64()));
-    ctx.progress("order", 2, 4, "HHA: vertices");
-
-    let t = Instant::now();
-    vea(geometries, &mut steps, ctx)?;
-    if settings.vertex == VertexMode::Exact {
-        optimal_vertices(geometries, &mut steps, ctx)?;
-    }
-    stage_s.push(("vertices".into(), t.elapsed().as_secs_f64()));
+    stage_s.push(("field_paths".into(), paths_s));
+    stage_s.push(("vertices".into(), vertices_s));
+    let Routed {
+        ordered,
+        dirs,
+        mut steps,
+        ..
+    } = best;
     ctx.progress("order", 3, 4, "HHA: refine");
+    let single = ordered.len() == 1;
+    let weight = stages.weight(single);
 
     if settings.hha_improve {
         let t = Instant::now();

@@ -148,3 +148,72 @@ fn hha_orders_every_geometry_once_field_by_field() {
     assert!(detail.iter().any(|(n, _)| n == "vertices"));
     let _ = Source::default();
 }
+
+/// Three fields whose geometries meet away from the shortest centre path: A (top left) holds
+/// two squares at its bottom edge, C (below A) two at its top edge, B (right of A) two at its
+/// bottom-left corner. The centre path A → B → C (70 + 106 mm) is shorter than A → C → B
+/// (80 + 106 mm), but the geometries are 20 mm apart from A to C and 22 mm from C to B against
+/// 40 mm from A to B, so the laser travels less on A → C → B.
+fn fields_meeting_off_the_centre_path() -> (Vec<Geometry>, Vec<ScanField>) {
+    let at = [
+        (30.0, 64.0),
+        (40.0, 64.0),
+        (75.0, 60.0),
+        (80.0, 64.0),
+        (35.0, 85.0),
+        (65.0, 85.0),
+    ];
+    let gs = at.iter().map(|&(x, y)| rect(x, y, 1.0, 1.0)).collect();
+    let fields = vec![
+        field(0, 35.0, 35.0, vec![0, 1]),
+        field(1, 105.0, 35.0, vec![2, 3]),
+        field(2, 35.0, 115.0, vec![4, 5]),
+    ];
+    (gs, fields)
+}
+
+#[test]
+fn the_gap_path_wins_where_the_geometries_meet_off_the_centre_path() {
+    let (gs, fields) = fields_meeting_off_the_centre_path();
+    let (p, settings, ctx) = (
+        MachineProfile::default(),
+        SolverSettings::default(),
+        JobCtx::default(),
+    );
+    let cent: Vec<Pt> = gs.iter().map(Geometry::centroid).collect();
+    let (by_centre, by_gap) = field_order_candidates(&fields, &cent, &p, &ctx).unwrap();
+    assert_eq!(by_centre, vec![0, 1, 2]);
+    assert_eq!(by_gap, Some(vec![0, 2, 1]));
+    let stages = Stages {
+        geometries: &gs,
+        cent: &cent,
+        profile: &p,
+        settings: &settings,
+        until: None,
+    };
+    let centre_only = stages.route(fields.iter().collect(), &ctx).unwrap();
+    let o = hha_order(&gs, &fields, &p, &settings, &ctx, &mut Vec::new()).unwrap();
+    assert_eq!(o.field_order, vec![0, 2, 1]);
+    let idle = crate::order::metrics::idle_mm(&gs, &o.steps);
+    assert!(
+        idle < centre_only.idle_mm - 10.0,
+        "{idle} vs the centre path's {}",
+        centre_only.idle_mm
+    );
+}
+
+#[test]
+fn many_fields_try_only_the_centre_path() {
+    let fields: Vec<ScanField> = (0..GAP_PATH_MAX_FIELDS + 1)
+        .map(|k| field(k, 70.0 * k as f64, 35.0, vec![k]))
+        .collect();
+    let gs: Vec<Geometry> = fields
+        .iter()
+        .map(|f| rect(f.center.x, f.center.y, 1.0, 1.0))
+        .collect();
+    let cent: Vec<Pt> = gs.iter().map(Geometry::centroid).collect();
+    let ctx = JobCtx::default();
+    let (_, by_gap) =
+        field_order_candidates(&fields, &cent, &MachineProfile::default(), &ctx).unwrap();
+    assert_eq!(by_gap, None);
+}
