@@ -6,7 +6,7 @@
 //! machine as on one with more fonts installed.
 
 use super::{FontSource, Warning};
-use std::sync::{Arc, Mutex, OnceLock};
+use std::sync::{Arc, Mutex, OnceLock, PoisonError};
 use usvg::fontdb::{self, Database, Family, Query, Source};
 use usvg::{FontResolver, FontStretch, FontStyle};
 
@@ -100,19 +100,16 @@ pub struct Misses(Mutex<Vec<FontMiss>>);
 
 impl Misses {
     fn push(&self, m: FontMiss) {
-        // a poisoned lock means a panic elsewhere, which already fails the import
-        if let Ok(mut v) = self.0.lock() {
-            if !v.contains(&m) {
-                v.push(m);
-            }
+        // a lock is poisoned only by a panic while it was held; the list is whole (a push)
+        let mut v = self.0.lock().unwrap_or_else(PoisonError::into_inner);
+        if !v.contains(&m) {
+            v.push(m);
         }
     }
     /// The misses recorded so far.
     pub fn take(&self) -> Vec<FontMiss> {
-        self.0
-            .lock()
-            .map(|mut v| std::mem::take(&mut *v))
-            .unwrap_or_default()
+        let mut v = self.0.lock().unwrap_or_else(PoisonError::into_inner);
+        std::mem::take(&mut *v)
     }
 }
 
