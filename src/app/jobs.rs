@@ -2,6 +2,7 @@
 //! a named thread; the GUI polls the result each frame and never blocks on the worker.
 
 use super::files::{ExportKind, Opened};
+use super::toolpaths::Prelowered;
 use crate::document::{Algo, Document, Plan};
 use crate::job::{CancelToken, JobCtx, Progress, ProgressSink};
 use crate::pipeline::order_document;
@@ -40,8 +41,15 @@ pub fn solver_threads() -> usize {
 
 /// What a finished job made.
 pub enum JobResult {
-    /// A plan (for HGA possibly the best one found before a cancel).
-    Plan(Box<Plan>),
+    /// A plan (for HGA possibly the best one found before a cancel) and its toolpath, lowered
+    /// on the job's thread so that the window does not wait for it (on the fly: seconds on
+    /// large jobs).
+    Plan {
+        /// The plan.
+        plan: Box<Plan>,
+        /// Its lowering.
+        lowered: Box<Prelowered>,
+    },
     /// A file opened (imported SVG with fields placed, or a project).
     Opened {
         /// The file.
@@ -154,9 +162,13 @@ impl Job {
         let thread = format!("solve-{}", algo.label());
         let limit = doc.settings.time_limit_s;
         Job::spawn(name, &thread, limit, repaint, move |ctx| {
-            order_document(&snapshot, ctx)
-                .map(|p| JobResult::Plan(Box::new(p)))
-                .map_err(|e| e.to_string())
+            let plan = order_document(&snapshot, ctx).map_err(|e| e.to_string())?;
+            ctx.progress("lower", 0, 1, "lowering the plan to a toolpath");
+            let lowered = Box::new(Prelowered::of(&snapshot, &plan));
+            Ok(JobResult::Plan {
+                plan: Box::new(plan),
+                lowered,
+            })
         })
     }
 

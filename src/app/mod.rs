@@ -771,12 +771,13 @@ impl App {
                 let what = kind.filter().0;
                 self.set_status(format!("wrote the {what} to {}", path.display()), false);
             }
-            JobOutcome::Done(JobResult::Plan(mut plan)) => {
+            JobOutcome::Done(JobResult::Plan { mut plan, lowered }) => {
                 plan.name = if cancelled {
                     format!("{name} (stopped)")
                 } else {
                     name
                 };
+                let lowered = lowered.renamed(&plan.name);
                 let m = &plan.metrics;
                 let job = m.job_time_s.map_or("job time unknown".to_string(), |t| {
                     format!("job time {t:.2} s")
@@ -795,8 +796,9 @@ impl App {
                 );
                 self.doc.plans.push(*plan);
                 self.changed();
-                self.toolpaths.sync(&self.doc);
                 let k = self.doc.plans.len() - 1;
+                self.toolpaths.adopt(k, lowered);
+                self.toolpaths.sync(&self.doc);
                 self.active = Some(k);
                 self.compare.push(k);
                 match self.toolpaths.get(k) {

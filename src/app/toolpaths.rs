@@ -107,6 +107,34 @@ struct Entry {
     result: Result<Arc<Lowered>, String>,
 }
 
+/// Lowers `plan` of `doc` and indexes it (or says in words why it cannot be lowered).
+fn lower(doc: &Document, plan: &Plan) -> Result<Arc<Lowered>, String> {
+    lower_plan(doc, plan)
+        .map(|t| Arc::new(Lowered::new(t)))
+        .map_err(|e| format!("cannot lower {} to a toolpath: {e}", plan.name))
+}
+
+/// A plan lowered by a background job on the document it was solved on, for
+/// [`ToolpathCache::adopt`]: the UI thread then need not lower it again.
+#[derive(Debug, Clone)]
+pub struct Prelowered(Entry);
+
+impl Prelowered {
+    /// Lowers `plan` of `doc` (on the job's thread).
+    pub fn of(doc: &Document, plan: &Plan) -> Self {
+        Self(Entry {
+            key: Key::of(doc, plan),
+            result: lower(doc, plan),
+        })
+    }
+
+    /// The plan was renamed after its job (e.g. "(stopped)"): the key follows.
+    pub fn renamed(mut self, name: &str) -> Self {
+        self.0.key.name = name.to_string();
+        self
+    }
+}
+
 /// The toolpaths of a document's plans, by plan index.
 #[derive(Debug, Clone, Default)]
 pub struct ToolpathCache {
@@ -124,18 +152,31 @@ impl ToolpathCache {
             if self.entries.get(k).is_some_and(|e| e.key == key) {
                 continue;
             }
-            let result = lower_plan(doc, plan)
-                .map(|t| Arc::new(Lowered::new(t)))
-                .map_err(|e| format!("cannot lower {} to a toolpath: {e}", plan.name));
-            let entry = Entry { key, result };
-            if k < self.entries.len() {
-                self.entries[k] = entry;
-            } else {
-                self.entries.push(entry);
-            }
+            let entry = Entry {
+                key,
+                result: lower(doc, plan),
+            };
+            self.put(k, entry);
             lowered += 1;
         }
         lowered
+    }
+
+    /// Takes the lowering a job made of plan `k` (which must already be in the document); a
+    /// following [`sync`](Self::sync) lowers it again only if the document changed meanwhile.
+    pub fn adopt(&mut self, k: usize, lowered: Prelowered) {
+        self.put(k, lowered.0);
+    }
+
+    /// Puts `entry` at plan index `k`. The entries are dense: when plans before `k` have none
+    /// yet, the entry is not kept and the next sync lowers plan `k` itself (same result, on the
+    /// UI thread).
+    fn put(&mut self, k: usize, entry: Entry) {
+        if k < self.entries.len() {
+            self.entries[k] = entry;
+        } else if k == self.entries.len() {
+            self.entries.push(entry);
+        }
     }
 
     /// Plan `k`'s toolpath, or the lowering error in words (`None`: no such plan, or not yet
@@ -227,5 +268,27 @@ mod tests {
         cache.sync(&doc);
         let e = cache.get(0).unwrap().unwrap_err();
         assert!(e.starts_with("cannot lower P to a toolpath:"), "{e}");
+    }
+
+    #[test]
+    fn a_job_lowering_is_adopted_and_redone_only_if_the_document_changed() {
+        let mut doc = doc_with_plan(false);
+        let job_doc = doc.clone();
+        let lowered = Prelowered::of(&job_doc, &job_doc.plans[0]).renamed("P (stopped)");
+        doc.plans[0].name = "P (stopped)".into();
+        let mut cache = ToolpathCache::default();
+        cache.adopt(0, lowered.clone());
+        assert_eq!(cache.sync(&doc), 0, "the job's lowering is taken as it is");
+        assert_eq!(cache.get(0).unwrap().unwrap().toolpath.strokes.len(), 1);
+        // the profile changed while the job ran: the job's lowering is stale
+        let mut cache = ToolpathCache::default();
+        doc.profile.scanner.mark_speed_mm_s *= 2.0;
+        cache.adopt(0, lowered.clone());
+        assert_eq!(cache.sync(&doc), 1);
+        // a plan index past the lowered ones is not kept: sync lowers it itself
+        let mut cache = ToolpathCache::default();
+        doc.plans.push(doc.plans[0].clone());
+        cache.adopt(1, lowered);
+        assert_eq!(cache.sync(&doc), 2);
     }
 }
