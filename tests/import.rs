@@ -222,3 +222,38 @@ fn bad_files_name_the_file_and_the_problem() {
         assert!(!e.to_string().contains('\n'));
     }
 }
+
+/// Arc radii of 10⁴⁰–10¹¹⁷ made usvg loop for minutes and use gigabytes (found by fuzzing,
+/// docs/FUZZING.md): such a file is refused before usvg sees it, naming the element and line.
+#[test]
+fn absurd_arc_radii_are_refused_before_usvg() {
+    for radius in ["1e40", "7e117", "-1e80", "1e10"] {
+        let text = svg(&format!(
+            "<path id=\"a\" d=\"M 40 240 A{radius} 15 10 0 0 1 70\"/>"
+        ));
+        let t0 = std::time::Instant::now();
+        let e = import_svg(text.as_bytes(), "t.svg", &ImportOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("<path id=\"a\"") && e.contains("arc radius"),
+            "{e}"
+        );
+        assert!(!e.contains('\n'), "{e}");
+        assert!(t0.elapsed().as_secs_f64() < 1.0);
+    }
+    // a large but real radius still imports (a nearly straight arc)
+    let text = svg("<path d=\"M 10 10 A 1e6 1e6 0 0 1 60 10\"/>");
+    assert_eq!(import(&text).geometries.len(), 1);
+    // the fuzzer's file itself
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/svg/fuzz/oom-huge-arc-radius.svg");
+    let e = import_svg(
+        &std::fs::read(path).unwrap(),
+        "f.svg",
+        &ImportOptions::default(),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("arc radius"), "{e}");
+}

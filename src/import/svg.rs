@@ -81,6 +81,7 @@ pub fn import_svg(bytes: &[u8], file: &str, opts: &ImportOptions) -> Result<Impo
             root.tag_name().name()
         )));
     }
+    check_arc_radii(&xml).map_err(malformed)?;
     let mut warnings = unsupported_content(&xml);
     let (geometries, page_mm, font_warnings) =
         tree_geometries(&xml, opts, opts.chord_tol_mm, MAX_POINTS).map_err(|e| match e {
@@ -210,6 +211,36 @@ fn describe(node: &roxmltree::Node) -> String {
     }
 }
 
+/// Largest arc radius in path data, in user units (10⁹: 1,000 km in mm, 264 km in px). usvg
+/// turns arcs into curves in `f32`, where radii past ~10³⁸ become infinite, and a radius of
+/// 10⁴⁰–10¹¹⁷ made it loop for minutes and use gigabytes (found by fuzzing); anything past this
+/// bound is not artwork, so the file is refused before usvg sees it.
+pub const ARC_RADIUS_MAX: f64 = 1e9;
+
+/// Refuses path data whose arcs have radii beyond [`ARC_RADIUS_MAX`] (or not finite), naming the
+/// element and its line. Path data that does not parse is left to usvg (which keeps the part
+/// before the error, as the SVG specification asks).
+fn check_arc_radii(xml: &roxmltree::Document) -> Result<(), String> {
+    for node in xml.descendants().filter(|n| n.is_element()) {
+        let Some(d) = node.attribute("d") else {
+            continue;
+        };
+        for segment in svgtypes::PathParser::from(d) {
+            let Ok(svgtypes::PathSegment::EllipticalArc { rx, ry, .. }) = segment else {
+                continue;
+            };
+            let worst = rx.abs().max(ry.abs());
+            if worst.is_nan() || worst > ARC_RADIUS_MAX {
+                let line = xml.text_pos_at(node.range().start).row;
+                return Err(format!(
+                    "{} (line {line}): an arc radius of {worst:e} user units is beyond {ARC_RADIUS_MAX:e}",
+                    describe(&node)
+                ));
+            }
+        }
+    }
+    Ok(())
+}
 fn unsupported_content(xml: &roxmltree::Document) -> Vec<Warning> {
     let mut out = Vec::new();
     let mut stack = vec![xml.root_element()];
