@@ -491,6 +491,35 @@ fn oversize_geometries_are_shown_uncovered_until_split() {
 }
 
 #[test]
+fn switching_to_on_the_fly_places_fields_for_what_was_uncovered() {
+    let path = common::root().join("assets/examples/oversize.svg");
+    let mut h = opened(&path);
+    let n = h.state().doc.geometries.len();
+    assert_eq!(h.state().uncovered().len(), n);
+    section(&mut h, "Solver settings");
+    h.get_by_label("Motion").click();
+    h.run();
+    // the switch starts a background placement: step, not run (the progress bar repaints)
+    h.get_by_label("On the fly (stage moves while marking)").click();
+    h.step();
+    wait_idle(&mut h, Duration::from_secs(60));
+    // no "Re-place automatically" press needed: only what is beyond the stage's reach stays
+    let left = h.state().uncovered().len();
+    assert!(left < n, "{left} of {n} still uncovered");
+    assert!(
+        h.state()
+            .uncovered()
+            .iter()
+            .all(|g| h.state().out_of_reach().contains(g)),
+        "{}",
+        h.state().status()
+    );
+    assert!(!h.state().doc.fields.is_empty());
+    // counts read as words: "1 geometry", not "1 geometries"
+    assert!(h.query_by_label_contains("1 geometries").is_none());
+}
+
+#[test]
 fn import_warnings_are_listed() {
     let dir = tempfile::tempdir().unwrap();
     let svg = dir.path().join("w.svg");

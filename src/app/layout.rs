@@ -346,7 +346,13 @@ impl App {
             Section::Layers => self.layers_ui(ui),
             Section::Settings => {
                 if let Some(cmd) = self.editors.settings_ui(ui, &self.doc.settings) {
-                    let _ = self.execute(cmd);
+                    let motion = self.doc.settings.motion;
+                    let changed = self.execute(cmd).is_ok() && self.doc.settings.motion != motion;
+                    // on the fly holds what no scan field could (and back): fields placed for
+                    // the other motion that leave geometries uncovered are placed again at once
+                    if changed && !self.uncovered.is_empty() && !self.is_busy() {
+                        self.replace_fields(ui.ctx());
+                    }
                 }
             }
             Section::Profile => {
@@ -378,10 +384,10 @@ impl App {
         if self.has_document() {
             let closed = self.doc.geometries.iter().filter(|g| g.closed).count();
             ui.label(format!(
-                "{} geometries ({closed} closed, {} open), {} fields",
-                self.doc.geometries.len(),
+                "{} ({closed} closed, {} open), {}",
+                super::count(self.doc.geometries.len(), "geometry", "geometries"),
                 self.doc.geometries.len() - closed,
-                self.doc.fields.len()
+                super::count(self.doc.fields.len(), "field", "fields")
             ));
             let far = self.out_of_reach.len();
             let near = self.uncovered.len() - far;
@@ -389,11 +395,14 @@ impl App {
                 ui.add(
                     egui::Label::new(
                         RichText::new(format!(
-                    "{far} geometries (dashed purple) cannot be held by any scan field: they are \
-                     larger than a field or lie beyond the stage's stroke plus half a field. Tick \
+                            "{} (dashed purple) cannot be held by any scan field: {} \
+                     larger than a field or {} beyond the stage's stroke plus half a field. Tick \
                      \"Split oversize geometries\" in Solver settings and press \"Re-place \
-                     automatically\", or choose \"On the fly\" as the motion."
-                ))
+                     automatically\", or choose \"On the fly\" as the motion.",
+                            super::count(far, "geometry", "geometries"),
+                            if far == 1 { "it is" } else { "they are" },
+                            if far == 1 { "lies" } else { "lie" }
+                        ))
                         .color(colour::OUT_OF_REACH),
                     )
                     .wrap(),
@@ -403,9 +412,11 @@ impl App {
                 ui.add(
                     egui::Label::new(
                         RichText::new(format!(
-                    "{near} geometries (red) are not covered by a scan field yet: add a field \
-                     (Add field) or press \"Re-place automatically\"."
-                ))
+                            "{} (red) {} not covered by a scan field yet: add a field \
+                     (Add field) or press \"Re-place automatically\".",
+                            super::count(near, "geometry", "geometries"),
+                            if near == 1 { "is" } else { "are" }
+                        ))
                         .color(ERROR),
                     )
                     .wrap(),

@@ -388,11 +388,11 @@ impl App {
         self.changed();
         self.saved_revision = self.revision;
         let msg = format!(
-            "{}: {} geometries on {} layers, {} scan fields, {} import warnings",
+            "{}: {} on {}, {}, {}",
             path.display(),
-            self.doc.geometries.len(),
-            self.doc.layers.len(),
-            self.doc.fields.len(),
+            count(self.doc.geometries.len(), "geometry", "geometries"),
+            count(self.doc.layers.len(), "layer", "layers"),
+            count(self.doc.fields.len(), "scan field", "scan fields"),
             self.doc.warnings.len()
         );
         match o.problem {
@@ -539,7 +539,10 @@ impl App {
             Ok(o) => {
                 if group.is_none() {
                     self.set_status(
-                        format!("{what}: {} geometries uncovered", o.uncovered.len()),
+                        format!(
+                            "{what}: {} uncovered",
+                            count(o.uncovered.len(), "geometry", "geometries")
+                        ),
                         false,
                     );
                 }
@@ -705,10 +708,10 @@ impl App {
         } else if !self.has_document() {
             Some("no document open".into())
         } else if !self.uncovered.is_empty() {
-            Some(format!(
-                "{} geometries are not covered by a scan field",
-                self.uncovered.len()
-            ))
+            Some(match self.uncovered.len() {
+                1 => "1 geometry is not covered by a scan field".to_string(),
+                n => format!("{n} geometries are not covered by a scan field"),
+            })
         } else {
             None
         }
@@ -979,6 +982,11 @@ fn can_be_covered(g: &crate::document::Geometry, profile: &MachineProfile) -> bo
 
 /// A library message in the GUI's words: command-line flags become the controls that do the
 /// same.
+/// `n` and the noun for it: "1 geometry", "3 geometries".
+pub fn count(n: usize, one: &str, many: &str) -> String {
+    format!("{n} {}", if n == 1 { one } else { many })
+}
+
 pub fn gui_words(msg: &str) -> String {
     msg.replace(
         "use --split-oversize to cut them at field borders",

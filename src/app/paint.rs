@@ -404,7 +404,10 @@ fn paint_caption(painter: &Painter, c: &Canvas<'_>, rect: Rect) {
     }
     if !c.uncovered.is_empty() {
         line(
-            format!("{} geometries not covered by a field", c.uncovered.len()),
+            format!(
+                "{} not covered by a field",
+                super::count(c.uncovered.len(), "geometry", "geometries")
+            ),
             colour::UNCOVERED,
         );
     }
