@@ -19,6 +19,14 @@ fn demo() -> PathBuf {
     common::root().join("assets/examples/demo.svg")
 }
 
+/// `assets/examples/oversize.svg` opened (no fields could be placed: every geometry is
+/// uncovered) and its geometry count.
+fn opened_oversize() -> (Harness<'static, App>, usize) {
+    let h = opened(&common::root().join("assets/examples/oversize.svg"));
+    let n = h.state().doc.geometries.len();
+    (h, n)
+}
+
 fn harness(app: App) -> Harness<'static, App> {
     Harness::builder()
         .with_size(Vec2::new(1500.0, 950.0))
@@ -452,9 +460,7 @@ fn project_round_trip_and_drag_and_drop() {
 
 #[test]
 fn oversize_geometries_are_shown_uncovered_until_split() {
-    let path = common::root().join("assets/examples/oversize.svg");
-    let mut h = opened(&path);
-    let n = h.state().doc.geometries.len();
+    let (mut h, n) = opened_oversize();
     // fields could not be placed: the document is open, every geometry is uncovered (red)
     assert_eq!(h.state().uncovered().len(), n);
     assert!(
@@ -492,15 +498,14 @@ fn oversize_geometries_are_shown_uncovered_until_split() {
 
 #[test]
 fn switching_to_on_the_fly_places_fields_for_what_was_uncovered() {
-    let path = common::root().join("assets/examples/oversize.svg");
-    let mut h = opened(&path);
-    let n = h.state().doc.geometries.len();
+    let (mut h, n) = opened_oversize();
     assert_eq!(h.state().uncovered().len(), n);
     section(&mut h, "Solver settings");
     h.get_by_label("Motion").click();
     h.run();
     // the switch starts a background placement: step, not run (the progress bar repaints)
-    h.get_by_label("On the fly (stage moves while marking)").click();
+    h.get_by_label("On the fly (stage moves while marking)")
+        .click();
     h.step();
     wait_idle(&mut h, Duration::from_secs(60));
     // no "Re-place automatically" press needed: only what is beyond the stage's reach stays

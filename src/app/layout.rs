@@ -280,8 +280,8 @@ impl App {
                 if self.has_document() {
                     let u = self.uncovered.len();
                     let t = RichText::new(format!(
-                        "{} fields · {} uncovered",
-                        self.doc.fields.len(),
+                        "{} · {} uncovered",
+                        super::count(self.doc.fields.len(), "field", "fields"),
                         u
                     ));
                     ui.label(if u > 0 { t.color(ERROR) } else { t });

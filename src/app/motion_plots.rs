@@ -190,14 +190,15 @@ fn speed_plot(
         profile.axis_y.max_velocity_mm_s,
     );
     ui.label(format!(
-        "Stage speed, mm/s: peak {:.0}, axis limit {:.0}",
+        "Stage speed, mm/s: peak {:.0} (each axis at most {:.0}, both together {:.0})",
         s.peak_speed_mm_s(),
-        vx.max(vy)
+        vx.max(vy),
+        vx.hypot(vy)
     ))
     .on_hover_text(
         "How fast the stage travels along its route (both axes together). Each axis stays \
-         within its own limit, so the combined speed may exceed the red line by up to 1.41 times \
-         on a diagonal.",
+         within its own limit (dashed), so on a diagonal the combined speed may reach the dotted \
+         line.",
     );
     Plot::new("otf-speed")
         .height(height_px)
@@ -209,9 +210,14 @@ fn speed_plot(
         .show(ui, |pui| {
             pui.line(Line::new("stage speed", s.curve(&s.stage_speed_mm_s)).color(ROUTE));
             pui.hline(
-                HLine::new("axis max velocity", vx.max(vy))
+                HLine::new("one axis at its limit", vx.max(vy))
                     .color(LIMIT)
                     .style(LineStyle::dashed_loose()),
+            );
+            pui.hline(
+                HLine::new("both axes at their limits", vx.hypot(vy))
+                    .color(LIMIT)
+                    .style(LineStyle::dotted_loose()),
             );
             if let Some(t) = t_s {
                 pui.vline(VLine::new("playback t", t).color(NOW).width(2.0));
