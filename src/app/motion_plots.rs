@@ -190,7 +190,7 @@ fn speed_plot(
         profile.axis_y.max_velocity_mm_s,
     );
     ui.label(format!(
-        "Stage speed, mm/s: peak {:.0} (each axis at most {:.0}, both together {:.0})",
+        "Stage speed, mm/s: peak {:.0}, limit {:.0} an axis, {:.0} both",
         s.peak_speed_mm_s(),
         vx.max(vy),
         vx.hypot(vy)
