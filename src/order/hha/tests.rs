@@ -104,7 +104,7 @@ fn eq7_construction_sweeps_towards_the_exit() {
         diag,
         false,
         1,
-        None,
+        IlsBudget::kicks(0),
         &JobCtx::default(),
     )
     .unwrap();
@@ -190,6 +190,7 @@ fn the_gap_path_wins_where_the_geometries_meet_off_the_centre_path() {
         profile: &p,
         settings: &settings,
         until: None,
+        descent_only: false,
     };
     let centre_only = stages.route(fields.iter().collect(), &ctx).unwrap();
     let o = hha_order(&gs, &fields, &p, &settings, &ctx, &mut Vec::new()).unwrap();
