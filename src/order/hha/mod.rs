@@ -601,7 +601,9 @@ pub fn hha_order(
     // nothing once the time objective frees both ends and searches the path with its full
     // budget, so HHA only gives it a start (BENCHMARKS, issue 16: 1,000 points 0.31 instead of
     // 0.42 s of ordering, +0.80 instead of +0.95 % above LKH)
-    let lone_before_time = time_follows && live.len() == 1;
+    // (on the fly no time search follows: `order_plan` runs it for step-and-scan only)
+    let lone_before_time =
+        time_follows && settings.motion == crate::document::MotionMode::Step && live.len() == 1;
     let cent: Vec<Pt> = geometries.iter().map(Geometry::centroid).collect();
     let (by_centre, by_gap) = field_order_candidates(&live_owned, &cent, profile, ctx)?;
     stage_s.push(("field_order".into(), t.elapsed().as_secs_f64()));
