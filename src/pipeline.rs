@@ -8,7 +8,9 @@ use crate::fields::{place_fields, split_oversize, FieldError, Placement};
 use crate::hatch::{is_hatch_output, layer_geometries, HatchError};
 use crate::import::{import_file, ImportError, ImportOptions};
 use crate::job::JobCtx;
-use crate::motion::{lower_motion, plan_stage_route, MotionError, OtfError, Toolpath};
+use crate::motion::{
+    label_layers, lower_motion, plan_stage_route, MotionError, OtfError, Toolpath,
+};
 use crate::order::{order_plan, OrderError};
 use std::path::Path;
 use std::time::Instant;
@@ -106,17 +108,25 @@ pub fn load_svg(
 /// `split_oversize`, geometries larger than a field are first cut into pieces (and reported as
 /// warnings). The plan is not added to `doc.plans`.
 pub fn plan_document(doc: &mut Document, ctx: &JobCtx) -> Result<Plan, PipelineError> {
+    plan_document_lowered(doc, ctx).map(|(plan, _)| plan)
+}
+
+/// [`plan_document`] with the plan's toolpath (see [`order_document_lowered`]).
+pub fn plan_document_lowered(
+    doc: &mut Document,
+    ctx: &JobCtx,
+) -> Result<(Plan, Toolpath), PipelineError> {
     let hatch_s = derive_geometries(doc, ctx)?;
     let t0 = Instant::now();
     let lower_bound = place_document_fields(doc, ctx)?;
     let fields_s = t0.elapsed().as_secs_f64();
-    let mut plan = order_document(doc, ctx)?;
+    let (mut plan, toolpath) = order_document_lowered(doc, ctx)?;
     plan.metrics.solve_s.hatch = hatch_s;
     plan.metrics.solve_s.fields = fields_s;
     plan.metrics.fields_lower_bound = Some(lower_bound);
     plan.metrics.solve_s.total =
         plan.metrics.solve_s.hatch + plan.metrics.solve_s.fields + plan.metrics.solve_s.order;
-    Ok(plan)
+    Ok((plan, toolpath))
 }
 
 /// The hatch stage: makes the geometries to mark from the artwork and its layers' pens
@@ -207,29 +217,29 @@ pub fn expand_passes(order: &[Step], geometries: &[Geometry], layers: &[Layer]) 
     out
 }
 
-/// Gives a fresh plan the document's layers (its pens: mark speeds, powers, passes): repeats
-/// strokes for passes, and when a pen changes speed or passes lowers it again and computes its
-/// metrics on that toolpath.
-fn apply_pens(doc: &Document, plan: &mut Plan) -> Result<(), PipelineError> {
+/// Gives a fresh plan the document's layers (its pens: mark speeds, powers, passes) and repeats
+/// strokes for passes. True when a pen changes the time law (speed or passes): the plan must
+/// then be lowered again.
+fn apply_pens(doc: &Document, plan: &mut Plan) -> bool {
     plan.layers = doc.layers.clone();
     let timed = plan
         .layers
         .iter()
         .any(|l| l.pen.mark_speed_mm_s.is_some() || l.pen.passes > 1);
-    if !timed {
-        return Ok(());
+    if timed {
+        plan.order = expand_passes(&plan.order, &doc.geometries, &plan.layers);
     }
-    plan.order = expand_passes(&plan.order, &doc.geometries, &plan.layers);
-    relower(doc, plan)
+    timed
 }
 
 /// On the fly with seed 001's routes (`lsa`, `cetsp-ga`): plans the stage route on the plan's
 /// final time law (its pens' speeds and passes, hence after [`apply_pens`], so that the GA runs
-/// once), lowers the plan along it and adds the route's planning time to the order stage.
-fn plan_seed_route(doc: &Document, plan: &mut Plan, ctx: &JobCtx) -> Result<(), PipelineError> {
+/// once) and adds the route's planning time to the order stage. True when a route was planned:
+/// the plan must then be lowered again, along it.
+fn plan_seed_route(doc: &Document, plan: &mut Plan, ctx: &JobCtx) -> Result<bool, PipelineError> {
     let s = &doc.settings;
     if plan.motion != MotionMode::OnTheFly || s.stage_route == StageRouteKind::Taut {
-        return Ok(());
+        return Ok(false);
     }
     let t = Instant::now();
     let file = || doc.source.clone().unwrap_or_else(|| "document".into());
@@ -258,12 +268,12 @@ fn plan_seed_route(doc: &Document, plan: &mut Plan, ctx: &JobCtx) -> Result<(), 
     solve.order += route_s;
     solve.total += route_s;
     solve.order_detail.push(("route".into(), route_s));
-    relower(doc, plan)
+    Ok(true)
 }
 
 /// Lowers `plan` again and computes its metrics on that toolpath (keeping its solve times and
-/// field lower bound).
-fn relower(doc: &Document, plan: &mut Plan) -> Result<(), PipelineError> {
+/// field lower bound); returns the toolpath.
+fn relower(doc: &Document, plan: &mut Plan) -> Result<Toolpath, PipelineError> {
     let toolpath = lower_plan(doc, plan)?;
     let m = crate::order::metrics::compute(
         &doc.geometries,
@@ -277,7 +287,7 @@ fn relower(doc: &Document, plan: &mut Plan) -> Result<(), PipelineError> {
         fields_lower_bound: plan.metrics.fields_lower_bound,
         ..m
     };
-    Ok(())
+    Ok(toolpath)
 }
 
 /// The field stage alone: makes the geometries from the layers (when they changed, see
@@ -337,12 +347,21 @@ fn whole_work_region(geometries: &[crate::document::Geometry]) -> Placement {
 /// The ordering stage alone, on the document's current fields and allocation (as the operator
 /// left them). Takes `&Document` so that it can run on a snapshot in a background thread.
 pub fn order_document(doc: &Document, ctx: &JobCtx) -> Result<Plan, PipelineError> {
+    order_document_lowered(doc, ctx).map(|(plan, _)| plan)
+}
+
+/// [`order_document`] with the plan's toolpath, the one its metrics were computed on (what
+/// [`lower_plan`] would make of the plan; lowering once is seconds on large on-the-fly jobs).
+pub fn order_document_lowered(
+    doc: &Document,
+    ctx: &JobCtx,
+) -> Result<(Plan, Toolpath), PipelineError> {
     let file = doc.source.clone().unwrap_or_else(|| "document".into());
     if let Some(r) = ctx.recorder() {
         r.geometry(&doc.geometries);
         r.fields(&doc.fields);
     }
-    let mut plan = order_plan(
+    let (mut plan, mut toolpath) = order_plan(
         &doc.geometries,
         &doc.fields,
         &doc.profile,
@@ -351,12 +370,19 @@ pub fn order_document(doc: &Document, ctx: &JobCtx) -> Result<Plan, PipelineErro
     )
     .map_err(|source| PipelineError::Order { file, source })?;
     plan.metrics.solve_s.total = plan.metrics.solve_s.order;
-    apply_pens(doc, &mut plan)?;
-    plan_seed_route(doc, &mut plan, ctx)?;
-    if let Some(r) = ctx.recorder() {
-        r.plan(&plan, &lower_plan(doc, &plan)?);
+    // both may change the time law: the plan is lowered again once, after both
+    let timed = apply_pens(doc, &mut plan);
+    let routed = plan_seed_route(doc, &mut plan, ctx)?;
+    if timed || routed {
+        toolpath = relower(doc, &mut plan)?;
+    } else {
+        // ordered before the plan had its layers, which do not change the timing here
+        label_layers(&mut toolpath, &doc.geometries, &plan.layers);
     }
-    Ok(plan)
+    if let Some(r) = ctx.recorder() {
+        r.plan(&plan, &toolpath);
+    }
+    Ok((plan, toolpath))
 }
 
 /// The machine motion of one of the document's plans, in the motion mode it was planned for

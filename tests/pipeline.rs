@@ -94,3 +94,74 @@ fn project_round_trip_with_plan() {
         "{e}"
     );
 }
+
+/// `order_document_lowered` hands out the toolpath the plan's metrics were computed on, which
+/// the GUI shows without lowering again: it must be what `lower_plan` makes of the plan, in
+/// step-and-scan, on the fly (taut and seed 001's lsa route) and with pens that change the time
+/// law (speeds, passes).
+#[test]
+fn the_ordering_toolpath_is_the_plans_lowering() {
+    use galvoplan::document::{MotionMode, PenLibrary, StageRouteKind};
+    use galvoplan::pipeline::{apply_pen_library, order_document_lowered, place_document_fields};
+    let examples = common::root().join("assets/examples");
+    let cases = [
+        ("demo.svg", MotionMode::Step, StageRouteKind::Taut, false),
+        (
+            "demo.svg",
+            MotionMode::OnTheFly,
+            StageRouteKind::Taut,
+            false,
+        ),
+        (
+            "oversize.svg",
+            MotionMode::OnTheFly,
+            StageRouteKind::Lsa,
+            false,
+        ),
+        (
+            "two-layers.svg",
+            MotionMode::Step,
+            StageRouteKind::Taut,
+            true,
+        ),
+        (
+            "two-layers.svg",
+            MotionMode::OnTheFly,
+            StageRouteKind::Lsa,
+            true,
+        ),
+    ];
+    for (name, motion, stage_route, pens) in cases {
+        let settings = SolverSettings {
+            motion,
+            stage_route,
+            ..SolverSettings::default()
+        };
+        let (mut doc, _) = load_svg(
+            &examples.join(name),
+            MachineProfile::default(),
+            settings,
+            &ImportOptions::default(),
+        )
+        .unwrap();
+        if pens {
+            let lib = PenLibrary::load(&examples.join("two-layers.pens.toml")).unwrap();
+            assert!(apply_pen_library(&mut doc, &lib).is_empty());
+        }
+        place_document_fields(&mut doc, &JobCtx::default()).unwrap();
+        let (plan, toolpath) = order_document_lowered(&doc, &JobCtx::default()).unwrap();
+        let case = format!("{name} {motion:?} {stage_route:?} pens {pens}");
+        assert_eq!(plan.motion, motion, "{case}");
+        assert_eq!(
+            plan.stage_route.is_some(),
+            stage_route != StageRouteKind::Taut && motion == MotionMode::OnTheFly,
+            "{case}"
+        );
+        assert_eq!(
+            plan.metrics.job_time_s,
+            Some(toolpath.duration_s()),
+            "{case}"
+        );
+        assert!(toolpath == lower_plan(&doc, &plan).unwrap(), "{case}");
+    }
+}

@@ -5,7 +5,7 @@ use super::files::{ExportKind, Opened};
 use super::toolpaths::Prelowered;
 use crate::document::{Algo, Document, Plan};
 use crate::job::{CancelToken, JobCtx, Progress, ProgressSink};
-use crate::pipeline::order_document;
+use crate::pipeline::order_document_lowered;
 use std::path::PathBuf;
 use std::sync::mpsc::{self, Receiver, TryRecvError};
 use std::sync::{Arc, Mutex};
@@ -162,9 +162,9 @@ impl Job {
         let thread = format!("solve-{}", algo.label());
         let limit = doc.settings.time_limit_s;
         Job::spawn(name, &thread, limit, repaint, move |ctx| {
-            let plan = order_document(&snapshot, ctx).map_err(|e| e.to_string())?;
-            ctx.progress("lower", 0, 1, "lowering the plan to a toolpath");
-            let lowered = Box::new(Prelowered::of(&snapshot, &plan));
+            let (plan, toolpath) =
+                order_document_lowered(&snapshot, ctx).map_err(|e| e.to_string())?;
+            let lowered = Box::new(Prelowered::of(&snapshot, &plan, toolpath));
             Ok(JobResult::Plan {
                 plan: Box::new(plan),
                 lowered,

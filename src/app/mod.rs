@@ -393,7 +393,7 @@ impl App {
             count(self.doc.geometries.len(), "geometry", "geometries"),
             count(self.doc.layers.len(), "layer", "layers"),
             count(self.doc.fields.len(), "scan field", "scan fields"),
-            self.doc.warnings.len()
+            count(self.doc.warnings.len(), "import warning", "import warnings")
         );
         match o.problem {
             Some(p) => {
@@ -980,13 +980,13 @@ fn can_be_covered(g: &crate::document::Geometry, profile: &MachineProfile) -> bo
     !x.is_empty() && !y.is_empty()
 }
 
-/// A library message in the GUI's words: command-line flags become the controls that do the
-/// same.
 /// `n` and the noun for it: "1 geometry", "3 geometries".
 pub fn count(n: usize, one: &str, many: &str) -> String {
     format!("{n} {}", if n == 1 { one } else { many })
 }
 
+/// A library message in the GUI's words: command-line flags become the controls that do the
+/// same.
 pub fn gui_words(msg: &str) -> String {
     msg.replace(
         "use --split-oversize to cut them at field borders",

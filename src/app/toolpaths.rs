@@ -120,11 +120,12 @@ fn lower(doc: &Document, plan: &Plan) -> Result<Arc<Lowered>, String> {
 pub struct Prelowered(Entry);
 
 impl Prelowered {
-    /// Lowers `plan` of `doc` (on the job's thread).
-    pub fn of(doc: &Document, plan: &Plan) -> Self {
+    /// Wraps the toolpath `plan` of `doc` was lowered to on the job's thread (by
+    /// [`order_document_lowered`](crate::pipeline::order_document_lowered)) and indexes it.
+    pub fn of(doc: &Document, plan: &Plan, toolpath: Toolpath) -> Self {
         Self(Entry {
             key: Key::of(doc, plan),
-            result: lower(doc, plan),
+            result: Ok(Arc::new(Lowered::new(toolpath))),
         })
     }
 
@@ -274,7 +275,8 @@ mod tests {
     fn a_job_lowering_is_adopted_and_redone_only_if_the_document_changed() {
         let mut doc = doc_with_plan(false);
         let job_doc = doc.clone();
-        let lowered = Prelowered::of(&job_doc, &job_doc.plans[0]).renamed("P (stopped)");
+        let toolpath = lower_plan(&job_doc, &job_doc.plans[0]).unwrap();
+        let lowered = Prelowered::of(&job_doc, &job_doc.plans[0], toolpath).renamed("P (stopped)");
         doc.plans[0].name = "P (stopped)".into();
         let mut cache = ToolpathCache::default();
         cache.adopt(0, lowered.clone());

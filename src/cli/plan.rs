@@ -8,7 +8,7 @@ use galvoplan::export::{
     geometry_svg, preview_svg, report_json, trajectory_csv, trajectory_period_s, write_gcode,
 };
 use galvoplan::job::{CancelToken, JobCtx};
-use galvoplan::pipeline::{apply_pen_library, load_svg, lower_plan_on, plan_document};
+use galvoplan::pipeline::{apply_pen_library, load_svg, lower_plan_on, plan_document_lowered};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -43,17 +43,21 @@ pub fn run(a: &PlanArgs) -> Result<()> {
         ctx = ctx.with_recorder(r.clone());
     }
     let imported_warnings = doc.warnings.len();
-    let result = plan_document(&mut doc, &ctx);
+    let result = plan_document_lowered(&mut doc, &ctx);
     progress.finish();
     for w in doc.warnings.iter().skip(imported_warnings) {
         eprintln!("galvoplan: warning: {}: {w}", a.input.display());
     }
-    let mut plan = result?;
+    let (mut plan, toolpath) = result?;
     let t0 = Instant::now();
     let source = a.input.display().to_string();
     // with a trajectory, everything is written from the toolpath on the controller's clock (the
     // same strokes; the report then gives its time)
-    let toolpath = lower_plan_on(&doc, &plan, period_s)?;
+    let toolpath = match period_s {
+        Some(_) => lower_plan_on(&doc, &plan, period_s)?,
+        // the toolpath the plan was ordered and measured on
+        None => toolpath,
+    };
     let trajectory = period_s.map(|p| {
         plan.metrics.job_time_s = Some(toolpath.duration_s());
         plan.metrics.job_time_breakdown_s = Some(toolpath.breakdown());

@@ -37,7 +37,7 @@ pub use toolpath::{
     MachineState, ScanMotion, Segment, SegmentKind, StageMotion, Stroke, Toolpath, TIME_EPS_S,
 };
 
-use crate::document::{Geometry, MachineProfile, MotionMode, Plan};
+use crate::document::{Geometry, Layer, MachineProfile, MotionMode, Plan};
 use crate::job::JobCtx;
 
 /// Why a plan cannot be turned into motion, in either mode.
@@ -70,13 +70,22 @@ pub fn lower_motion(
         }
         MotionMode::OnTheFly => lower_on_the_fly(geometries, plan, profile, clock_s, ctx)?,
     };
-    if !plan.layers.is_empty() {
-        for s in &mut path.strokes {
-            let layer = geometries.get(s.geometry).map(|g| &g.layer);
-            s.layer = layer.and_then(|name| plan.layers.iter().position(|l| &l.name == name));
-        }
-    }
+    label_layers(&mut path, geometries, &plan.layers);
     Ok(path)
+}
+
+/// Gives each stroke of `path` the index of its geometry's layer in `layers` (what the G-code
+/// reads each pen's power from); no layers leave the strokes on the profile's pen. A toolpath
+/// lowered before a plan had its layers becomes the plan's lowering this way when the layers do
+/// not change its timing.
+pub fn label_layers(path: &mut Toolpath, geometries: &[Geometry], layers: &[Layer]) {
+    if layers.is_empty() {
+        return;
+    }
+    for s in &mut path.strokes {
+        let layer = geometries.get(s.geometry).map(|g| &g.layer);
+        s.layer = layer.and_then(|name| layers.iter().position(|l| &l.name == name));
+    }
 }
 
 #[cfg(test)]

@@ -46,14 +46,15 @@ pub struct Ordering {
 }
 
 /// Orders the allocated geometries with the algorithm in `settings` and returns the plan with
-/// its metrics (stage times other than `order` are left for the caller to fill in).
+/// its metrics (stage times other than `order` are left for the caller to fill in) and the
+/// toolpath they were computed on, so that the caller need not lower the plan again.
 pub fn order_plan(
     geometries: &[Geometry],
     fields: &[ScanField],
     profile: &MachineProfile,
     settings: &SolverSettings,
     ctx: &JobCtx,
-) -> Result<Plan, OrderError> {
+) -> Result<(Plan, Toolpath), OrderError> {
     check_allocation(geometries.len(), fields)?;
     let t0 = std::time::Instant::now();
     let mut detail = Vec::new();
@@ -105,7 +106,7 @@ pub fn order_plan(
     );
     m.solve_s.order = order_s;
     m.solve_s.order_detail = detail;
-    Ok(Plan {
+    let plan = Plan {
         name: settings.algo.label().into(),
         algo: settings.algo,
         fields: plan_fields,
@@ -115,7 +116,8 @@ pub fn order_plan(
         motion: settings.motion,
         stage_route: None,
         layers: Vec::new(),
-    })
+    };
+    Ok((plan, toolpath))
 }
 
 /// The ordering of the settings' algorithm, HGA's HHA seed ordering (when it had one) and HGA's
