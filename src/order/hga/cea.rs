@@ -44,8 +44,9 @@ impl Shared<'_> {
                 flipped.push(false);
             } else {
                 let (s, e) = geom.ends(0);
-                nodes.push(Node { s, e, p: 0.0 });
-                flippable.push(true);
+                let (node, flips) = Node::open_stroke(s, e, 0.0);
+                nodes.push(node);
+                flippable.push(flips);
                 flipped.push(c.vo[g] == 1);
             }
             cluster.push(self.field_of[g] as u32);

@@ -392,12 +392,14 @@ pub(crate) fn refine_field(
         } else {
             (b, a)
         };
-        nodes.push(Node {
-            s: ns,
-            e: ne,
-            p: g.centroid().dot(dir),
-        });
-        flippable.push(!g.closed);
+        let p = g.centroid().dot(dir);
+        let (node, flips) = if g.closed {
+            (Node::point(ns, p), false)
+        } else {
+            Node::open_stroke(ns, ne, p)
+        };
+        nodes.push(node);
+        flippable.push(flips);
     }
     if let Some(z) = after {
         nodes.push(Node::point(z, f64::INFINITY));

@@ -218,3 +218,52 @@ fn many_fields_try_only_the_centre_path() {
         field_order_candidates(&fields, &cent, &MachineProfile::default(), &ctx).unwrap();
     assert_eq!(by_gap, None);
 }
+
+/// An open stroke of `len` mm along x from `(x, y)`.
+fn stroke(x: f64, y: f64, len: f64) -> Geometry {
+    Geometry::new(
+        vec![Pt::new(x, y), Pt::new(x + len, y)],
+        false,
+        Source::default(),
+    )
+}
+
+#[test]
+fn refining_moves_dots_as_points_keeping_their_direction_and_flips_strokes() {
+    // dots of 2 µm in a shuffled row, each marked in a given direction, then a 5 mm stroke
+    // that the free path should mark from its near end
+    let mut gs: Vec<Geometry> = (0..12)
+        .map(|k| stroke(((k * 7) % 12) as f64 * 3.0, 0.0, 0.002))
+        .collect();
+    gs.push(stroke(40.0, 0.0, 5.0));
+    let run: Vec<Step> = (0..gs.len())
+        .map(|g| Step::from_choice(g, 0, &gs[g], usize::from(g % 3 == 0 || g == 12)))
+        .collect();
+    let before = crate::order::metrics::idle_mm(&gs, &run);
+    let out = refine_field(
+        &gs,
+        &run,
+        Some(Pt::new(-5.0, 0.0)),
+        None,
+        Pt::new(1.0, 0.0),
+        0.0,
+        7,
+        IlsBudget::kicks(50),
+        &JobCtx::default(),
+    )
+    .unwrap();
+    let after = crate::order::metrics::idle_mm(&gs, &out);
+    assert!(after < before, "{after} mm idle after, {before} before");
+    for s in &out {
+        if s.geometry < 12 {
+            assert_eq!(s.reversed, s.geometry % 3 == 0, "dot {} turned", s.geometry);
+        } else {
+            assert!(!s.reversed, "the 5 mm stroke runs away from the dots");
+        }
+    }
+    let xs: Vec<f64> = out.iter().map(|s| gs[s.geometry].points[0].x).collect();
+    assert!(
+        xs.windows(2).all(|w| w[0] < w[1]),
+        "the row is swept in order: {xs:?}"
+    );
+}

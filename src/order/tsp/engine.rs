@@ -51,6 +51,9 @@ pub(super) struct Engine<'p> {
     /// The cost is plain Euclidean distance (λ = 0, no cluster penalty): edges are computed
     /// directly, the hot path of plain TSPs.
     plain: bool,
+    /// `plain`, and no node may flip: every node is a point (`s = e`), so an edge is the
+    /// distance between two points whatever the orientations.
+    plain_points: bool,
 }
 
 /// Why a local search stopped early.
@@ -80,10 +83,15 @@ impl<'p> Engine<'p> {
         if lo > hi {
             return None;
         }
+        let plain = prob.lambda == 0.0
+            && (prob.cluster.is_empty() || prob.cluster_penalty == 0.0)
+            && prob.metric == TravelCost::Distance;
+        let ring = Ring::new(tour, &prob.flippable);
         Some(Engine {
             prob,
             nbr,
-            ring: Ring::new(tour, &prob.flippable),
+            plain_points: plain && !ring.any_flippable(),
+            ring,
             lo,
             hi,
             or_max,
@@ -92,9 +100,7 @@ impl<'p> Engine<'p> {
             queued: vec![false; n],
             touched: Vec::new(),
             deadline: None,
-            plain: prob.lambda == 0.0
-                && (prob.cluster.is_empty() || prob.cluster_penalty == 0.0)
-                && prob.metric == TravelCost::Distance,
+            plain,
         })
     }
 
@@ -105,6 +111,9 @@ impl<'p> Engine<'p> {
 
     /// Cost of the edge `u → v` with the current orientations.
     pub(super) fn edge(&self, u: usize, v: usize) -> f64 {
+        if self.plain_points {
+            return self.prob.nodes[u].s.dist(self.prob.nodes[v].s);
+        }
         self.cost_o(u, self.ring.flipped(u), v, self.ring.flipped(v))
     }
 
@@ -122,6 +131,9 @@ impl<'p> Engine<'p> {
 
     /// Cost of the edge `u → v` when `u`'s orientation is toggled (`tu`) and/or `v`'s (`tv`).
     pub(super) fn edge_toggled(&self, u: usize, tu: bool, v: usize, tv: bool) -> f64 {
+        if self.plain_points {
+            return self.prob.nodes[u].s.dist(self.prob.nodes[v].s);
+        }
         let fu = self.ring.flipped(u) ^ (tu && self.ring.flippable(u));
         let fv = self.ring.flipped(v) ^ (tv && self.ring.flippable(v));
         self.cost_o(u, fu, v, fv)

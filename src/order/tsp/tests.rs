@@ -408,3 +408,70 @@ proptest! {
         check_result(&prob, &t, c, before)?;
     }
 }
+
+#[test]
+fn strokes_shorter_than_the_tolerance_are_searched_as_points() {
+    let (dot, flips) = Node::open_stroke(Pt::new(1.0, 2.0), Pt::new(1.002, 2.0), 0.5);
+    assert!(!flips);
+    assert_eq!(dot.s, dot.e);
+    assert!((dot.s.x - 1.001).abs() < 1e-12 && dot.p == 0.5);
+    let end = Pt::new(2.0 * POINT_LIKE_MM, 0.0);
+    let (line, flips) = Node::open_stroke(Pt::new(0.0, 0.0), end, 0.0);
+    assert!(flips);
+    assert_eq!((line.s, line.e), (Pt::new(0.0, 0.0), end));
+}
+
+#[test]
+fn the_point_fast_path_gives_the_tours_of_the_general_cost() {
+    let n = 400;
+    let pts = rnd_points(8, n);
+    let plain = PathProblem::points(&pts, &vec![0.0; n], 0.0);
+    // the same costs through the general path: one cluster for every node adds no penalty,
+    // but a cluster penalty turns the plain-distance shortcuts off
+    let mut general = plain.clone();
+    general.cluster = vec![0; n];
+    general.cluster_penalty = 1.0;
+    let run = |prob: &PathProblem| {
+        let mut t = Tour {
+            order: (0..n).collect(),
+            flipped: vec![false; n],
+        };
+        let c = LocalSearch::new(prob, LsOptions::default())
+            .iterated(&mut t, 300, 4, &JobCtx::default())
+            .unwrap();
+        (t, c)
+    };
+    let ((t_plain, c_plain), (t_general, c_general)) = (run(&plain), run(&general));
+    assert_eq!(t_plain, t_general);
+    assert_eq!(c_plain, c_general);
+}
+
+#[test]
+fn the_held_karp_bound_is_below_the_optimum_and_close_to_it() {
+    for seed in 0..6 {
+        let pts = rnd_points(200 + seed, 8);
+        let prob = PathProblem::points(&pts, &[0.0; 8], 0.0);
+        let opt = (0..8)
+            .map(|first| brute_force(&prob, first, None))
+            .fold(f64::INFINITY, f64::min);
+        let bound = held_karp_open_path(&pts, opt * 1.1, 300, &JobCtx::default()).unwrap();
+        assert!(
+            bound <= opt + 1e-9,
+            "seed {seed}: bound {bound} above the optimum {opt}"
+        );
+        assert!(
+            bound >= 0.9 * opt,
+            "seed {seed}: bound {bound} far below {opt}"
+        );
+    }
+    // on a line the best 1-tree is the path itself: the bound reaches the optimum
+    let line: Vec<Pt> = [3.0, 0.0, 7.0, 1.0, 12.0, 5.0]
+        .iter()
+        .map(|&x| Pt::new(x, 2.0))
+        .collect();
+    let bound = held_karp_open_path(&line, 20.0, 300, &JobCtx::default()).unwrap();
+    assert!((bound - 12.0).abs() < 1e-3, "{bound} on a 12 mm line");
+    let cancelled = JobCtx::default();
+    cancelled.cancel_token().cancel();
+    assert!(held_karp_open_path(&line, 20.0, 300, &cancelled).is_err());
+}
