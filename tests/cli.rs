@@ -407,3 +407,53 @@ fn plan_takes_dxf_and_text_labels() {
         assert_eq!(r["order"].as_array().unwrap().len(), geometries, "{input}");
     }
 }
+
+#[test]
+fn tsp_orders_a_generated_set_and_measures_it_against_the_held_karp_bound() {
+    let dir = tempfile::tempdir().unwrap();
+    let stem = dir.path().join("u60").display().to_string();
+    let out = galvoplan(&[
+        "tsp",
+        "--generate",
+        "uniform:60",
+        "--seed",
+        "3",
+        "--out",
+        &stem,
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let tour = dir.path().join("tour.txt").display().to_string();
+    let tsp = format!("{stem}.tsp");
+    let out = galvoplan(&["tsp", &tsp, "--bound", "200", "--tour", &tour]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    let row: Vec<&str> = text
+        .lines()
+        .find(|l| l.starts_with("| u60 "))
+        .expect("a row for the set")
+        .split('|')
+        .map(str::trim)
+        .collect();
+    let (length, bound): (f64, f64) = (row[4].parse().unwrap(), row[6].parse().unwrap());
+    // the bound is below every path, and Held–Karp is within a few % on uniform points
+    assert!(
+        bound > 0.9 * length && bound <= length,
+        "{length} mm vs bound {bound}"
+    );
+    assert!(row[7].ends_with('%'), "gap column: {}", row[7]);
+    let mut order: Vec<usize> = std::fs::read_to_string(&tour)
+        .unwrap()
+        .lines()
+        .map(|l| l.parse().unwrap())
+        .collect();
+    order.sort_unstable();
+    assert_eq!(order, (0..60).collect::<Vec<_>>());
+}

@@ -49,7 +49,7 @@ pub fn held_karp_open_path(
     let mut stall = 0;
     for _ in 0..iterations {
         ctx.check()?;
-        let bound = one_tree(points, &penalty, &mut degree);
+        let bound = one_tree(points, &penalty, &mut degree, ctx)?;
         if bound > best {
             best = bound;
             stall = 0;
@@ -73,8 +73,16 @@ pub fn held_karp_open_path(
     Ok(best.max(0.0))
 }
 
+/// Points added to the tree between two polls of the cancel token (a few ms at 10⁵ points).
+const POLL_EVERY: usize = 256;
+
 /// `L(π)` (see the module docs) and the degree of every point in the minimum 1-tree.
-fn one_tree(points: &[Pt], penalty: &[f64], degree: &mut [u32]) -> f64 {
+fn one_tree(
+    points: &[Pt],
+    penalty: &[f64],
+    degree: &mut [u32],
+    ctx: &JobCtx,
+) -> Result<f64, Cancelled> {
     let n = points.len();
     degree.iter_mut().for_each(|d| *d = 0);
     // Prim over the complete graph; `rest` holds the points not yet in the tree
@@ -84,6 +92,9 @@ fn one_tree(points: &[Pt], penalty: &[f64], degree: &mut [u32]) -> f64 {
     let mut tree = 0.0;
     let mut u = 0;
     while !rest.is_empty() {
+        if rest.len() % POLL_EVERY == 0 {
+            ctx.check()?;
+        }
         let mut pick = 0;
         for (k, &v) in rest.iter().enumerate() {
             let c = points[u].dist(points[v]) + penalty[u] + penalty[v];
@@ -115,5 +126,5 @@ fn one_tree(points: &[Pt], penalty: &[f64], degree: &mut [u32]) -> f64 {
     }
     degree[first] += 1;
     degree[second] += 1;
-    tree + penalty[first] + penalty[second] - 2.0 * penalty.iter().sum::<f64>()
+    Ok(tree + penalty[first] + penalty[second] - 2.0 * penalty.iter().sum::<f64>())
 }
