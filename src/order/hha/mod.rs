@@ -318,6 +318,8 @@ fn order_field(
     budget: IlsBudget,
     ctx: &JobCtx,
 ) -> Result<Vec<usize>, Cancelled> {
+    // parallel callers run every field's closure even after a cancel: stop before the set-up
+    ctx.check()?;
     let m = members.len();
     if m <= 2 {
         let mut v = vec![start];
@@ -377,6 +379,7 @@ pub(crate) fn refine_field(
     budget: IlsBudget,
     ctx: &JobCtx,
 ) -> Result<Vec<Step>, Cancelled> {
+    ctx.check()?;
     let mut nodes = Vec::with_capacity(run.len() + 2);
     let mut flippable = Vec::with_capacity(run.len() + 2);
     if let Some(a) = before {
