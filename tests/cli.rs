@@ -456,4 +456,40 @@ fn tsp_orders_a_generated_set_and_measures_it_against_the_held_karp_bound() {
         .collect();
     order.sort_unstable();
     assert_eq!(order, (0..60).collect::<Vec<_>>());
+    // the same dots planned on the benchmarks' one-field profile: one field, idle above the bound
+    let profile = common::root()
+        .join("assets/profiles/tsp-one-field.toml")
+        .display()
+        .to_string();
+    let report = dir.path().join("plan.json").display().to_string();
+    let gcode = dir.path().join("plan.gcode").display().to_string();
+    let svg = format!("{stem}.svg");
+    let out = galvoplan(&[
+        "plan",
+        &svg,
+        "--profile",
+        &profile,
+        "-o",
+        &gcode,
+        "--report",
+        &report,
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert_eq!(report["metrics"]["fields"], 1);
+    let idle = report["metrics"]["idle_mm"].as_f64().unwrap();
+    // dots of 2 µm: the marks add at most 2 µm per dot to the path between centroids
+    assert!(
+        idle >= bound - 60.0 * 0.002,
+        "idle {idle} mm below the bound {bound}"
+    );
+    assert!(
+        idle <= 1.05 * length,
+        "idle {idle} mm against the engine's {length}"
+    );
 }
