@@ -366,6 +366,24 @@ fn order_field(
     Ok(order.into_iter().map(|k| members[k]).collect())
 }
 
+/// Largest lone field that HHA still descends before the time objective searches it: below
+/// it the descent costs under a millisecond and gives the time objective's few kicks a better
+/// basin than a Hilbert curve (rnd-32: job time 0.4939 s against 0.4949, with a
+/// nearest-neighbour start 0.4951); above it the descent only costs time (BENCHMARKS, issue
+/// 16: 1,000 dots 0.21 → 0.18 s of ordering, 10⁵ dots 9.5 → 3.4 s).
+const LONE_DESCENT_MAX: usize = 200;
+
+/// A field's geometries along a Hilbert curve through their centroids: the start a later
+/// search takes over (it descends with its own cost and free ends).
+fn hilbert_start(members: &[usize], cent: &[Pt], ctx: &JobCtx) -> Result<Vec<usize>, Cancelled> {
+    ctx.check()?;
+    let pts: Vec<Pt> = members.iter().map(|&g| cent[g]).collect();
+    Ok(space_filling_order(&pts)
+        .into_iter()
+        .map(|k| members[k])
+        .collect())
+}
+
 /// Local search of one field's strokes on their real ends, between fixed anchor points.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn refine_field(
@@ -477,8 +495,9 @@ struct Stages<'a> {
     /// When the per-field searches stop (a share of `--time-limit`).
     until: Option<Instant>,
     /// A later search redoes the field's path with its full budget and free ends (the time
-    /// objective on a lone field): the path only descends to a local optimum, without kicks.
-    descent_only: bool,
+    /// objective on a lone field): the path is only a start, a descent up to
+    /// [`LONE_DESCENT_MAX`] geometries and a Hilbert curve beyond.
+    start_only: bool,
 }
 
 impl Stages<'_> {
@@ -516,14 +535,17 @@ impl Stages<'_> {
                 } else {
                     exit_point(f.center, dirs[j], profile.field_mm)
                 };
+                let m = f.geometries.len();
+                if self.start_only && m > LONE_DESCENT_MAX {
+                    return hilbert_start(&f.geometries, cent, ctx);
+                }
                 let seed = self.settings.seed ^ ((j as u64) << 32);
                 // the refinement rounds or the time objective go on from here: a fraction of
                 // the kicks, or none
-                let budget = if self.descent_only {
+                let budget = if self.start_only {
                     IlsBudget::kicks(0)
                 } else {
-                    IlsBudget::until(f.geometries.len(), self.until)
-                        .divided(PRELIMINARY_KICK_DIVISOR)
+                    IlsBudget::until(m, self.until).divided(PRELIMINARY_KICK_DIVISOR)
                 };
                 order_field(
                     &f.geometries,
@@ -604,8 +626,7 @@ pub fn hha_order(
     let live_owned: Vec<ScanField> = live.iter().map(|f| (*f).clone()).collect();
     // a lone field under the time objective: HHA's sweep direction and start/end rules mean
     // nothing once the time objective frees both ends and searches the path with its full
-    // budget, so HHA only gives it a start (BENCHMARKS, issue 16: 1,000 points 0.31 instead of
-    // 0.42 s of ordering, +0.80 instead of +0.95 % above LKH)
+    // budget, so HHA only gives it a start along a Hilbert curve (BENCHMARKS, issue 16)
     // (on the fly no time search follows: `order_plan` runs it for step-and-scan only)
     let lone_before_time =
         time_follows && settings.motion == crate::document::MotionMode::Step && live.len() == 1;
@@ -621,7 +642,7 @@ pub fn hha_order(
         profile,
         settings,
         until: limited(FIELD_PATHS_SHARE),
-        descent_only: lone_before_time,
+        start_only: lone_before_time,
     };
     let slots = |fo: &[usize]| -> Vec<&ScanField> { fo.iter().map(|&k| live[k]).collect() };
     let mut best = stages.route(slots(&by_centre), ctx)?;

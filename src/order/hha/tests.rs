@@ -190,7 +190,7 @@ fn the_gap_path_wins_where_the_geometries_meet_off_the_centre_path() {
         profile: &p,
         settings: &settings,
         until: None,
-        descent_only: false,
+        start_only: false,
     };
     let centre_only = stages.route(fields.iter().collect(), &ctx).unwrap();
     let o = hha_order(&gs, &fields, &p, &settings, &ctx, &mut Vec::new()).unwrap();
@@ -266,4 +266,48 @@ fn refining_moves_dots_as_points_keeping_their_direction_and_flips_strokes() {
         xs.windows(2).all(|w| w[0] < w[1]),
         "the row is swept in order: {xs:?}"
     );
+}
+
+/// One 70 mm field holding `n` dots scattered over it.
+fn lone_field_of_dots(n: usize) -> (Vec<Geometry>, Vec<ScanField>) {
+    let gs: Vec<Geometry> = (0..n)
+        .map(|k| {
+            let (x, y) = ((k * 37 % 61) as f64, (k * 23 % 59) as f64);
+            stroke(5.0 + x, 5.0 + y + (k % 7) as f64 * 0.1, 0.002)
+        })
+        .collect();
+    let field = field(0, 35.0, 35.0, (0..n).collect());
+    (gs, vec![field])
+}
+
+#[test]
+fn a_large_lone_field_before_the_time_objective_starts_along_a_hilbert_curve() {
+    let settings = SolverSettings {
+        cost_model: crate::document::CostModel::Time,
+        ..SolverSettings::default()
+    };
+    let p = MachineProfile::default();
+    let order = |n: usize| {
+        let (gs, fields) = lone_field_of_dots(n);
+        let o = hha_order(
+            &gs,
+            &fields,
+            &p,
+            &settings,
+            &JobCtx::default(),
+            &mut Vec::new(),
+        )
+        .unwrap();
+        let cent: Vec<Pt> = gs.iter().map(Geometry::centroid).collect();
+        let hilbert: Vec<usize> = space_filling_order(&cent);
+        let got: Vec<usize> = o.steps.iter().map(|s| s.geometry).collect();
+        (got, hilbert)
+    };
+    let (got, hilbert) = order(LONE_DESCENT_MAX + 50);
+    assert_eq!(
+        got, hilbert,
+        "beyond the bound: the curve, for the time objective"
+    );
+    let (got, hilbert) = order(LONE_DESCENT_MAX);
+    assert_ne!(got, hilbert, "up to the bound: HHA's own descent");
 }

@@ -112,8 +112,11 @@ const KICKS_PER_NODE: usize = 2;
 const KICKS_MAX: usize = 1500;
 
 /// Bound on `kicks · n` of the default budget, so that a huge path (whose construction and first
-/// descent dominate) gets fewer kicks: 1,000 at 10⁴ nodes, 100 at 10⁵.
-const KICK_WORK_MAX: usize = 10_000_000;
+/// descent dominate) gets fewer kicks: 1,500 up to 13,333 nodes, 200 at 10⁵. Raised from 10⁷
+/// when a lone field's HHA descent gave way to a Hilbert start: on 10⁴ dots (seeds 1–3) the
+/// time objective's 2,000 kicks give +2.48 / +2.76 / +2.68 % above LKH where the descent and
+/// 1,000 kicks gave +2.57 / +2.65 / +2.72 %, in less time (BENCHMARKS, issue 16).
+const KICK_WORK_MAX: usize = 20_000_000;
 
 /// Kicks of the default budget for a path of `n` nodes: [`KICKS_PER_NODE`] per node, at least 32,
 /// at most [`KICKS_MAX`] and [`KICK_WORK_MAX`]` / n` (at least 8).
