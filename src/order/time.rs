@@ -94,7 +94,7 @@ fn path_on_stage_time(
     let mut prob = PathProblem::points(centres, &vec![0.0; n], 0.0);
     prob.metric = TravelCost::StageTime(StageDynamics::of(profile));
     let kicks = (2 * n).clamp(STAGE_KICKS_MIN, STAGE_KICKS_MAX);
-    LocalSearch::new(&prob, LsOptions::default()).iterated(&mut tour, kicks, seed, ctx)?;
+    LocalSearch::new(&prob, LsOptions::default(), ctx)?.iterated(&mut tour, kicks, seed, ctx)?;
     Ok(tour.order)
 }
 

@@ -148,7 +148,7 @@ pub fn hga_order(
         field_of,
         corner,
         penalty: profile.field_mm[0].hypot(profile.field_mm[1]),
-        neighbours: neighbour_lists(&nprob, 12),
+        neighbours: neighbour_lists(&nprob, 12, ctx)?,
         exact_vertices: settings.vertex == VertexMode::Exact,
     };
     let mut rng = ChaCha8Rng::seed_from_u64(settings.seed);

@@ -357,7 +357,7 @@ fn order_field(
             order,
             flipped: vec![false; m],
         };
-        LocalSearch::new(&prob, LsOptions::default())
+        LocalSearch::new(&prob, LsOptions::default(), ctx)?
             .iterated_within(&mut tour, budget, seed, ctx)?;
         tour.order
     } else {
@@ -454,7 +454,8 @@ pub(crate) fn refine_field(
         order: (0..n).collect(),
         flipped,
     };
-    LocalSearch::new(&prob, LsOptions::default()).iterated_within(&mut tour, budget, seed, ctx)?;
+    LocalSearch::new(&prob, LsOptions::default(), ctx)?
+        .iterated_within(&mut tour, budget, seed, ctx)?;
     Ok(tour
         .order
         .iter()

@@ -2,6 +2,8 @@
 
 use super::problem::{Node, PathProblem};
 use crate::geom::Pt;
+use crate::job::{Cancelled, JobCtx};
+use rayon::prelude::*;
 use rustc_hash::{FxHashMap, FxHashSet};
 
 /// A uniform grid over the nodes' end points, for candidate pools on large instances.
@@ -82,66 +84,87 @@ impl EndGrid {
     }
 }
 
+/// Nodes whose lists are built between two polls of the cancel token (10⁵ nodes take about a
+/// second on one core).
+const POLL_EVERY: usize = 1024;
+
+/// The quadrant search looks at the nearest this many candidates of a node only.
+const POOL: usize = 96;
+
 /// Candidate neighbours of every node: the `k` nearest by the shortest distance between end
 /// points (so that long open strokes find the nodes near either end), plus the two nearest in
 /// each quadrant around each end point (so that clusters of coincident points do not hide the
-/// rest of the instance). Deterministic: ties by index.
-pub fn neighbour_lists(prob: &PathProblem, k: usize) -> Vec<Vec<usize>> {
+/// rest of the instance). Deterministic (ties by index) on any number of threads; polls `ctx`.
+pub fn neighbour_lists(
+    prob: &PathProblem,
+    k: usize,
+    ctx: &JobCtx,
+) -> Result<Vec<Vec<usize>>, Cancelled> {
     let n = prob.nodes.len();
     let k = k.min(n.saturating_sub(1));
-    let near = |a: &Node, b: &Node| -> f64 {
-        a.s.dist2(b.s)
-            .min(a.s.dist2(b.e))
-            .min(a.e.dist2(b.s))
-            .min(a.e.dist2(b.e))
-    };
-    // the quadrant search looks at the nearest POOL candidates only
-    const POOL: usize = 96;
     let grid = (n > 4 * POOL).then(|| EndGrid::new(&prob.nodes));
     (0..n)
+        .into_par_iter()
         .map(|i| {
-            let a = &prob.nodes[i];
-            let pool: Vec<usize> = match &grid {
-                Some(g) => g.around(a, i, POOL),
-                None => (0..n).filter(|&j| j != i).collect(),
-            };
-            let mut c: Vec<(f64, usize)> = pool
-                .into_iter()
-                .map(|j| (near(a, &prob.nodes[j]), j))
-                .collect();
-            let cmp = |x: &(f64, usize), y: &(f64, usize)| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1));
-            if c.len() > POOL {
-                c.select_nth_unstable_by(POOL, cmp);
-                c.truncate(POOL);
+            if i % POLL_EVERY == 0 {
+                ctx.check()?;
             }
-            c.sort_by(cmp);
-            let mut out: Vec<usize> = c.iter().take(k).map(|x| x.1).collect();
-            let origins: &[Pt] = if a.s == a.e {
-                &[a.s][..]
-            } else {
-                &[a.s, a.e][..]
-            };
-            for &o in origins {
-                let mut per_quadrant = [0usize; 4];
-                for &(_, j) in &c {
-                    let b = &prob.nodes[j];
-                    let q = b.s.plus(b.e).scale(0.5).minus(o);
-                    if q.x == 0.0 && q.y == 0.0 {
-                        continue;
-                    }
-                    let quad = usize::from(q.x < 0.0) * 2 + usize::from(q.y < 0.0);
-                    if per_quadrant[quad] < 2 {
-                        per_quadrant[quad] += 1;
-                        if !out.contains(&j) {
-                            out.push(j);
-                        }
-                    }
-                    if per_quadrant.iter().all(|&m| m >= 2) {
-                        break;
-                    }
-                }
-            }
-            out
+            Ok(node_list(prob, grid.as_ref(), i, k))
         })
         .collect()
+}
+
+/// Shortest distance between the end points of two nodes, squared.
+fn near(a: &Node, b: &Node) -> f64 {
+    a.s.dist2(b.s)
+        .min(a.s.dist2(b.e))
+        .min(a.e.dist2(b.s))
+        .min(a.e.dist2(b.e))
+}
+
+/// Node `i`'s list (see [`neighbour_lists`]).
+fn node_list(prob: &PathProblem, grid: Option<&EndGrid>, i: usize, k: usize) -> Vec<usize> {
+    let n = prob.nodes.len();
+    let a = &prob.nodes[i];
+    let pool: Vec<usize> = match grid {
+        Some(g) => g.around(a, i, POOL),
+        None => (0..n).filter(|&j| j != i).collect(),
+    };
+    let mut c: Vec<(f64, usize)> = pool
+        .into_iter()
+        .map(|j| (near(a, &prob.nodes[j]), j))
+        .collect();
+    let cmp = |x: &(f64, usize), y: &(f64, usize)| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1));
+    if c.len() > POOL {
+        c.select_nth_unstable_by(POOL, cmp);
+        c.truncate(POOL);
+    }
+    c.sort_by(cmp);
+    let mut out: Vec<usize> = c.iter().take(k).map(|x| x.1).collect();
+    let origins: &[Pt] = if a.s == a.e {
+        &[a.s][..]
+    } else {
+        &[a.s, a.e][..]
+    };
+    for &o in origins {
+        let mut per_quadrant = [0usize; 4];
+        for &(_, j) in &c {
+            let b = &prob.nodes[j];
+            let q = b.s.plus(b.e).scale(0.5).minus(o);
+            if q.x == 0.0 && q.y == 0.0 {
+                continue;
+            }
+            let quad = usize::from(q.x < 0.0) * 2 + usize::from(q.y < 0.0);
+            if per_quadrant[quad] < 2 {
+                per_quadrant[quad] += 1;
+                if !out.contains(&j) {
+                    out.push(j);
+                }
+            }
+            if per_quadrant.iter().all(|&m| m >= 2) {
+                break;
+            }
+        }
+    }
+    out
 }

@@ -135,7 +135,7 @@ pub fn local_search(
     opts: LsOptions,
     ctx: &JobCtx,
 ) -> Result<f64, Cancelled> {
-    LocalSearch::new(prob, opts).run(tour, None, ctx)
+    LocalSearch::new(prob, opts, ctx)?.run(tour, None, ctx)
 }
 
 /// A local search with its neighbour lists built once, for repeated runs (iterated local search,
@@ -147,13 +147,13 @@ pub struct LocalSearch<'a> {
 }
 
 impl<'a> LocalSearch<'a> {
-    /// Builds the neighbour lists.
-    pub fn new(prob: &'a PathProblem, opts: LsOptions) -> Self {
-        Self {
+    /// Builds the neighbour lists (polling `ctx`: about a second at 10⁵ nodes).
+    pub fn new(prob: &'a PathProblem, opts: LsOptions, ctx: &JobCtx) -> Result<Self, Cancelled> {
+        Ok(Self {
             prob,
-            nbr: Cow::Owned(neighbour_lists(prob, opts.neighbours)),
+            nbr: Cow::Owned(neighbour_lists(prob, opts.neighbours, ctx)?),
             opts,
-        }
+        })
     }
 
     /// A local search with neighbour lists supplied by the caller (shared between runs whose nodes
@@ -309,6 +309,7 @@ pub fn open_path(
         order: super::construct::space_filling_order(points),
         flipped: vec![false; n],
     };
-    LocalSearch::new(&prob, LsOptions::default()).iterated_within(&mut tour, budget, seed, ctx)?;
+    LocalSearch::new(&prob, LsOptions::default(), ctx)?
+        .iterated_within(&mut tour, budget, seed, ctx)?;
     Ok(tour.order)
 }

@@ -277,7 +277,7 @@ fn iterated_search_finds_the_exact_optimum_on_small_cases() {
             order: (0..7).collect(),
             flipped: vec![false; 7],
         };
-        let ls = LocalSearch::new(&prob, LsOptions::default());
+        let ls = LocalSearch::new(&prob, LsOptions::default(), &JobCtx::default()).unwrap();
         let c = ls.iterated(&mut t, 300, seed, &JobCtx::default()).unwrap();
         let opt = brute_force_oriented(&prob);
         assert!(
@@ -296,7 +296,8 @@ fn iterated_search_is_deterministic_for_a_seed() {
             order: (0..300).collect(),
             flipped: vec![false; 300],
         };
-        LocalSearch::new(&prob, LsOptions::default())
+        LocalSearch::new(&prob, LsOptions::default(), &JobCtx::default())
+            .unwrap()
             .iterated(&mut t, 200, seed, &JobCtx::default())
             .unwrap();
         t
@@ -314,7 +315,9 @@ fn a_cancelled_search_returns_an_error_and_a_valid_tour() {
         order: (0..200).collect(),
         flipped: vec![false; 200],
     };
-    let r = LocalSearch::new(&prob, LsOptions::default()).iterated(&mut t, 1_000_000, 1, &ctx);
+    let r = LocalSearch::new(&prob, LsOptions::default(), &JobCtx::default())
+        .unwrap()
+        .iterated(&mut t, 1_000_000, 1, &ctx);
     assert!(r.is_err());
     let mut s = t.order.clone();
     s.sort();
@@ -330,7 +333,8 @@ fn a_past_deadline_ends_the_kicks_with_a_local_optimum() {
         flipped: vec![false; 200],
     };
     let budget = IlsBudget::until(200, Some(std::time::Instant::now()));
-    let c = LocalSearch::new(&prob, LsOptions::default())
+    let c = LocalSearch::new(&prob, LsOptions::default(), &JobCtx::default())
+        .unwrap()
         .iterated_within(&mut t, budget, 1, &JobCtx::default())
         .unwrap();
     assert!((c - prob.tour_cost(&t)).abs() < 1e-6);
@@ -402,7 +406,7 @@ proptest! {
         let prob = small_problem(seed, n, lambda, fixed_first, fixed_last);
         let mut t = Tour { order: (0..n).collect(), flipped: vec![false; n] };
         let before = prob.tour_cost(&t);
-        let c = LocalSearch::new(&prob, LsOptions::default())
+        let c = LocalSearch::new(&prob, LsOptions::default(), &JobCtx::default()).unwrap()
             .iterated(&mut t, 50, seed, &JobCtx::default())
             .unwrap();
         check_result(&prob, &t, c, before)?;
@@ -436,7 +440,8 @@ fn the_point_fast_path_gives_the_tours_of_the_general_cost() {
             order: (0..n).collect(),
             flipped: vec![false; n],
         };
-        let c = LocalSearch::new(prob, LsOptions::default())
+        let c = LocalSearch::new(prob, LsOptions::default(), &JobCtx::default())
+            .unwrap()
             .iterated(&mut t, 300, 4, &JobCtx::default())
             .unwrap();
         (t, c)
@@ -474,4 +479,24 @@ fn the_held_karp_bound_is_below_the_optimum_and_close_to_it() {
     let cancelled = JobCtx::default();
     cancelled.cancel_token().cancel();
     assert!(held_karp_open_path(&line, 20.0, 300, &cancelled).is_err());
+}
+
+#[test]
+fn neighbour_lists_are_the_same_on_any_thread_count_and_stop_on_a_cancel() {
+    let n = 3000;
+    let pts = rnd_points(9, n);
+    let prob = PathProblem::points(&pts, &vec![0.0; n], 0.0);
+    let on = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| neighbour_lists(&prob, 16, &JobCtx::default()).unwrap())
+    };
+    let one = on(1);
+    assert_eq!(one, on(3));
+    assert!(one.iter().enumerate().all(|(i, l)| l.len() >= 16 && !l.contains(&i)));
+    let cancelled = JobCtx::default();
+    cancelled.cancel_token().cancel();
+    assert!(neighbour_lists(&prob, 16, &cancelled).is_err());
 }
