@@ -495,7 +495,10 @@ fn neighbour_lists_are_the_same_on_any_thread_count_and_stop_on_a_cancel() {
     };
     let one = on(1);
     assert_eq!(one, on(3));
-    assert!(one.iter().enumerate().all(|(i, l)| l.len() >= 16 && !l.contains(&i)));
+    assert!(one
+        .iter()
+        .enumerate()
+        .all(|(i, l)| l.len() >= 16 && !l.contains(&i)));
     let cancelled = JobCtx::default();
     cancelled.cancel_token().cancel();
     assert!(neighbour_lists(&prob, 16, &cancelled).is_err());
