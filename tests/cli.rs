@@ -421,19 +421,11 @@ fn tsp_orders_a_generated_set_and_measures_it_against_the_held_karp_bound() {
         "--out",
         &stem,
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_succeeded(&out);
     let tour = dir.path().join("tour.txt").display().to_string();
     let tsp = format!("{stem}.tsp");
     let out = galvoplan(&["tsp", &tsp, "--bound", "200", "--tour", &tour]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_succeeded(&out);
     let text = String::from_utf8_lossy(&out.stdout);
     let row: Vec<&str> = text
         .lines()
@@ -474,11 +466,7 @@ fn tsp_orders_a_generated_set_and_measures_it_against_the_held_karp_bound() {
         "--report",
         &report,
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_succeeded(&out);
     let report: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
     assert_eq!(report["metrics"]["fields"], 1);
@@ -491,5 +479,14 @@ fn tsp_orders_a_generated_set_and_measures_it_against_the_held_karp_bound() {
     assert!(
         idle <= 1.05 * length,
         "idle {idle} mm against the engine's {length}"
+    );
+}
+
+/// Asserts that a run of the binary succeeded (showing its stderr otherwise).
+fn assert_succeeded(out: &std::process::Output) {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
     );
 }
