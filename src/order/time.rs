@@ -105,8 +105,8 @@ const SEARCHES_PER_FIELD_MAX: usize = 4;
 /// number of threads); with one, the threads the fields leave idle each run a search of their
 /// own (different seeds, the shortest kept) until the deadline. Results under a deadline
 /// already depend on the machine's speed; now also on its thread count. On one 1,000-point
-/// field with `--time-limit 1` and 2 threads: median +0.46 % above LKH instead of +0.49 %, and
-/// +0.54 → +0.46 % on seed 1 (BENCHMARKS, issue 16).
+/// field with `--time-limit 1` and 2 threads: median +0.37 % above LKH instead of +0.49 %
+/// (seeds 1–3 × 5 point sets; seed 1 alone +0.54 → +0.37 %; BENCHMARKS, issue 16).
 fn searches_per_field(fields: usize, until: Option<Instant>) -> usize {
     match until {
         Some(_) => (rayon::current_num_threads() / fields.max(1)).clamp(1, SEARCHES_PER_FIELD_MAX),

@@ -370,7 +370,7 @@ fn order_field(
 /// it the descent costs under a millisecond and gives the time objective's few kicks a better
 /// basin than a Hilbert curve (rnd-32: job time 0.4939 s against 0.4949, with a
 /// nearest-neighbour start 0.4951); above it the descent only costs time (BENCHMARKS, issue
-/// 16: 1,000 dots 0.21 → 0.18 s of ordering, 10⁵ dots 9.5 → 3.4 s).
+/// 16: 1,000 dots 0.175 → 0.142 s of ordering, 10⁵ dots 9.45 → 3.43 s).
 const LONE_DESCENT_MAX: usize = 200;
 
 /// A field's geometries along a Hilbert curve through their centroids: the start a later
