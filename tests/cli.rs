@@ -424,6 +424,12 @@ fn tsp_orders_a_generated_set_and_measures_it_against_the_held_karp_bound() {
     assert_succeeded(&out);
     let tour = dir.path().join("tour.txt").display().to_string();
     let tsp = format!("{stem}.tsp");
+    let out = galvoplan(&["tsp", &tsp, "--bound", "0"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && err.contains("--bound needs at least 1 iteration"),
+        "{err}"
+    );
     let out = galvoplan(&["tsp", &tsp, "--bound", "200", "--tour", &tour]);
     assert_succeeded(&out);
     let text = String::from_utf8_lossy(&out.stdout);

@@ -71,6 +71,9 @@ pub fn run(a: &TspArgs) -> Result<()> {
         return generate(spec, a.seed, out);
     }
     anyhow::ensure!(!a.inputs.is_empty(), "no input: give TSPLIB or SVG files");
+    if a.bound == Some(0) {
+        anyhow::bail!("--bound needs at least 1 iteration");
+    }
     if let Some(t) = a.time_limit {
         anyhow::ensure!(
             t.is_finite() && t > 0.0,

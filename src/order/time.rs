@@ -123,32 +123,33 @@ fn best_free_field_path(
     until: Option<Instant>,
     ctx: &JobCtx,
 ) -> Result<Vec<Step>, Cancelled> {
-    let candidates: Vec<Result<Vec<Step>, Cancelled>> = seeds
+    let run_idle_mm = idle_mm(geometries, run);
+    let candidates: Vec<Result<(Vec<Step>, f64), Cancelled>> = seeds
         .par_iter()
-        .map(|&seed| free_field_path(geometries, run, seed, until, ctx))
+        .map(|&seed| free_field_path(geometries, run, run_idle_mm, seed, until, ctx))
         .collect();
-    let mut best: Option<(f64, Vec<Step>)> = None;
+    let mut best: Option<(Vec<Step>, f64)> = None;
     for c in candidates {
-        let steps = c?;
-        let idle = idle_mm(geometries, &steps);
-        if best.as_ref().is_none_or(|(b, _)| idle < *b) {
-            best = Some((idle, steps));
+        let (steps, idle) = c?;
+        if best.as_ref().is_none_or(|(_, b)| idle < *b) {
+            best = Some((steps, idle));
         }
     }
-    Ok(best.map_or_else(|| run.to_vec(), |(_, steps)| steps))
+    Ok(best.map_or_else(|| run.to_vec(), |(steps, _)| steps))
 }
 
-/// One field's strokes as a free open path on distance (λ = 0), exact start vertices; the old
-/// run is kept when that is not shorter.
+/// One field's strokes as a free open path on distance (λ = 0), exact start vertices, with its
+/// idle travel in mm; the old run (of idle `run_idle_mm`) is kept when that is not shorter.
 fn free_field_path(
     geometries: &[Geometry],
     run: &[Step],
+    run_idle_mm: f64,
     seed: u64,
     until: Option<Instant>,
     ctx: &JobCtx,
-) -> Result<Vec<Step>, Cancelled> {
+) -> Result<(Vec<Step>, f64), Cancelled> {
     if run.len() < 2 {
-        return Ok(run.to_vec());
+        return Ok((run.to_vec(), run_idle_mm));
     }
     let mut next = refine_field(
         geometries,
@@ -162,10 +163,10 @@ fn free_field_path(
         ctx,
     )?;
     let idle = optimal_vertices(geometries, &mut next, ctx)?;
-    Ok(if idle < idle_mm(geometries, run) {
-        next
+    Ok(if idle < run_idle_mm {
+        (next, idle)
     } else {
-        run.to_vec()
+        (run.to_vec(), run_idle_mm)
     })
 }
 
@@ -213,7 +214,9 @@ mod tests {
             .map(|g| Step::from_choice(g, 0, &geometries[g], 0))
             .collect();
         let ctx = JobCtx::default();
-        let first = free_field_path(&geometries, &run, 5, None, &ctx).unwrap();
+        let first = free_field_path(&geometries, &run, idle_mm(&geometries, &run), 5, None, &ctx)
+            .unwrap()
+            .0;
         let best = best_free_field_path(&geometries, &run, &[5, 6, 7], None, &ctx).unwrap();
         assert!(idle_mm(&geometries, &best) <= idle_mm(&geometries, &first) + 1e-9);
         let mut seen: Vec<usize> = best.iter().map(|s| s.geometry).collect();

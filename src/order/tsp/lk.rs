@@ -7,10 +7,11 @@
 //! `G = (cost before the chain − cost now) + cost(t1–t4)`, a step is explored only while
 //! `G − cost(t2–t3) > 0` and `G_next > 0` (the gain criterion of Lin and Kernighan), the chain
 //! stops at the first step that lowers the cost (first improvement, as LKH does) and
-//! otherwise follows the one step of most open gain up to [`MAX_DEPTH`] (as LKH does: on 1,000 uniform
-//! points, trying the best 3 or 5 steps at the first level gave the same tours after 2,000 kicks,
-//! within the spread of three instances, in 15–30 % more time). Depth 3 reaches the
-//! sequential 3-opt moves made of reversals; the pure segment moves are in `moves.rs`.
+//! otherwise follows the one step of most open gain up to [`MAX_DEPTH`], also as LKH does (on
+//! 1,000 uniform points, trying the best 3 or 5 steps at the first level gave the same tours
+//! after 2,000 kicks, within the spread of three instances, in 15–30 % more time). Depth 3
+//! reaches the sequential 3-opt moves made of reversals; the pure segment moves are in
+//! `moves.rs`.
 //!
 //! When `t3` lies beyond `t1` the reversal holds `t1` itself (the run from `t3` to `t1`), so `t1`'s
 //! new neighbour `t4` is on its other side: the chain continues in the mirrored direction.

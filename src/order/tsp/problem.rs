@@ -18,11 +18,12 @@ pub struct Node {
 ///
 /// Moving an end by at most half the stroke's length changes each of its two edges by at most
 /// that much (triangle inequality), so the search's cost is within `Σ length` of the true one;
-/// the exact vertex stage that follows every search picks the orientation of such strokes
-/// exactly for the order found (callers that keep the search's orientations keep the stroke's
-/// old one). 10 µm is below a marking spot and a galvanometer's repeatability, while dot
+/// the vertex stage that follows every search (VEA, then by default the exact DP) picks the
+/// orientation of such strokes for the order found (callers that keep the search's
+/// orientations keep the stroke's old one). 10 µm is below a marking spot and a galvanometer's repeatability, while dot
 /// patterns (drilling, textures, seed 002's placements) are strokes of a few µm: as points they
-/// need no flips, which on 1,000 dots made the search ~30 % faster.
+/// need no flips and take the engine's all-point path (1,000 dots: 0.288 → 0.170 s of ordering
+/// with both; BENCHMARKS, issue 16).
 pub const POINT_LIKE_MM: f64 = 0.01;
 
 impl Node {
