@@ -19,6 +19,10 @@ if [ ${#need[@]} -gt 0 ]; then
 fi
 
 start=$(date +%s)
+# Lints first: formatting, then clippy with warnings as errors (no unwrap/expect outside tests).
+rustup component list --installed 2>/dev/null | grep -q '^clippy' || rustup component add clippy rustfmt
+cargo fmt --all -- --check
+cargo clippy --all-targets -- -D warnings
 # The headless core on its own (no GUI dependencies).
 cargo test --no-default-features --lib --bins
 # Everything: library, CLI, integration and GUI (egui_kittest) tests.

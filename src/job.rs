@@ -2,7 +2,7 @@
 //! optional run recorder (rerun).
 
 use crate::document::{Geometry, Plan, ScanField};
-use crate::motion::Toolpath;
+use crate::geom::Pt;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Instant;
@@ -65,8 +65,9 @@ pub trait RunRecorder: Send + Sync {
     fn geometry(&self, geometries: &[Geometry]);
     /// The scan fields.
     fn fields(&self, fields: &[ScanField]);
-    /// A finished plan (marks and idle moves of its lowered toolpath).
-    fn plan(&self, plan: &Plan, toolpath: &Toolpath);
+    /// A finished plan: the tool-centre polylines of its marks in marking order, from its
+    /// lowered toolpath (idle moves join one mark's end to the next's start).
+    fn plan(&self, plan: &Plan, marks: &[&[Pt]]);
     /// One GA generation: best and mean idle travel.
     fn generation(&self, generation: usize, best_idle_mm: f64, mean_idle_mm: f64);
 }

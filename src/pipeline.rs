@@ -1,16 +1,15 @@
 //! The whole pipeline on a [`Document`]: import → fields → order → metrics, with stage times.
 
 use crate::document::{
-    pen_of, sync_layers, DerivedKey, Document, Geometry, Layer, MachineProfile, MotionMode, Pen,
-    PenLibrary, Plan, ScanField, SolverSettings, StageRouteKind, Step,
+    is_hatch_output, sync_layers, DerivedKey, Document, MachineProfile, MotionMode, Pen,
+    PenLibrary, Plan, PlanInputs, ScanField, SolverSettings, StageRouteKind,
 };
 use crate::fields::{place_fields, split_oversize, FieldError, Placement};
-use crate::hatch::{is_hatch_output, layer_geometries, HatchError};
+use crate::hatch::{layer_geometries, HatchError};
 use crate::import::{import_file, ImportError, ImportOptions};
 use crate::job::JobCtx;
-use crate::motion::{
-    label_layers, lower_motion, plan_stage_route, MotionError, OtfError, Toolpath,
-};
+use crate::motion::{lower_motion, plan_stage_route, MotionError, OtfError, Toolpath};
+pub use crate::order::expand_passes;
 use crate::order::{order_plan, OrderError};
 use std::path::Path;
 use std::time::Instant;
@@ -60,6 +59,12 @@ pub enum PipelineError {
         /// The document's source file.
         file: String,
     },
+    /// The document no longer has the geometries the plan was planned on.
+    #[error("{file}: the geometries this plan was planned on are no longer in the document; solve again")]
+    LostGeometries {
+        /// The document's source file.
+        file: String,
+    },
     /// Hatching failed.
     #[error("{file}: {source}")]
     Hatch {
@@ -68,6 +73,27 @@ pub enum PipelineError {
         /// The cause.
         source: HatchError,
     },
+}
+
+/// Something the operator can do about a failure (the CLI and the GUI each say it in their
+/// own words: a flag, or the control that does the same).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Remedy {
+    /// Geometries are larger than a scan field: cut them at field borders, or mark on the fly.
+    SplitOversize,
+}
+
+impl PipelineError {
+    /// What could help, when the operator can act on the cause.
+    pub fn remedy(&self) -> Option<Remedy> {
+        match self {
+            PipelineError::Fields {
+                source: FieldError::Oversize { .. },
+                ..
+            } => Some(Remedy::SplitOversize),
+            _ => None,
+        }
+    }
 }
 
 /// Imports an SVG or DXF file ([`import_file`]) into a new document with the given profile and
@@ -92,13 +118,11 @@ pub fn load_svg(
         page_mm: imported.page_mm,
         artwork: imported.geometries.clone(),
         layers,
-        derived_with: None,
         geometries: imported.geometries,
         warnings: imported.warnings,
         profile,
         settings,
-        fields: Vec::new(),
-        plans: Vec::new(),
+        ..Document::default()
     };
     Ok((doc, t0.elapsed().as_secs_f64()))
 }
@@ -158,12 +182,8 @@ pub fn derive_geometries(doc: &mut Document, ctx: &JobCtx) -> Result<f64, Pipeli
             source,
         },
     )?;
-    if made.geometries != doc.geometries {
-        doc.geometries = made.geometries;
-        // indices changed: fields and plans of the old geometry list are void
-        doc.fields.clear();
-        doc.plans.clear();
-    }
+    // indices may change: the fields go, the plans keep the geometries they were planned on
+    doc.set_geometries(made.geometries);
     for w in made.warnings {
         if !doc.warnings.contains(&w) {
             doc.warnings.push(w);
@@ -197,47 +217,11 @@ pub fn apply_pen_library(doc: &mut Document, library: &PenLibrary) -> Vec<String
     library.apply(&mut doc.layers)
 }
 
-/// Repeats each layer's strokes for its passes: inside each run of one field, the run's
-/// strokes are marked again, in the same order, once for every further pass of their layer
-/// (the stage does not move between passes).
-pub fn expand_passes(order: &[Step], geometries: &[Geometry], layers: &[Layer]) -> Vec<Step> {
-    let passes = |s: &Step| {
-        geometries
-            .get(s.geometry)
-            .and_then(|g| pen_of(layers, g))
-            .map_or(1, |p| p.passes)
-    };
-    let mut out = Vec::with_capacity(order.len());
-    for run in order.chunk_by(|a, b| a.field == b.field) {
-        let most = run.iter().map(passes).max().unwrap_or(1);
-        for pass in 0..most {
-            out.extend(run.iter().filter(|s| passes(s) > pass));
-        }
-    }
-    out
-}
-
-/// Gives a fresh plan the document's layers (its pens: mark speeds, powers, passes) and repeats
-/// strokes for passes. True when a pen changes the time law (speed or passes): the plan must
-/// then be lowered again.
-fn apply_pens(doc: &Document, plan: &mut Plan) -> bool {
-    plan.layers = doc.layers.clone();
-    let timed = plan
-        .layers
-        .iter()
-        .any(|l| l.pen.mark_speed_mm_s.is_some() || l.pen.passes > 1);
-    if timed {
-        plan.order = expand_passes(&plan.order, &doc.geometries, &plan.layers);
-    }
-    timed
-}
-
 /// On the fly with seed 001's routes (`lsa`, `cetsp-ga`): plans the stage route on the plan's
-/// final time law (its pens' speeds and passes, hence after [`apply_pens`], so that the GA runs
-/// once) and adds the route's planning time to the order stage. True when a route was planned:
-/// the plan must then be lowered again, along it.
+/// time law (its pens' speeds and passes) and adds the route's planning time to the order
+/// stage. True when a route was planned: the plan must then be lowered along it.
 fn plan_seed_route(doc: &Document, plan: &mut Plan, ctx: &JobCtx) -> Result<bool, PipelineError> {
-    let s = &doc.settings;
+    let s = &plan.settings;
     if plan.motion != MotionMode::OnTheFly || s.stage_route == StageRouteKind::Taut {
         return Ok(false);
     }
@@ -246,7 +230,7 @@ fn plan_seed_route(doc: &Document, plan: &mut Plan, ctx: &JobCtx) -> Result<bool
     let route = plan_stage_route(
         &doc.geometries,
         plan,
-        &doc.profile,
+        &plan.profile,
         s.stage_route,
         &s.route_ga,
         s.seed,
@@ -271,15 +255,15 @@ fn plan_seed_route(doc: &Document, plan: &mut Plan, ctx: &JobCtx) -> Result<bool
     Ok(true)
 }
 
-/// Lowers `plan` again and computes its metrics on that toolpath (keeping its solve times and
-/// field lower bound); returns the toolpath.
+/// Lowers `plan` again (along its new stage route) and computes its metrics on that toolpath
+/// (keeping its solve times and field lower bound); returns the toolpath.
 fn relower(doc: &Document, plan: &mut Plan) -> Result<Toolpath, PipelineError> {
     let toolpath = lower_plan(doc, plan)?;
     let m = crate::order::metrics::compute(
         &doc.geometries,
         &plan.fields,
         &plan.order,
-        &doc.profile,
+        &plan.profile,
         &toolpath,
     );
     plan.metrics = crate::document::Metrics {
@@ -303,11 +287,11 @@ pub fn place_document_fields(doc: &mut Document, ctx: &JobCtx) -> Result<usize, 
     }
     let file = doc.source.clone().unwrap_or_else(|| "document".into());
     if doc.settings.split_oversize {
-        let warnings = split_oversize(&mut doc.geometries, doc.profile.field_mm);
+        let mut geometries = doc.geometries.clone();
+        let warnings = split_oversize(&mut geometries, doc.profile.field_mm);
         if !warnings.is_empty() {
-            // indices changed: fields and plans of the old geometry list are void
-            doc.fields.clear();
-            doc.plans.clear();
+            // indices changed: the plans keep the geometries they were planned on
+            doc.set_geometries(geometries);
         }
         doc.warnings.extend(warnings);
     }
@@ -350,8 +334,10 @@ pub fn order_document(doc: &Document, ctx: &JobCtx) -> Result<Plan, PipelineErro
     order_document_lowered(doc, ctx).map(|(plan, _)| plan)
 }
 
-/// [`order_document`] with the plan's toolpath, the one its metrics were computed on (what
-/// [`lower_plan`] would make of the plan; lowering once is seconds on large on-the-fly jobs).
+/// [`order_document`] with the plan's toolpath, the one its metrics were computed on. The
+/// plan records the document's inputs ([`PlanInputs`]): pens and passes are part of the time
+/// law from the start, so the objective and every keep-the-faster choice see them, and the
+/// plan is lowered once (twice only when seed 001's route is planned for it afterwards).
 pub fn order_document_lowered(
     doc: &Document,
     ctx: &JobCtx,
@@ -361,32 +347,24 @@ pub fn order_document_lowered(
         r.geometry(&doc.geometries);
         r.fields(&doc.fields);
     }
-    let (mut plan, mut toolpath) = order_plan(
-        &doc.geometries,
-        &doc.fields,
-        &doc.profile,
-        &doc.settings,
-        ctx,
-    )
-    .map_err(|source| PipelineError::Order { file, source })?;
+    let inputs = PlanInputs::of(doc);
+    let (mut plan, mut toolpath) = order_plan(&doc.geometries, &doc.fields, &inputs, ctx)
+        .map_err(|source| PipelineError::Order { file, source })?;
     plan.metrics.solve_s.total = plan.metrics.solve_s.order;
-    // both may change the time law: the plan is lowered again once, after both
-    let timed = apply_pens(doc, &mut plan);
-    let routed = plan_seed_route(doc, &mut plan, ctx)?;
-    if timed || routed {
+    if plan_seed_route(doc, &mut plan, ctx)? {
         toolpath = relower(doc, &mut plan)?;
-    } else {
-        // ordered before the plan had its layers, which do not change the timing here
-        label_layers(&mut toolpath, &doc.geometries, &plan.layers);
     }
     if let Some(r) = ctx.recorder() {
-        r.plan(&plan, &toolpath);
+        let marks: Vec<&[crate::geom::Pt]> = (0..toolpath.strokes.len())
+            .map(|k| toolpath.stroke_points(k))
+            .collect();
+        r.plan(&plan, &marks);
     }
     Ok((plan, toolpath))
 }
 
-/// The machine motion of one of the document's plans, in the motion mode it was planned for
-/// ([`crate::motion::lower_motion`]).
+/// The machine motion of one of the document's plans: on its own geometries, machine, pens
+/// and motion ([`crate::motion::lower_motion`]), whatever the document's current ones.
 pub fn lower_plan(doc: &Document, plan: &Plan) -> Result<Toolpath, PipelineError> {
     lower_plan_on(doc, plan, None)
 }
@@ -397,12 +375,14 @@ pub fn lower_plan_on(
     plan: &Plan,
     clock_s: Option<f64>,
 ) -> Result<Toolpath, PipelineError> {
+    let file = || doc.source.clone().unwrap_or_else(|| "document".into());
+    let geometries = doc
+        .plan_geometries(plan)
+        .ok_or_else(|| PipelineError::LostGeometries { file: file() })?;
     // exports and the GUI's display run to the end: no cancel
     let ctx = JobCtx::default();
-    lower_motion(&doc.geometries, plan, &doc.profile, clock_s, &ctx).map_err(|source| {
-        PipelineError::Lower {
-            file: doc.source.clone().unwrap_or_else(|| "document".into()),
-            source,
-        }
+    lower_motion(geometries, plan, clock_s, &ctx).map_err(|source| PipelineError::Lower {
+        file: file(),
+        source,
     })
 }

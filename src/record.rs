@@ -4,7 +4,6 @@
 use crate::document::{Geometry, Plan, ScanField};
 use crate::geom::Pt;
 use crate::job::RunRecorder;
-use crate::motion::Toolpath;
 use thiserror::Error;
 
 /// The recording could not be created or written.
@@ -84,17 +83,14 @@ impl RunRecorder for RerunRecorder {
         );
     }
 
-    fn plan(&self, plan: &Plan, toolpath: &Toolpath) {
-        let marks: Vec<rerun::LineStrip2D> = (0..toolpath.strokes.len())
-            .map(|k| {
-                rerun::LineStrip2D::from_iter(toolpath.stroke_points(k).iter().map(|&p| xy(p)))
-            })
+    fn plan(&self, plan: &Plan, marks: &[&[Pt]]) {
+        let ends: Vec<(Pt, Pt)> = marks
+            .iter()
+            .filter_map(|pts| Some((*pts.first()?, *pts.last()?)))
             .collect();
-        let ends: Vec<(Pt, Pt)> = (0..toolpath.strokes.len())
-            .filter_map(|k| {
-                let pts = toolpath.stroke_points(k);
-                Some((*pts.first()?, *pts.last()?))
-            })
+        let marks: Vec<rerun::LineStrip2D> = marks
+            .iter()
+            .map(|pts| rerun::LineStrip2D::from_iter(pts.iter().map(|&p| xy(p))))
             .collect();
         let idle: Vec<rerun::LineStrip2D> = ends
             .windows(2)

@@ -496,3 +496,81 @@ fn assert_succeeded(out: &std::process::Output) {
         String::from_utf8_lossy(&out.stderr)
     );
 }
+
+#[test]
+fn an_output_onto_an_input_is_refused_and_the_input_kept() {
+    let dir = tempfile::tempdir().unwrap();
+    let art = dir.path().join("art.svg");
+    std::fs::copy(common::root().join("assets/examples/demo.svg"), &art).unwrap();
+    let before = std::fs::read(&art).unwrap();
+    let a = art.display().to_string();
+    for args in [
+        vec!["plan", &a, "-o", &a],
+        vec!["plan", &a, "-o", "/dev/null", "--report", &a],
+    ] {
+        let out = galvoplan(&args);
+        assert!(!out.status.success());
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains("refusing to write"), "{err}");
+        assert_eq!(std::fs::read(&art).unwrap(), before);
+    }
+    // two outputs onto one file are refused too
+    let g = dir.path().join("job.gcode").display().to_string();
+    let out = galvoplan(&["plan", &a, "-o", &g, "--preview", &g]);
+    assert!(!out.status.success());
+    assert!(!std::path::Path::new(&g).exists());
+}
+
+#[test]
+fn the_report_holds_the_plans_profile_pens_and_settings_and_fields_are_numbered_in_visiting_order()
+{
+    let dir = tempfile::tempdir().unwrap();
+    let d = |n: &str| dir.path().join(n).display().to_string();
+    let root = common::root();
+    let art = root
+        .join("assets/examples/two-layers.svg")
+        .display()
+        .to_string();
+    let pens = root
+        .join("assets/examples/two-layers.pens.toml")
+        .display()
+        .to_string();
+    let out = galvoplan(&[
+        "plan",
+        &art,
+        "--pens",
+        &pens,
+        "-o",
+        &d("j.gcode"),
+        "--report",
+        &d("j.json"),
+    ]);
+    assert_succeeded(&out);
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d("j.json")).unwrap()).unwrap();
+    assert_eq!(r["algo"], "hha");
+    assert_eq!(r["profile"]["field_mm"][0], 70.0);
+    assert!(r["settings"]["cost_model"].is_string());
+    let pens = r["pens"].as_array().unwrap();
+    assert_eq!(pens.len(), 2);
+    assert!(pens
+        .iter()
+        .any(|l| l["name"] == "fill" && l["mark_speed_mm_s"] == 600.0));
+    // the G-code numbers fields 1…n in visiting order, as the report's field numbers
+    let g = std::fs::read_to_string(d("j.gcode")).unwrap();
+    let numbers: Vec<usize> = g
+        .lines()
+        .filter_map(|l| l.strip_prefix("; field "))
+        .map(|l| l.split_whitespace().next().unwrap().parse().unwrap())
+        .collect();
+    let n = r["fields"].as_array().unwrap().len();
+    assert_eq!(numbers, (1..=n).collect::<Vec<_>>());
+    for (k, f) in r["fields"].as_array().unwrap().iter().enumerate() {
+        assert_eq!(f["number"], k + 1);
+    }
+    let summary = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !summary.contains("1 fields") && !summary.contains("1 geometries"),
+        "{summary}"
+    );
+}

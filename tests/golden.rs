@@ -30,7 +30,6 @@ fn gcode_for(profile: MachineProfile, settings: SolverSettings) -> String {
     write_gcode(
         &lower_plan(&doc, &plan).unwrap(),
         &plan,
-        &doc.profile,
         doc.page_mm[1],
         "small.svg",
     )

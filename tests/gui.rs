@@ -251,7 +251,7 @@ fn invalid_profile_and_settings_input_is_rejected() {
     assert!(h.query_by_label_contains("field_mm").is_none());
     assert_eq!(h.state().doc.profile.field_mm, [70.0, 70.0]);
     set_text(&mut h, "Field width (mm)", "abc");
-    h.get_by_label_contains("Field width (mm): 'abc' is not a number");
+    h.get_by_label_contains("Field width (mm) must be a number, not 'abc'");
     assert_eq!(h.state().doc.profile.field_mm, [70.0, 70.0]);
     section(&mut h, "Solver settings");
     set_text(&mut h, "GA mutation rate", "1.5");
@@ -750,10 +750,10 @@ fn the_motion_switch_plans_on_the_fly() {
     assert_eq!(h.state().doc.settings.motion, MotionMode::OnTheFly);
     // the step plan keeps the motion it was planned for
     let kept = h.state().toolpath(0).unwrap().unwrap().clone();
-    assert!(!kept.on_the_fly() && kept.job_time_mismatch_s(&step).is_none());
-    assert!(h
-        .query_by_label_contains("toolpath re-lowered with current settings")
-        .is_none());
+    assert!(!kept.on_the_fly());
+    assert_eq!(Some(kept.duration_s()), step.metrics.job_time_s);
+    // ... and says that the motion setting changed since
+    h.get_by_label_contains("is stale: motion step-and-scan → on the fly");
     // the solve uses the setting: a route, and another job time than the step plan's
     let otf = solve(&mut h, "Run HHA");
     let l = h.state().toolpath(1).unwrap().unwrap().clone();
@@ -766,11 +766,7 @@ fn the_motion_switch_plans_on_the_fly() {
         (t_otf - t_step).abs() > 0.01 * t_step,
         "{t_otf} s vs {t_step} s"
     );
-    assert!(
-        l.job_time_mismatch_s(&otf).is_none(),
-        "{} s",
-        l.duration_s()
-    );
+    assert_eq!(Some(l.duration_s()), otf.metrics.job_time_s);
     // the compare view puts both side by side, each with the job time of its solve
     h.get_by_label("Compare").click();
     h.run();
@@ -778,7 +774,6 @@ fn the_motion_switch_plans_on_the_fly() {
         let text = format!("{t_s:.3}");
         assert!(h.query_all_by_label(&text).count() >= 1, "{text}");
     }
-    assert!(h.query_by_label_contains("re-lowered").is_none());
     // one undoable settings step back to step-and-scan
     h.get_by_label("Workbench").click();
     h.run();
@@ -889,7 +884,7 @@ fn hatch_settings_in_the_layers_panel_rehatch_the_document() {
         .all(|g| g.layer == "fill"));
     assert!(h.state().uncovered().is_empty());
     // a finer spacing hatches again with more strokes
-    enter_nth(&mut h, "Spacing (mm)", 0, "0.25");
+    enter_nth(&mut h, "Hatch spacing (mm)", 0, "0.25");
     wait_idle(&mut h, Duration::from_secs(60));
     let finer = h.state().doc.geometries.len();
     let len = |doc: &galvoplan::document::Document| -> f64 {
@@ -934,7 +929,7 @@ fn a_disabled_layer_is_left_out_and_pens_change_at_once() {
     assert!(!h.state().doc.layers[1].pen.enabled);
     assert_eq!(h.state().doc.geometries.len(), all - fill);
     // a speed is a pen change only: no job, the geometries stay
-    enter_nth(&mut h, "Speed (mm/s)", 0, "750");
+    enter_nth(&mut h, "Mark speed (mm/s)", 0, "750");
     h.run();
     assert!(!h.state().is_busy());
     assert_eq!(h.state().doc.layers[0].pen.mark_speed_mm_s, Some(750.0));
@@ -952,7 +947,7 @@ fn a_rejected_pen_value_shows_a_worded_error() {
     h.run();
     h.get_by_label("Layer 'fill': Passes must be a whole number from 1 to 100, not 0");
     assert_eq!(h.state().doc.layers, before);
-    enter_nth(&mut h, "Speed (mm/s)", 0, "fast");
+    enter_nth(&mut h, "Mark speed (mm/s)", 0, "fast");
     h.run();
     h.get_by_label("Layer 'outline': Mark speed (mm/s) must be a number, not 'fast'");
     assert_eq!(h.state().doc.layers, before);
@@ -1035,7 +1030,8 @@ fn exporting_a_stale_plan_asks_first() {
     h.run();
     h.key_press_modifiers(ctrl(), Key::E);
     h.run();
-    h.get_by_label("Export a stale plan?");
+    h.get_by_label("The plan shown is stale");
+    h.get_by_label("• the scan fields changed");
 }
 
 #[test]
@@ -1071,4 +1067,167 @@ fn a_dropped_dxf_opens_with_its_layers() {
     assert_eq!(doc.geometries.len(), 26, "{}", h.state().status());
     assert!(doc.geometries.iter().any(|g| g.source.layer == "CUT"));
     assert!(!doc.fields.is_empty());
+}
+
+/// two-layers.svg solved with HHA, native dialogs off (file actions ask for a path).
+fn two_layers_solved() -> Harness<'static, App> {
+    let mut app = App::default();
+    app.set_native_dialogs(false);
+    assert!(app.open(&two_layers()), "{}", app.status());
+    let mut h = harness(app);
+    h.run();
+    solve(&mut h, "Run HHA");
+    h
+}
+
+#[test]
+fn a_pen_edit_makes_the_plan_stale_and_re_solve_and_export_writes_the_new_feed() {
+    let mut h = two_layers_solved();
+    assert!(h.state().plan_staleness(0).is_empty());
+    enter_nth(&mut h, "Mark speed (mm/s)", 1, "300");
+    h.run();
+    // stale, with the reason in words, in the plan list and under the metrics
+    assert_eq!(
+        h.state().plan_staleness(0),
+        ["fill: mark speed unset → 300 mm/s"]
+    );
+    h.get_by_label("stale");
+    h.get_by_label_contains("HHA #1 is stale: fill: mark speed unset → 300 mm/s since it was made");
+    // export asks; re-solving is the default answer and writes the new feed
+    h.key_press_modifiers(ctrl(), Key::E);
+    h.run();
+    h.get_by_label("The plan shown is stale");
+    h.get_by_label("• fill: mark speed unset → 300 mm/s");
+    h.get_by_label("Re-solve and export").click();
+    h.run();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("job.gcode");
+    enter_nth(&mut h, "File path", 0, &out.display().to_string());
+    wait_idle(&mut h, Duration::from_secs(120));
+    wait_idle(&mut h, Duration::from_secs(120));
+    let g = std::fs::read_to_string(&out).unwrap_or_else(|e| panic!("{e}: {}", h.state().status()));
+    assert!(g.contains(" F18000"), "no feed of 300 mm/s in the G-code");
+    assert_eq!(h.state().doc.plans.len(), 2);
+    assert!(h.state().plan_staleness(1).is_empty());
+    assert!(h.state().plan_staleness(0).len() == 1);
+    let job_s = h.state().doc.plans[1].metrics.job_time_s.unwrap();
+    assert!(g.contains(&format!("job time {job_s:.3} s")));
+}
+
+#[test]
+fn a_profile_edit_makes_the_headline_stale() {
+    let mut h = two_layers_solved();
+    section(&mut h, "Machine profile");
+    set_text(&mut h, "Base X max velocity (mm/s)", "100");
+    h.run();
+    assert_eq!(h.state().doc.profile.axis_x.max_velocity_mm_s, 100.0);
+    let why = h.state().plan_staleness(0).to_vec();
+    assert_eq!(why.len(), 1, "{why:?}");
+    assert!(why[0].starts_with("base x max velocity ") && why[0].ends_with("→ 100 mm/s"));
+    h.get_by_label_contains("HHA #1 is stale: base x max velocity");
+    h.get_by_label("stale");
+    // the plan keeps the figures and the toolpath of its own profile
+    let plan = h.state().doc.plans[0].clone();
+    let l = h.state().toolpath(0).unwrap().unwrap().clone();
+    assert_eq!(Some(l.duration_s()), plan.metrics.job_time_s);
+}
+
+#[test]
+fn exports_never_overwrite_the_artwork() {
+    let mut h = two_layers_solved();
+    let source = two_layers();
+    let before = std::fs::read(&source).unwrap();
+    h.state_mut().request_export(
+        galvoplan::app::files::ExportKind::Preview,
+        &egui::Context::default(),
+    );
+    h.run();
+    let Some(galvoplan::app::Prompt::Path { text, .. }) = h.state().prompt().cloned() else {
+        panic!("no path field: {:?}", h.state().prompt());
+    };
+    assert!(text.ends_with("two-layers.preview.svg"), "{text}");
+    // typing the artwork's own path is refused and the file is unchanged
+    h.get_by_label("Cancel").click();
+    h.run();
+    let e = h
+        .state_mut()
+        .export(galvoplan::app::files::ExportKind::Preview, &source)
+        .unwrap_err();
+    assert!(e.contains("refusing"), "{e}");
+    h.state_mut().export_in_background(
+        galvoplan::app::files::ExportKind::Preview,
+        &source,
+        &egui::Context::default(),
+    );
+    h.run();
+    assert!(
+        h.state().status().contains("refusing"),
+        "{}",
+        h.state().status()
+    );
+    assert_eq!(std::fs::read(&source).unwrap(), before);
+}
+
+#[test]
+fn a_hatch_edit_keeps_the_plans_and_marks_them_stale() {
+    let mut h = two_layers_solved();
+    nth_by_label(&h, "Hatch", 1).click();
+    h.run();
+    h.get_by_label("zigzag").click();
+    h.step();
+    wait_idle(&mut h, Duration::from_secs(60));
+    assert_eq!(h.state().doc.plans.len(), 1);
+    let why = h.state().plan_staleness(0);
+    assert!(
+        why.iter().any(|w| w.starts_with("the geometries changed")),
+        "{why:?}"
+    );
+    assert!(
+        why.iter()
+            .any(|w| w.starts_with("fill: hatch none → zigzag")),
+        "{why:?}"
+    );
+    // the plan is still drawn and exported on the geometries it was planned on
+    let plan = h.state().doc.plans[0].clone();
+    assert_eq!(
+        Some(h.state().toolpath(0).unwrap().unwrap().duration_s()),
+        plan.metrics.job_time_s
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("as-planned.gcode");
+    h.state_mut()
+        .export(galvoplan::app::files::ExportKind::Gcode, &out)
+        .unwrap();
+    assert!(std::fs::read_to_string(&out).unwrap().contains(&format!(
+        "job time {:.3} s",
+        plan.metrics.job_time_s.unwrap()
+    )));
+}
+
+#[test]
+fn the_status_of_a_delete_names_the_field_as_the_canvas_does() {
+    use galvoplan::app::field_number;
+    let mut h = opened(&demo());
+    solve(&mut h, "Run HHA");
+    let fields = h.state().doc.fields.clone();
+    let visiting = h.state().active_plan().unwrap().fields.clone();
+    // a field whose visiting number is not its placement number
+    let f = fields
+        .iter()
+        .find(|f| field_number(&fields, Some(&visiting), f.id) != field_number(&fields, None, f.id))
+        .expect("the plan visits the fields in another order than placed");
+    let label = field_number(&fields, Some(&visiting), f.id);
+    assert_eq!(h.state().field_label(f.id), label);
+    h.state_mut()
+        .execute(Command::DeleteField { id: f.id })
+        .unwrap();
+    h.run();
+    assert!(
+        h.state()
+            .status()
+            .starts_with(&format!("delete field {label}:")),
+        "{}",
+        h.state().status()
+    );
+    assert_eq!(h.state().doc.plans.len(), 1);
 }

@@ -12,9 +12,9 @@
 
 mod common;
 
+use galvoplan::bench::hatch::read_contours;
 use galvoplan::document::{MachineProfile, SolverSettings};
 use galvoplan::geom::{point_segment_dist, star_polygon as star, Pt};
-use galvoplan::hatch::bench::read_contours;
 use galvoplan::hatch::{
     hatch_contours, FillRule, HatchSettings, HatchStroke, HatchStyle, OutlineMode, RegionHatch,
     StrokeKind,

@@ -82,11 +82,14 @@ fn stage_scanner_gcode_marks_what_the_tcp_gcode_marks() {
         profile.gcode.flip_y = flip;
         let (doc, plan) = plan_example("demo.svg", profile, SolverSettings::default());
         let toolpath = lower_plan(&doc, &plan).unwrap();
-        let tcp = write_gcode(&toolpath, &plan, &doc.profile, doc.page_mm[1], "t").unwrap();
+        let tcp = write_gcode(&toolpath, &plan, doc.page_mm[1], "t").unwrap();
         let mut p2 = doc.profile.clone();
         p2.gcode.mode = GcodeMode::StageScanner;
         p2.gcode.scanner_axes = ["A".into(), "B".into()];
-        let split = write_gcode(&toolpath, &plan, &p2, doc.page_mm[1], "t").unwrap();
+        // the same plan written in another dialect (the dialect does not change the timing)
+        let mut in_p2 = plan.clone();
+        in_p2.profile = p2;
+        let split = write_gcode(&toolpath, &in_p2, doc.page_mm[1], "t").unwrap();
         assert!(
             split.contains("G0 A") && split.contains("G1 A"),
             "scanner words"
@@ -139,7 +142,7 @@ fn trajectory_marks_the_gcode_path() {
     );
     let toolpath = lower_plan(&doc, &plan).unwrap();
     let marks = gcode_marks(
-        &write_gcode(&toolpath, &plan, &doc.profile, doc.page_mm[1], "t").unwrap(),
+        &write_gcode(&toolpath, &plan, doc.page_mm[1], "t").unwrap(),
         None,
     );
     let period_s = 1e-3;
@@ -363,11 +366,11 @@ fn on_the_fly_keeps_the_scanner_in_reach_and_the_stage_within_its_limits() {
         );
     }
     // no stage-scanner G-code on the fly, a clear error instead
-    let mut split = doc.profile.clone();
-    split.gcode.mode = GcodeMode::StageScanner;
-    let e = write_gcode(&path, &plan, &split, 300.0, "t").unwrap_err();
+    let mut split = plan.clone();
+    split.profile.gcode.mode = GcodeMode::StageScanner;
+    let e = write_gcode(&path, &split, 300.0, "t").unwrap_err();
     assert!(e.to_string().contains("step-and-scan"), "{e}");
-    assert!(write_gcode(&path, &plan, &doc.profile, 300.0, "t").is_ok());
+    assert!(write_gcode(&path, &plan, 300.0, "t").is_ok());
 }
 
 #[test]

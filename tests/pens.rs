@@ -78,7 +78,7 @@ fn two_layers_plan_with_their_pens() {
     assert!((plan.metrics.marked_mm - marked).abs() < 1e-6);
     // the G-code carries both powers and both feeds
     let toolpath = lower_plan(&doc, &plan).unwrap();
-    let g = write_gcode(&toolpath, &plan, &doc.profile, doc.page_mm[1], "t").unwrap();
+    let g = write_gcode(&toolpath, &plan, doc.page_mm[1], "t").unwrap();
     assert!(g.contains("\nM3 S40\n") && g.contains("\nM3 S85\n"));
     assert!(g.contains(" F90000\n") && g.contains(" F36000\n"));
     assert!(g.contains("; layer fill: mark speed 600 mm/s, passes 2, pulse frequency 60 kHz"));

@@ -38,16 +38,11 @@ fn demo_plans_and_checks() {
     assert!(m.overlap_pct >= 0.0 && m.overlap_pct < 100.0);
     // idle_mm equals the sum of the G-code's laser-off travel between strokes
     let toolpath = lower_plan(&doc, &plan).unwrap();
-    let g = write_gcode(&toolpath, &plan, &doc.profile, doc.page_mm[1], "demo").unwrap();
+    let g = write_gcode(&toolpath, &plan, doc.page_mm[1], "demo").unwrap();
     assert!(g.starts_with("; galvoplan"));
     assert!(g.contains("G21\nG90\n"));
-    let report: serde_json::Value = serde_json::from_str(&report_json(
-        "demo.svg",
-        &plan,
-        &doc.settings,
-        &doc.warnings,
-    ))
-    .unwrap();
+    let report: serde_json::Value =
+        serde_json::from_str(&report_json("demo.svg", &plan, &doc.warnings)).unwrap();
     assert_eq!(
         report["order"].as_array().unwrap().len(),
         doc.geometries.len()

@@ -161,8 +161,8 @@ pub struct Canvas<'a> {
     pub add_tool: bool,
     /// Layers.
     pub layers: Layers,
-    /// The path was planned on other fields than those shown.
-    pub stale: bool,
+    /// What changed since the path was planned (empty: it is current).
+    pub stale: &'a [String],
     /// Playback time: the machine is drawn at this job time (`None`: the planned path only).
     pub playback_t_s: Option<f64>,
 }

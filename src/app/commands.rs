@@ -7,12 +7,11 @@
 //! together.
 
 use crate::document::{
-    validate_layers, DerivedKey, Document, Geometry, Layer, MachineProfile, Plan, ScanField,
-    SolverSettings,
+    validate_layers, DerivedKey, Document, Geometry, GeometryRevision, Layer, MachineProfile, Plan,
+    ScanField, SolverSettings, Warning,
 };
 use crate::fields::{add_field, delete_field, move_field, reallocate, set_locked};
 use crate::geom::Pt;
-use crate::import::Warning;
 use crate::job::JobCtx;
 use crate::pipeline::place_document_fields;
 
@@ -68,14 +67,15 @@ pub enum Command {
 }
 
 impl Command {
-    /// A short description for the status line and the undo menu.
-    pub fn describe(&self) -> String {
+    /// A short description for the status line and the undo menu; `number` gives the number
+    /// the canvas shows for a field id.
+    pub fn describe(&self, number: &dyn Fn(usize) -> usize) -> String {
         match self {
-            Command::MoveField { id, .. } => format!("move field {id}"),
+            Command::MoveField { id, .. } => format!("move field {}", number(*id)),
             Command::AddField { .. } => "add field".into(),
-            Command::DeleteField { id } => format!("delete field {id}"),
-            Command::SetLocked { id, locked: true } => format!("lock field {id}"),
-            Command::SetLocked { id, locked: false } => format!("unlock field {id}"),
+            Command::DeleteField { id } => format!("delete field {}", number(*id)),
+            Command::SetLocked { id, locked: true } => format!("lock field {}", number(*id)),
+            Command::SetLocked { id, locked: false } => format!("unlock field {}", number(*id)),
             Command::ReplaceAutomatically => "re-place fields automatically".into(),
             Command::SetProfile(_) => "change machine profile".into(),
             Command::SetSettings(_) => "change solver settings".into(),
@@ -120,7 +120,8 @@ pub fn apply(doc: &mut Document, cmd: &Command) -> Result<Outcome, String> {
         }
         Command::ReplaceAutomatically => {
             let mut work = doc.clone();
-            place_document_fields(&mut work, &JobCtx::default()).map_err(|e| e.to_string())?;
+            place_document_fields(&mut work, &JobCtx::default())
+                .map_err(|e| super::gui_error(&e))?;
             *doc = work;
             Ok(uncovered(reallocate(doc)))
         }
@@ -150,12 +151,46 @@ pub fn apply(doc: &mut Document, cmd: &Command) -> Result<Outcome, String> {
         Command::SetContent { doc: new, .. } => {
             new.validate().map_err(|e| e.to_string())?;
             doc.geometries = new.geometries.clone();
+            doc.geometry_rev = new.geometry_rev;
+            doc.kept_geometries = new.kept_geometries.clone();
             doc.layers = new.layers.clone();
             doc.derived_with = new.derived_with.clone();
             doc.fields = new.fields.clone();
             doc.plans = new.plans.clone();
             doc.warnings = new.warnings.clone();
             Ok(uncovered(reallocate(doc)))
+        }
+    }
+}
+
+/// The geometries (with their revision and the kept revisions), plans and warnings.
+#[derive(Debug, Clone)]
+struct Content {
+    geometries: Vec<Geometry>,
+    geometry_rev: u64,
+    kept_geometries: Vec<GeometryRevision>,
+    plans: Vec<Plan>,
+    warnings: Vec<Warning>,
+}
+
+impl Content {
+    fn of(doc: &Document) -> Self {
+        Self {
+            geometries: doc.geometries.clone(),
+            geometry_rev: doc.geometry_rev,
+            kept_geometries: doc.kept_geometries.clone(),
+            plans: doc.plans.clone(),
+            warnings: doc.warnings.clone(),
+        }
+    }
+    /// Puts this content into the document and returns what it replaced.
+    fn swap(self, doc: &mut Document) -> Self {
+        Self {
+            geometries: std::mem::replace(&mut doc.geometries, self.geometries),
+            geometry_rev: std::mem::replace(&mut doc.geometry_rev, self.geometry_rev),
+            kept_geometries: std::mem::replace(&mut doc.kept_geometries, self.kept_geometries),
+            plans: std::mem::replace(&mut doc.plans, self.plans),
+            warnings: std::mem::replace(&mut doc.warnings, self.warnings),
         }
     }
 }
@@ -169,23 +204,17 @@ struct Snapshot {
     layers: Vec<Layer>,
     derived_with: Option<DerivedKey>,
     /// Geometries, plans and warnings, for commands that can rewrite them.
-    content: Option<(Vec<Geometry>, Vec<Plan>, Vec<Warning>)>,
+    content: Option<Content>,
     what: String,
 }
 
 impl Snapshot {
-    fn take(doc: &Document, cmd: &Command) -> Self {
+    fn take(doc: &Document, cmd: &Command, what: String) -> Self {
         let rewrites = matches!(
             cmd,
             Command::ReplaceAutomatically | Command::SetContent { .. }
         );
-        let content = rewrites.then(|| {
-            (
-                doc.geometries.clone(),
-                doc.plans.clone(),
-                doc.warnings.clone(),
-            )
-        });
+        let content = rewrites.then(|| Content::of(doc));
         Self {
             fields: doc.fields.clone(),
             profile: doc.profile.clone(),
@@ -193,18 +222,12 @@ impl Snapshot {
             layers: doc.layers.clone(),
             derived_with: doc.derived_with.clone(),
             content,
-            what: cmd.describe(),
+            what,
         }
     }
     /// Puts the snapshot into the document and returns the snapshot of what it replaced.
     fn swap(self, doc: &mut Document) -> Snapshot {
-        let content = self.content.map(|(g, p, w)| {
-            (
-                std::mem::replace(&mut doc.geometries, g),
-                std::mem::replace(&mut doc.plans, p),
-                std::mem::replace(&mut doc.warnings, w),
-            )
-        });
+        let content = self.content.map(|c| c.swap(doc));
         Snapshot {
             fields: std::mem::replace(&mut doc.fields, self.fields),
             profile: std::mem::replace(&mut doc.profile, self.profile),
@@ -227,16 +250,18 @@ pub struct History {
 }
 
 impl History {
-    /// Runs a command; on success records the state before it (unless `group` equals the
-    /// group of the newest entry, which then covers this command too). Clears the redo stack.
+    /// Runs a command; on success records the state before it under `what` (unless `group`
+    /// equals the group of the newest entry, which then covers this command too). Clears the
+    /// redo stack.
     pub fn execute(
         &mut self,
         doc: &mut Document,
         cmd: Command,
         group: Option<u64>,
+        what: String,
     ) -> Result<Outcome, String> {
         let coalesce = group.is_some() && group == self.open_group && !self.undo.is_empty();
-        let before = (!coalesce).then(|| Snapshot::take(doc, &cmd));
+        let before = (!coalesce).then(|| Snapshot::take(doc, &cmd, what));
         let outcome = apply(doc, &cmd)?;
         if let Some(s) = before {
             self.undo.push(s);
@@ -317,6 +342,7 @@ mod tests {
                     center: Pt::new(35.0, 35.0),
                 },
                 None,
+                "add field".into(),
             )
             .unwrap();
         assert_eq!(out.uncovered, vec![1]);
@@ -330,6 +356,7 @@ mod tests {
                     center: Pt::new(x, 151.0),
                 },
                 Some(7),
+                "move field 0".into(),
             )
             .unwrap();
         }
@@ -351,13 +378,18 @@ mod tests {
         let mut d = doc();
         let mut h = History::default();
         assert!(h
-            .execute(&mut d, Command::DeleteField { id: 3 }, None)
+            .execute(&mut d, Command::DeleteField { id: 3 }, None, "edit".into())
             .is_err());
         assert!(h.undo_label().is_none());
         let mut bad = MachineProfile::default();
         bad.field_mm[0] = -1.0;
         assert!(h
-            .execute(&mut d, Command::SetProfile(Box::new(bad)), None)
+            .execute(
+                &mut d,
+                Command::SetProfile(Box::new(bad)),
+                None,
+                "edit".into()
+            )
             .is_err());
         assert_eq!(d.profile, MachineProfile::default());
     }
@@ -366,14 +398,19 @@ mod tests {
     fn profile_change_resizes_fields_and_undoes() {
         let mut d = doc();
         let mut h = History::default();
-        h.execute(&mut d, Command::ReplaceAutomatically, None)
+        h.execute(&mut d, Command::ReplaceAutomatically, None, "edit".into())
             .unwrap();
         assert!(!d.fields.is_empty());
         let mut p = d.profile.clone();
         p.field_mm = [30.0, 30.0];
         p.stroke_mm = [100.0, 100.0];
-        h.execute(&mut d, Command::SetProfile(Box::new(p)), None)
-            .unwrap();
+        h.execute(
+            &mut d,
+            Command::SetProfile(Box::new(p)),
+            None,
+            "edit".into(),
+        )
+        .unwrap();
         assert!(d
             .fields
             .iter()

@@ -296,27 +296,24 @@ fn value_cell(ui: &mut egui::Ui, row: &Row, mine: Option<f64>, other: Option<f64
     }
 }
 
-/// A visible note under a metrics table for each plan whose toolpath (lowered with the
-/// current settings, the one drawn and played) does not have the job time of its solve, which
-/// the table shows.
-pub fn relowered_notes(ui: &mut egui::Ui, plans: &[(&Plan, Option<Result<&Lowered, &str>>)]) {
-    for (plan, lowered) in plans {
-        let Some(Ok(l)) = lowered else { continue };
-        if let Some((stored_s, now_s)) = l.job_time_mismatch_s(plan) {
-            ui.label(
-                RichText::new(format!(
-                    "{}: {}",
-                    plan.name,
-                    super::paint::relowered_note(stored_s, now_s)
-                ))
-                .small()
-                .color(Color32::from_rgb(180, 83, 9)),
-            )
-            .on_hover_text(
-                "The table shows the job time computed when the plan was solved; the canvas and \
-                 the playback use the toolpath lowered with the current motion mode and profile.",
-            );
-        }
+/// A visible note under a metrics table for each stale plan: what changed since it was made
+/// (its figures are those of its own inputs, not of the document's current ones).
+pub fn stale_notes(ui: &mut egui::Ui, plans: &[(&Plan, &[String])]) {
+    for (plan, why) in plans {
+        let Some(first) = why.first() else { continue };
+        let more = match why.len() {
+            1 => String::new(),
+            n => format!(" (and {} more)", n - 1),
+        };
+        ui.label(
+            RichText::new(format!(
+                "{} is stale: {first} since it was made{more}",
+                plan.name
+            ))
+            .small()
+            .color(super::layout::STALE),
+        )
+        .on_hover_text(super::layout::stale_text(why));
     }
 }
 
@@ -443,14 +440,17 @@ fn toolbar(ui: &mut egui::Ui, st: &mut CompareState, plans: &[Plan]) {
     });
 }
 
-/// The whole compare view; `toolpaths` holds the plans' lowered toolpaths.
+/// The whole compare view; `toolpaths` holds the plans' lowered toolpaths, `stale` what
+/// changed since each plan was made.
 pub fn show(
     ui: &mut egui::Ui,
     st: &mut CompareState,
     doc: &Document,
     toolpaths: &ToolpathCache,
+    stale: &[Vec<String>],
     layers: Layers,
 ) {
+    let stale_of = |k: usize| stale.get(k).map_or(&[][..], Vec::as_slice);
     st.fix(doc.plans.len());
     toolbar(ui, st, &doc.plans);
     let Some((ka, kb)) = shown(st, doc.plans.len()) else {
@@ -484,7 +484,7 @@ pub fn show(
         editable: false,
         add_tool: false,
         layers,
-        stale: false,
+        stale: stale_of(k),
         playback_t_s,
     };
     // the metrics table's height (17 rows), or less on a small window (it scrolls then)
@@ -523,11 +523,11 @@ pub fn show(
                 .max_height(bottom)
                 .show(ui, |ui| {
                     metrics_table(ui, "compare-metrics", a, b);
-                    let mut notes = vec![(a, toolpaths.get(ka))];
+                    let mut notes = vec![(a, stale_of(ka))];
                     if let (Some(b), Some(kb)) = (b, kb) {
-                        notes.push((b, toolpaths.get(kb)));
+                        notes.push((b, stale_of(kb)));
                     }
-                    relowered_notes(ui, &notes);
+                    stale_notes(ui, &notes);
                 });
         });
         ui.separator();

@@ -3,10 +3,12 @@
 //! operation is also reachable through the [`App`](super::App) methods that take a path.
 
 use crate::document::{load_project, write_atomic, Document, MachineProfile, Plan, SolverSettings};
-use crate::export::{preview_svg, report_json, write_gcode};
+use crate::export::{preview_svg, report_json, trajectory_csv, trajectory_period_s, write_gcode};
 use crate::import::ImportOptions;
 use crate::job::JobCtx;
+use crate::motion::Toolpath;
 use crate::pipeline::{load_svg, place_document_fields};
+use crate::pipeline::{lower_plan, lower_plan_on};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -71,7 +73,7 @@ pub fn open(
             Err(e) if ctx.is_cancelled() => {
                 return Err(format!("{}: cancelled ({e})", path.display()))
             }
-            Err(e) => Some(e.to_string()),
+            Err(e) => Some(super::gui_error(&e)),
         };
         Ok(Opened {
             doc,
@@ -89,7 +91,7 @@ pub fn open(
 }
 
 /// What can be exported from a plan.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub enum ExportKind {
     /// G-code of the TCP path.
     Gcode,
@@ -97,6 +99,8 @@ pub enum ExportKind {
     Report,
     /// An SVG preview of the planned path.
     Preview,
+    /// The stage and scanner trajectory sampled every millisecond (CSV).
+    Trajectory,
 }
 
 impl ExportKind {
@@ -106,25 +110,97 @@ impl ExportKind {
             ExportKind::Gcode => ("G-code", "gcode"),
             ExportKind::Report => ("JSON report", "json"),
             ExportKind::Preview => ("SVG preview", "svg"),
+            ExportKind::Trajectory => ("trajectory", "csv"),
         }
+    }
+    /// The default file name's ending after the artwork's stem: never the artwork's own
+    /// (`demo.svg` → `demo.preview.svg`, not `demo.svg`).
+    pub fn suffix(self) -> &'static str {
+        match self {
+            ExportKind::Gcode => "gcode",
+            ExportKind::Report => "report.json",
+            ExportKind::Preview => "preview.svg",
+            ExportKind::Trajectory => "trajectory.csv",
+        }
+    }
+    /// Every kind, in menu order.
+    pub const ALL: [ExportKind; 4] = [
+        ExportKind::Gcode,
+        ExportKind::Report,
+        ExportKind::Preview,
+        ExportKind::Trajectory,
+    ];
+}
+
+/// The folder last exported to, per kind of export (kept between runs).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct ExportDirs(pub Vec<(ExportKind, PathBuf)>);
+
+impl ExportDirs {
+    /// Remembers the folder of `path` for `kind`.
+    pub fn remember(&mut self, kind: ExportKind, path: &Path) {
+        let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) else {
+            return;
+        };
+        let dir = std::fs::canonicalize(dir).unwrap_or_else(|_| dir.to_path_buf());
+        self.0.retain(|(k, _)| *k != kind);
+        self.0.push((kind, dir));
+    }
+    /// The folder last used for `kind`.
+    pub fn get(&self, kind: ExportKind) -> Option<&Path> {
+        self.0
+            .iter()
+            .find(|(k, _)| *k == kind)
+            .map(|(_, d)| d.as_path())
     }
 }
 
-/// The text of an export, from the plan's lowered toolpath.
-pub fn export_text(doc: &Document, plan: &Plan, kind: ExportKind) -> Result<String, String> {
+/// The text of an export of `plan` as planned (its own profile, pens and settings), from its
+/// lowered toolpath (`toolpath`, else lowered here; a trajectory is lowered on its clock).
+pub fn export_text(
+    doc: &Document,
+    plan: &Plan,
+    toolpath: Option<&Toolpath>,
+    kind: ExportKind,
+) -> Result<String, String> {
     let source = doc.source.clone().unwrap_or_else(|| "document".into());
-    let toolpath = crate::pipeline::lower_plan(doc, plan).map_err(|e| e.to_string())?;
+    if kind == ExportKind::Report {
+        return Ok(report_json(&source, plan, &doc.warnings));
+    }
+    let lowered;
+    let toolpath = match (kind, toolpath) {
+        (ExportKind::Trajectory, _) => {
+            let period_s = trajectory_period_s(1.0).map_err(|e| e.to_string())?;
+            lowered = lower_plan_on(doc, plan, Some(period_s)).map_err(|e| e.to_string())?;
+            &lowered
+        }
+        (_, Some(t)) => t,
+        (_, None) => {
+            lowered = lower_plan(doc, plan).map_err(|e| e.to_string())?;
+            &lowered
+        }
+    };
     Ok(match kind {
-        ExportKind::Gcode => write_gcode(&toolpath, plan, &doc.profile, doc.page_mm[1], &source)
+        ExportKind::Gcode => write_gcode(toolpath, plan, doc.page_mm[1], &source)
             .map_err(|e| format!("{source}: {e}"))?,
-        ExportKind::Report => report_json(&source, plan, &doc.settings, &doc.warnings),
-        ExportKind::Preview => preview_svg(&toolpath, plan, doc.page_mm),
+        ExportKind::Preview => preview_svg(toolpath, plan, doc.page_mm),
+        ExportKind::Trajectory => {
+            let period_s = trajectory_period_s(1.0).map_err(|e| e.to_string())?;
+            trajectory_csv(toolpath, period_s)
+        }
+        ExportKind::Report => report_json(&source, plan, &doc.warnings),
     })
 }
 
 /// Writes an export atomically.
-pub fn export(doc: &Document, plan: &Plan, kind: ExportKind, path: &Path) -> Result<(), String> {
-    write_atomic(path, export_text(doc, plan, kind)?.as_bytes())
+pub fn export(
+    doc: &Document,
+    plan: &Plan,
+    toolpath: Option<&Toolpath>,
+    kind: ExportKind,
+    path: &Path,
+) -> Result<(), String> {
+    write_atomic(path, export_text(doc, plan, toolpath, kind)?.as_bytes())
         .map_err(|e| format!("{}: cannot write: {e}", path.display()))
 }
 
@@ -161,16 +237,24 @@ pub fn native_dialogs_available() -> bool {
     bus_env || bus_socket
 }
 
-/// A save dialog for one kind of file.
-pub fn pick_save(filter: &str, ext: &str, default_name: &str) -> Option<PathBuf> {
-    rfd::FileDialog::new()
+/// A save dialog for one kind of file, in `folder` when given.
+pub fn pick_save(
+    filter: &str,
+    ext: &str,
+    default_name: &str,
+    folder: Option<&Path>,
+) -> Option<PathBuf> {
+    let mut d = rfd::FileDialog::new()
         .add_filter(filter, &[ext])
-        .set_file_name(default_name)
-        .save_file()
+        .set_file_name(default_name);
+    if let Some(f) = folder {
+        d = d.set_directory(f);
+    }
+    d.save_file()
 }
 
-/// A default file name next to the source: `demo.svg` → `demo.<ext>`.
-pub fn default_name(doc: &Document, ext: &str) -> String {
+/// A default file name after the source's stem: `demo.svg` → `demo.<ending>`.
+pub fn default_name(doc: &Document, ending: &str) -> String {
     let stem = doc
         .source
         .as_deref()
@@ -178,5 +262,5 @@ pub fn default_name(doc: &Document, ext: &str) -> String {
         .and_then(Path::file_stem)
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "job".into());
-    format!("{stem}.{ext}")
+    format!("{stem}.{ending}")
 }

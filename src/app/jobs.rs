@@ -148,15 +148,14 @@ impl Job {
         let mut snapshot = Document {
             source: doc.source.clone(),
             page_mm: doc.page_mm,
-            artwork: Vec::new(),
             layers: doc.layers.clone(),
             derived_with: doc.derived_with.clone(),
             geometries: doc.geometries.clone(),
-            warnings: Vec::new(),
+            geometry_rev: doc.geometry_rev,
             profile: doc.profile.clone(),
             settings: doc.settings.clone(),
             fields: doc.fields.clone(),
-            plans: Vec::new(),
+            ..Document::default()
         };
         snapshot.settings.algo = algo;
         let thread = format!("solve-{}", algo.label());
@@ -164,7 +163,7 @@ impl Job {
         Job::spawn(name, &thread, limit, repaint, move |ctx| {
             let (plan, toolpath) =
                 order_document_lowered(&snapshot, ctx).map_err(|e| e.to_string())?;
-            let lowered = Box::new(Prelowered::of(&snapshot, &plan, toolpath));
+            let lowered = Box::new(Prelowered::of(&plan, toolpath));
             Ok(JobResult::Plan {
                 plan: Box::new(plan),
                 lowered,

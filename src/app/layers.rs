@@ -4,6 +4,7 @@
 //! is made in a background job by the caller.
 
 use super::prompts::PathAction;
+use crate::document::spec::{self, FieldSpec};
 use crate::document::{Layer, MachineProfile, Pen};
 use crate::hatch::{HatchSettings, HatchStyle, OutlineMode};
 use egui::{Color32, RichText};
@@ -27,69 +28,62 @@ enum Col {
 }
 
 impl Col {
-    /// The label, as the pen's validation words it.
-    fn label(self) -> &'static str {
+    /// The key of its row in the pen's or the hatch's spec table.
+    fn key(self) -> &'static str {
         match self {
-            Col::Speed => "Mark speed (mm/s)",
-            Col::Power => "Power",
-            Col::Frequency => "Pulse frequency (kHz)",
-            Col::Passes => "Passes",
-            Col::Spacing => "Hatch spacing (mm)",
-            Col::Angle => "Hatch angle (°)",
-            Col::Edge => "Hatch edge offset (mm)",
+            Col::Speed => "mark_speed_mm_s",
+            Col::Power => "power",
+            Col::Frequency => "frequency_khz",
+            Col::Passes => "passes",
+            Col::Spacing => "spacing_mm",
+            Col::Angle => "angle_deg",
+            Col::Edge => "edge_offset_mm",
+        }
+    }
+    fn is_hatch(self) -> bool {
+        matches!(self, Col::Spacing | Col::Angle | Col::Edge)
+    }
+    /// The label, as the pen's validation words it.
+    fn label(self) -> String {
+        if self.is_hatch() {
+            find(&spec::hatch_specs(), self.key()).map_or_else(String::new, |s| s.words())
+        } else {
+            find(&spec::pen_specs(), self.key()).map_or_else(String::new, |s| s.words())
         }
     }
     fn get(self, p: &Pen) -> String {
-        let opt = |v: Option<f64>| v.map(|v| v.to_string()).unwrap_or_default();
-        let h = p.hatch.as_ref();
-        match self {
-            Col::Speed => opt(p.mark_speed_mm_s),
-            Col::Power => opt(p.power),
-            Col::Frequency => opt(p.frequency_khz),
-            Col::Passes => p.passes.to_string(),
-            Col::Spacing => opt(h.map(|h| h.spacing_mm)),
-            Col::Angle => opt(h.map(|h| h.angle_deg)),
-            Col::Edge => opt(h.and_then(|h| h.edge_offset_mm)),
+        if self.is_hatch() {
+            let spec = find(&spec::hatch_specs(), self.key());
+            p.hatch
+                .as_ref()
+                .zip(spec)
+                .map_or_else(String::new, |(h, s)| (s.show)(h))
+        } else {
+            find(&spec::pen_specs(), self.key()).map_or_else(String::new, |s| (s.show)(p))
         }
     }
     /// Parses `text` into `p` (empty: unset, where a value may be unset).
     fn set(self, p: &mut Pen, text: &str) -> Result<(), String> {
-        let t = text.trim();
-        let num = || -> Result<Option<f64>, String> {
-            if t.is_empty() {
-                return Ok(None);
+        if self.is_hatch() {
+            let (Some(h), Some(s)) = (&mut p.hatch, find(&spec::hatch_specs(), self.key())) else {
+                return Ok(());
+            };
+            if !s.optional && text.trim().is_empty() {
+                return Err(format!("{} needs a value", s.words()));
             }
-            match t.parse::<f64>() {
-                Ok(v) if v.is_finite() => Ok(Some(v)),
-                _ => Err(format!("{} must be a number, not '{t}'", self.label())),
-            }
-        };
-        let required = |v: Option<f64>| v.ok_or(format!("{} needs a value", self.label()));
-        match self {
-            Col::Speed => p.mark_speed_mm_s = num()?,
-            Col::Power => p.power = num()?,
-            Col::Frequency => p.frequency_khz = num()?,
-            Col::Passes => {
-                p.passes = t.parse().map_err(|_| {
-                    format!(
-                        "{} must be a whole number of 1 or more, not '{t}'",
-                        self.label()
-                    )
-                })?
-            }
-            Col::Spacing | Col::Angle | Col::Edge => {
-                let v = num()?;
-                if let Some(h) = &mut p.hatch {
-                    match self {
-                        Col::Spacing => h.spacing_mm = required(v)?,
-                        Col::Angle => h.angle_deg = required(v)?,
-                        _ => h.edge_offset_mm = v,
-                    }
-                }
+            s.set_text(h, text)
+        } else {
+            match find(&spec::pen_specs(), self.key()) {
+                Some(s) => s.set_text(p, text),
+                None => Ok(()),
             }
         }
-        Ok(())
     }
+}
+
+/// The row of `key` in a spec table.
+fn find<T>(specs: &[FieldSpec<T>], key: &str) -> Option<FieldSpec<T>> {
+    specs.iter().find(|s| s.key == key).copied()
 }
 
 /// What the panel asks the window to do.
@@ -141,6 +135,8 @@ impl LayerEditor {
         busy: Option<&str>,
     ) -> Option<LayerAction> {
         if self.synced.as_deref() != Some(layers) {
+            // the table changed (a valid edit, undo, another file): nothing typed is pending
+            self.error = None;
             self.text = layers
                 .iter()
                 .map(|l| COLS.iter().map(|c| c.get(&l.pen)).collect())
@@ -274,7 +270,7 @@ impl LayerEditor {
         layer: &Layer,
         hint: &str,
     ) -> Option<Layer> {
-        let label = ui.label(short_label(c));
+        let label = ui.label(c.label());
         let bad = self.error.as_ref().is_some_and(|e| e.0 == k && e.1 == c);
         let mut edit = egui::TextEdit::singleline(&mut self.text[k][n])
             .desired_width(60.0)
@@ -297,8 +293,9 @@ impl LayerEditor {
             .and_then(|()| candidate.validate().map_err(|e| e.to_string()));
         match result {
             Ok(()) => {
-                if self.error.as_ref().is_some_and(|e| e.0 == k && e.1 == c) {
-                    self.error = None;
+                // a valid value: an earlier rejected one is no longer current
+                if self.error.take().is_some_and(|e| (e.0, e.1) != (k, c)) {
+                    self.synced = None;
                 }
                 (candidate != *layer).then_some(candidate)
             }
@@ -307,19 +304,6 @@ impl LayerEditor {
                 None
             }
         }
-    }
-}
-
-/// The label in the grid (the layer's name is in the block's header).
-fn short_label(c: Col) -> &'static str {
-    match c {
-        Col::Speed => "Speed (mm/s)",
-        Col::Power => "Power",
-        Col::Frequency => "Freq. (kHz)",
-        Col::Passes => "Passes",
-        Col::Spacing => "Spacing (mm)",
-        Col::Angle => "Angle (°)",
-        Col::Edge => "Edge offset (mm)",
     }
 }
 

@@ -5,7 +5,7 @@ use super::commands::Command;
 use super::files::ExportKind;
 use super::layers::LayerAction;
 use super::paint::colour;
-use super::{compare, is_stale, motion_plots, playback, App, Section, Tab, SOLVERS};
+use super::{compare, motion_plots, playback, App, Section, Tab, SOLVERS};
 use egui::{Color32, RichText};
 
 const ERROR: Color32 = Color32::from_rgb(200, 30, 30);
@@ -39,6 +39,7 @@ impl App {
                         &mut self.compare,
                         &self.doc,
                         &self.toolpaths,
+                        &self.stale,
                         self.layers,
                     );
                 } else {
@@ -100,6 +101,7 @@ impl App {
                     (ExportKind::Gcode, "Export G-code…", "Ctrl+E"),
                     (ExportKind::Report, "Export report (JSON)…", ""),
                     (ExportKind::Preview, "Export SVG preview…", ""),
+                    (ExportKind::Trajectory, "Export trajectory (CSV)…", ""),
                 ] {
                     let b = egui::Button::new(label).shortcut_text(keys);
                     if ui
@@ -433,8 +435,8 @@ impl App {
             ui.separator();
             ui.heading("Metrics");
             compare::metrics_table(ui, "active-metrics", plan, None);
-            let lowered = self.active.and_then(|k| self.toolpaths.get(k));
-            compare::relowered_notes(ui, &[(plan, lowered)]);
+            let stale = self.active.map_or(&[][..], |k| self.plan_staleness(k));
+            compare::stale_notes(ui, &[(plan, stale)]);
         }
         ui.separator();
         let n = self.doc.warnings.len();
@@ -504,7 +506,7 @@ impl App {
         let mut remove = None;
         for k in 0..self.doc.plans.len() {
             let p = &self.doc.plans[k];
-            let stale = is_stale(p, &self.doc);
+            let stale = self.plan_staleness(k).to_vec();
             ui.horizontal(|ui| {
                 let text = match p.metrics.job_time_s {
                     Some(t) => format!("{}  job time {t:.2} s", p.name),
@@ -513,9 +515,9 @@ impl App {
                 if ui.selectable_label(self.active == Some(k), text).clicked() {
                     self.active = Some(k);
                 }
-                if stale {
-                    ui.label(RichText::new("stale").color(Color32::from_rgb(180, 83, 9)))
-                        .on_hover_text("planned on other fields than the current ones");
+                if !stale.is_empty() {
+                    ui.label(RichText::new("stale").color(STALE))
+                        .on_hover_text(stale_text(&stale));
                 }
                 if ui
                     .small_button("Remove")
@@ -558,7 +560,9 @@ impl App {
         let plan = self.active.and_then(|k| self.doc.plans.get(k));
         let lowered = self.active.and_then(|k| self.toolpaths.get(k));
         playback::controls(ui, "workbench", &mut self.playback, lowered, true);
-        let stale = plan.is_some_and(|p| is_stale(p, &self.doc));
+        let stale = self
+            .active
+            .map_or_else(Vec::new, |k| self.plan_staleness(k).to_vec());
         let playback_t_s = lowered
             .and_then(Result::ok)
             .and_then(|_| self.playback.shown_t_s());
@@ -587,7 +591,7 @@ impl App {
             editable: true,
             add_tool: self.add_tool,
             layers: self.layers,
-            stale,
+            stale: &stale,
             playback_t_s,
         };
         let motion = lowered.and_then(Result::ok).and_then(|l| l.motion.as_ref());
@@ -614,6 +618,14 @@ impl App {
         }
         self.on_canvas(actions);
     }
+}
+
+/// The colour of "stale" marks and notes.
+pub const STALE: Color32 = Color32::from_rgb(180, 83, 9);
+
+/// What changed since a plan was made, one reason a line.
+pub fn stale_text(why: &[String]) -> String {
+    format!("Changed since this plan was made:\n{}", why.join("\n"))
 }
 
 /// The header of the motion plots: shows or hides them.

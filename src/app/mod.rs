@@ -30,7 +30,8 @@ pub mod toolpaths;
 pub use canvas::{Canvas, CanvasAction, CanvasState, Layers, View};
 
 use crate::document::{
-    Algo, DerivedKey, Document, Layer, MachineProfile, MotionMode, Plan, ScanField, SolverSettings,
+    staleness, Algo, DerivedKey, Document, Layer, MachineProfile, MotionMode, Plan, ScanField,
+    SolverSettings,
 };
 use crate::job::JobCtx;
 use crate::pipeline::{derive_geometries, place_document_fields};
@@ -71,6 +72,8 @@ pub struct Prefs {
     pub layers: Layers,
     /// Show the frame timings in the status bar (View menu; a debugging aid).
     pub frame_times: bool,
+    /// The folder last exported to, per kind of export.
+    pub export_dirs: files::ExportDirs,
 }
 
 /// Opens the main window, with `file` (an SVG or a project) loaded when given.
@@ -226,6 +229,15 @@ pub struct App {
     /// Uncovered geometries no scan field can ever hold (larger than a field, or beyond the
     /// stage's stroke plus half a field).
     out_of_reach: Vec<usize>,
+    /// Per plan, what changed since it was planned, in words (empty: current).
+    stale: Vec<Vec<String>>,
+    /// DejaVu Sans is installed as the fallback font (arrows, symbols, layer names in other
+    /// scripts would otherwise miss glyphs).
+    fonts_installed: bool,
+    /// An export to write once the solve running now ends (re-solve and export).
+    export_after_solve: Option<(ExportKind, PathBuf)>,
+    /// The folder last exported to, per kind of export.
+    export_dirs: files::ExportDirs,
 }
 
 impl Default for App {
@@ -283,6 +295,10 @@ impl App {
             layer_counts: Vec::new(),
             colours: Vec::new(),
             out_of_reach: Vec::new(),
+            stale: Vec::new(),
+            fonts_installed: false,
+            export_after_solve: None,
+            export_dirs: prefs.export_dirs,
         }
     }
 
@@ -294,6 +310,7 @@ impl App {
             recent: self.recent.clone(),
             layers: self.layers,
             frame_times: self.frame_times,
+            export_dirs: self.export_dirs.clone(),
         }
     }
 
@@ -397,7 +414,6 @@ impl App {
         );
         match o.problem {
             Some(p) => {
-                let p = gui_words(&p);
                 self.set_status(format!("{msg}; scan fields not placed: {p}"), true);
                 self.problem = Some(p);
             }
@@ -438,7 +454,7 @@ impl App {
             "place",
             repaint,
             move |ctx| {
-                place_document_fields(&mut work, ctx).map_err(|e| gui_words(&e.to_string()))?;
+                place_document_fields(&mut work, ctx).map_err(|e| gui_error(&e))?;
                 Ok(JobResult::Placed {
                     doc: Box::new(work),
                     what: "re-place fields automatically".into(),
@@ -465,7 +481,7 @@ impl App {
             let before = work.geometries.len();
             derive_geometries(&mut work, ctx).map_err(|e| e.to_string())?;
             if work.fields.is_empty() && !work.geometries.is_empty() {
-                place_document_fields(&mut work, ctx).map_err(|e| gui_words(&e.to_string()))?;
+                place_document_fields(&mut work, ctx).map_err(|e| gui_error(&e))?;
             }
             let what = format!(
                 "change layers: {before} to {} geometries",
@@ -488,39 +504,89 @@ impl App {
         Ok(())
     }
 
-    /// Exports the plan shown on the workbench.
+    /// The files the document was read from (artwork, project): no export may overwrite them.
+    pub fn input_files(&self) -> Vec<PathBuf> {
+        let mut v: Vec<PathBuf> = self.doc.source.iter().map(PathBuf::from).collect();
+        v.extend(self.project_path.clone());
+        v
+    }
+
+    /// Refuses an export path that is one of the document's input files.
+    fn check_export_path(&self, kind: ExportKind, path: &Path) -> Result<(), String> {
+        let inputs = self.input_files();
+        let inputs: Vec<&Path> = inputs.iter().map(PathBuf::as_path).collect();
+        crate::export::check_outputs(&inputs, &[(kind.filter().0, path)]).map_err(|e| e.to_string())
+    }
+
+    /// Exports the plan shown on the workbench, as planned (with its own inputs), on this
+    /// thread.
     pub fn export(&mut self, kind: ExportKind, path: &Path) -> Result<(), String> {
+        self.check_export_path(kind, path)?;
+        let k = self.active.ok_or("no plan to export: run a solver first")?;
         let plan = self
-            .active_plan()
+            .doc
+            .plans
+            .get(k)
             .ok_or("no plan to export: run a solver first")?;
-        let stale = is_stale(plan, &self.doc);
-        files::export(&self.doc, plan, kind, path)?;
-        let note = if stale {
-            " (note: the plan is stale, the fields changed since)"
-        } else {
-            ""
+        let toolpath = self
+            .toolpaths
+            .get(k)
+            .and_then(Result::ok)
+            .map(|l| &l.toolpath);
+        files::export(&self.doc, plan, toolpath, kind, path)?;
+        self.export_dirs.remember(kind, path);
+        let note = match self.stale.get(k) {
+            Some(why) if !why.is_empty() => " as planned (stale: the document changed since)",
+            _ => "",
         };
         self.set_status(format!("wrote {}{note}", path.display()), false);
         Ok(())
     }
 
-    /// Exports the plan shown on the workbench in a background job.
+    /// Exports the plan shown on the workbench in a background job, as planned.
     pub fn export_in_background(&mut self, kind: ExportKind, path: &Path, repaint: &egui::Context) {
-        let Some(plan) = self.active_plan().cloned() else {
+        if let Err(e) = self.check_export_path(kind, path) {
+            self.set_status(e, true);
+            return;
+        }
+        let Some((k, plan)) = self
+            .active
+            .and_then(|k| Some((k, self.doc.plans.get(k)?.clone())))
+        else {
             self.set_status("no plan to export: run a solver first", true);
             return;
         };
+        let lowered = self.toolpaths.get(k).and_then(Result::ok).cloned();
         let doc = Document {
             plans: Vec::new(),
             artwork: Vec::new(),
             ..self.doc.clone()
         };
+        self.export_dirs.remember(kind, path);
         let file = path.to_path_buf();
         let name = format!("exporting {}", path.display());
         self.start_job(name, "export", repaint, move |_| {
-            files::export(&doc, &plan, kind, &file)?;
+            let toolpath = lowered.as_ref().map(|l| &l.toolpath);
+            files::export(&doc, &plan, toolpath, kind, &file)?;
             Ok(JobResult::Exported { path: file, kind })
         });
+    }
+
+    /// Solves the shown plan's algorithm again on the current document, then exports the new
+    /// plan to `path` (the answer "re-solve and export" to a stale export).
+    pub fn resolve_and_export(&mut self, kind: ExportKind, path: &Path, repaint: &egui::Context) {
+        if let Err(e) = self.check_export_path(kind, path) {
+            self.set_status(e, true);
+            return;
+        }
+        let Some(algo) = self.active_plan().map(|p| p.algo) else {
+            self.set_status("no plan to export: run a solver first", true);
+            return;
+        };
+        self.start_solve(algo, repaint);
+        if self.job.is_some() {
+            self.export_after_solve = Some((kind, path.to_path_buf()));
+        }
     }
 
     /// Applies an edit command through the undo history.
@@ -529,8 +595,10 @@ impl App {
     }
 
     fn execute_grouped(&mut self, cmd: Command, group: Option<u64>) -> Result<Outcome, String> {
-        let what = cmd.describe();
-        let r = self.history.execute(&mut self.doc, cmd, group);
+        let what = cmd.describe(&|id| self.field_label(id));
+        let r = self
+            .history
+            .execute(&mut self.doc, cmd, group, what.clone());
         self.refresh();
         if r.is_ok() {
             self.changed();
@@ -550,7 +618,7 @@ impl App {
                     self.problem = None;
                 }
             }
-            Err(e) => self.set_status(format!("cannot {what}: {}", gui_words(e)), true),
+            Err(e) => self.set_status(format!("cannot {what}: {e}"), true),
         }
         r
     }
@@ -607,6 +675,29 @@ impl App {
             self.active = self.doc.plans.len().checked_sub(1);
         }
         self.toolpaths.sync(&self.doc);
+        self.refresh_staleness();
+    }
+
+    /// What changed since each plan was planned.
+    fn refresh_staleness(&mut self) {
+        self.stale = self
+            .doc
+            .plans
+            .iter()
+            .map(|p| staleness(p, &self.doc))
+            .collect();
+    }
+
+    /// What changed since plan `k` was planned, in words (empty: it is current).
+    pub fn plan_staleness(&self, k: usize) -> &[String] {
+        self.stale.get(k).map_or(&[], Vec::as_slice)
+    }
+
+    /// The number the canvas shows for field `id`: 1…n in the visiting order of the plan
+    /// shown, else in placement order.
+    pub fn field_label(&self, id: usize) -> usize {
+        let visiting = self.active_plan().map(|p| p.fields.as_slice());
+        field_number(&self.doc.fields, visiting, id)
     }
 
     /// Layer counts and colours after the geometries or layers changed.
@@ -758,7 +849,7 @@ impl App {
             .unwrap_or(label)
     }
 
-    fn poll_job(&mut self) {
+    fn poll_job(&mut self, ui_ctx: &egui::Context) {
         let Some(job) = &self.job else { return };
         let Some(outcome) = job.poll() else { return };
         let (name, cancelled, elapsed) = (job.name.clone(), job.is_cancelled(), job.elapsed());
@@ -802,6 +893,7 @@ impl App {
                 let k = self.doc.plans.len() - 1;
                 self.toolpaths.adopt(k, lowered);
                 self.toolpaths.sync(&self.doc);
+                self.refresh_staleness();
                 self.active = Some(k);
                 self.compare.push(k);
                 match self.toolpaths.get(k) {
@@ -809,13 +901,27 @@ impl App {
                         let msg = format!("{msg}; {why}");
                         self.set_status(msg, true);
                     }
-                    _ => self.set_status(msg, false),
+                    _ => self.set_status(msg.clone(), false),
+                }
+                if let Some((kind, path)) = self.export_after_solve.take() {
+                    if cancelled {
+                        self.set_status(
+                            format!("{msg}; stopped, so {} was not written", path.display()),
+                            true,
+                        );
+                    } else {
+                        self.export_in_background(kind, &path, ui_ctx);
+                    }
                 }
             }
             JobOutcome::Failed(e) if cancelled => {
+                self.export_after_solve = None;
                 self.set_status(format!("{name}: cancelled ({e})"), false)
             }
-            JobOutcome::Failed(e) => self.set_status(format!("{name} failed: {e}"), true),
+            JobOutcome::Failed(e) => {
+                self.export_after_solve = None;
+                self.set_status(format!("{name} failed: {e}"), true)
+            }
         }
     }
 
@@ -837,7 +943,7 @@ impl App {
                     if let Some(f) = self.doc.fields.iter().find(|f| Some(f.id) == self.selected) {
                         let msg = format!(
                             "moved field {} to ({:.1}, {:.1}) mm: {} geometries, {} uncovered",
-                            field_number(&self.doc.fields, None, f.id),
+                            self.field_label(f.id),
                             f.center.x,
                             f.center.y,
                             f.geometries.len(),
@@ -858,7 +964,11 @@ impl App {
     /// Draws one frame.
     pub fn ui(&mut self, ui: &mut egui::Ui) {
         let t0 = Instant::now();
-        self.poll_job();
+        if !self.fonts_installed {
+            install_fallback_font(ui.ctx());
+            self.fonts_installed = true;
+        }
+        self.poll_job(ui.ctx());
         self.handle_input(ui.ctx());
         // plans added, loaded or removed, the profile or the geometries changed
         self.toolpaths.sync(&self.doc);
@@ -953,31 +1063,28 @@ impl App {
     }
 }
 
-/// A plan is stale when the fields it was planned on (centres, sizes, allocation) differ from
-/// the document's current fields.
-pub fn is_stale(plan: &Plan, doc: &Document) -> bool {
-    type Key = (usize, [u64; 4], Vec<usize>);
-    fn key(fields: &[ScanField]) -> Vec<Key> {
-        let mut v: Vec<Key> = fields
-            .iter()
-            .filter(|f| !f.geometries.is_empty())
-            .map(|f| {
-                let mut g = f.geometries.clone();
-                g.sort_unstable();
-                let b = [f.center.x, f.center.y, f.size[0], f.size[1]].map(f64::to_bits);
-                (f.id, b, g)
-            })
-            .collect();
-        v.sort();
-        v
-    }
-    key(&plan.fields) != key(&doc.fields)
-}
-
 /// True when some scan-field position within the stage's stroke holds all of `g`.
 fn can_be_covered(g: &crate::document::Geometry, profile: &MachineProfile) -> bool {
     let (x, y) = crate::fields::center_range(&g.bbox(), profile);
     !x.is_empty() && !y.is_empty()
+}
+
+/// Adds the bundled DejaVu Sans after egui's own fonts, for the glyphs they lack (→, ≤, …);
+/// active from the next frame.
+fn install_fallback_font(ctx: &egui::Context) {
+    let mut fonts = egui::FontDefinitions::default();
+    fonts.font_data.insert(
+        "dejavu-sans".into(),
+        std::sync::Arc::new(egui::FontData::from_static(crate::import::bundled_font())),
+    );
+    for family in [egui::FontFamily::Proportional, egui::FontFamily::Monospace] {
+        fonts
+            .families
+            .entry(family)
+            .or_default()
+            .push("dejavu-sans".into());
+    }
+    ctx.set_fonts(fonts);
 }
 
 /// `n` and the noun for it: "1 geometry", "3 geometries".
@@ -985,14 +1092,17 @@ pub fn count(n: usize, one: &str, many: &str) -> String {
     format!("{n} {}", if n == 1 { one } else { many })
 }
 
-/// A library message in the GUI's words: command-line flags become the controls that do the
-/// same.
-pub fn gui_words(msg: &str) -> String {
-    msg.replace(
-        "use --split-oversize to cut them at field borders",
-        "tick \"Split oversize geometries\" in Solver settings and press \"Re-place \
-         automatically\" to cut them at field borders, or choose \"On the fly\" as the motion",
-    )
+/// A pipeline error in the GUI's words: the message, then what the operator can do, naming
+/// the controls that do it.
+pub fn gui_error(e: &crate::pipeline::PipelineError) -> String {
+    use crate::pipeline::Remedy;
+    match e.remedy() {
+        Some(Remedy::SplitOversize) => format!(
+            "{e}; tick \"Split oversize geometries\" in Solver settings and press \"Re-place \
+             automatically\" to cut them at field borders, or choose \"On the fly\" as the motion"
+        ),
+        None => e.to_string(),
+    }
 }
 
 /// The number shown for field `id`: 1…n in the visiting order of `visiting` (a plan's fields)

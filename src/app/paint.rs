@@ -271,7 +271,7 @@ fn paint_path(
     rect: Rect,
 ) {
     let s = |q: Pt| view.to_screen(rect, q);
-    let col = if c.stale {
+    let col = if !c.stale.is_empty() {
         path.colour.gamma_multiply(0.45)
     } else {
         path.colour
@@ -376,12 +376,6 @@ fn paint_caption(painter: &Painter, c: &Canvas<'_>, rect: Rect) {
                     col,
                 );
             }
-            if let Some((stored_s, now_s)) = l.job_time_mismatch_s(p.plan) {
-                line(
-                    relowered_note(stored_s, now_s),
-                    Color32::from_rgb(180, 83, 9),
-                );
-            }
         }
         match (p.lowered, c.playback_t_s) {
             (Err(why), _) => line(why.to_string(), colour::UNCOVERED),
@@ -396,10 +390,14 @@ fn paint_caption(painter: &Painter, c: &Canvas<'_>, rect: Rect) {
             (Ok(_), None) => {}
         }
     }
-    if c.stale {
+    if let Some(first) = c.stale.first() {
+        let more = match c.stale.len() {
+            1 => String::new(),
+            n => format!(" (and {} more)", n - 1),
+        };
         line(
-            "plan is stale: the fields changed since it was planned".into(),
-            Color32::from_rgb(180, 83, 9),
+            format!("stale plan: {first} since it was made{more}"),
+            super::layout::STALE,
         );
     }
     if !c.uncovered.is_empty() {
@@ -413,24 +411,14 @@ fn paint_caption(painter: &Painter, c: &Canvas<'_>, rect: Rect) {
     }
 }
 
-/// The note shown when a plan's toolpath no longer has the job time of its solve.
-pub fn relowered_note(stored_s: f64, now_s: f64) -> String {
-    format!(
-        "toolpath re-lowered with current settings: plays {now_s:.2} s, solved as {stored_s:.2} s \
-         (solve again for matching figures)"
-    )
-}
-
 /// How many caption lines a canvas shows at most (title, and per plan: figures, playback
-/// state, stage route legend, re-lowered note).
+/// state, stage route legend; a stale note).
 pub fn caption_lines(c: &Canvas<'_>) -> usize {
     let per_plan = |p: &PathLayer<'_>| match p.lowered {
-        Ok(l) => {
-            2 + usize::from(l.on_the_fly()) + usize::from(l.job_time_mismatch_s(p.plan).is_some())
-        }
+        Ok(l) => 2 + usize::from(l.on_the_fly()),
         Err(_) => 2,
     };
-    1 + c.paths.iter().map(per_plan).sum::<usize>().max(2)
+    1 + usize::from(!c.stale.is_empty()) + c.paths.iter().map(per_plan).sum::<usize>().max(2)
 }
 
 /// A plan's caption, led by the figure that decides: its job time.

@@ -6,240 +6,27 @@
 //! [`Command::SetProfile`] / [`Command::SetSettings`] (so it can be undone).
 
 use super::commands::Command;
+use crate::document::spec::{self, FieldSpec, Rule};
 use crate::document::{
     CostModel, FieldsMode, MachineProfile, MotionMode, SolverSettings, StageRouteKind, VertexMode,
     BUILTIN,
 };
 use egui::{Color32, RichText};
 
-/// One editable value of a `T`: shown as text, parsed back when committed.
-struct Spec<T> {
-    label: &'static str,
-    help: &'static str,
-    get: fn(&T) -> String,
-    set: fn(&mut T, &str) -> Result<(), String>,
+/// The profile editor's rows: every value of the profile's table that is typed.
+fn profile_specs() -> Vec<FieldSpec<MachineProfile>> {
+    spec::profile_specs()
+        .into_iter()
+        .filter(|s| s.rule != Rule::Choice)
+        .collect()
 }
 
-fn num(s: &str) -> Result<f64, String> {
-    let v: f64 = s
-        .trim()
-        .parse()
-        .map_err(|_| format!("'{}' is not a number", s.trim()))?;
-    if v.is_finite() {
-        Ok(v)
-    } else {
-        Err(format!("'{}' is not a finite number", s.trim()))
-    }
-}
-
-fn count(s: &str) -> Result<u64, String> {
-    s.trim()
-        .parse()
-        .map_err(|_| format!("'{}' is not a whole number (0 or more)", s.trim()))
-}
-
-fn fmt(v: f64) -> String {
-    format!("{v}")
-}
-
-fn opt_num(s: &str) -> Result<Option<f64>, String> {
-    if s.trim().is_empty() {
-        Ok(None)
-    } else {
-        num(s).map(Some)
-    }
-}
-
-fn opt_fmt(v: Option<f64>) -> String {
-    v.map(fmt).unwrap_or_default()
-}
-
-macro_rules! spec {
-    ($label:expr, $help:expr, |$v:ident| $get:expr, |$m:ident, $s:ident| $set:expr) => {
-        Spec {
-            label: $label,
-            help: $help,
-            get: |$v| $get,
-            set: |$m, $s| {
-                $set;
-                Ok(())
-            },
-        }
-    };
-}
-
-fn profile_specs() -> Vec<Spec<MachineProfile>> {
-    vec![
-        spec!("Name", "display name", |p| p.name.clone(), |p, s| p.name =
-            s.trim().to_string()),
-        spec!(
-            "Stroke X (mm)",
-            "base-stage travel in x: field centres range over [0, stroke]",
-            |p| fmt(p.stroke_mm[0]),
-            |p, s| p.stroke_mm[0] = num(s)?
-        ),
-        spec!(
-            "Stroke Y (mm)",
-            "base-stage travel in y",
-            |p| fmt(p.stroke_mm[1]),
-            |p, s| p.stroke_mm[1] = num(s)?
-        ),
-        spec!(
-            "Field width (mm)",
-            "scan-field size in x",
-            |p| fmt(p.field_mm[0]),
-            |p, s| p.field_mm[0] = num(s)?
-        ),
-        spec!(
-            "Field height (mm)",
-            "scan-field size in y",
-            |p| fmt(p.field_mm[1]),
-            |p, s| p.field_mm[1] = num(s)?
-        ),
-        spec!(
-            "Base X max velocity (mm/s)",
-            "",
-            |p| fmt(p.axis_x.max_velocity_mm_s),
-            |p, s| p.axis_x.max_velocity_mm_s = num(s)?
-        ),
-        spec!(
-            "Base X max accel (mm/s²)",
-            "",
-            |p| fmt(p.axis_x.max_accel_mm_s2),
-            |p, s| p.axis_x.max_accel_mm_s2 = num(s)?
-        ),
-        spec!(
-            "Base Y max velocity (mm/s)",
-            "",
-            |p| fmt(p.axis_y.max_velocity_mm_s),
-            |p, s| p.axis_y.max_velocity_mm_s = num(s)?
-        ),
-        spec!(
-            "Base Y max accel (mm/s²)",
-            "",
-            |p| fmt(p.axis_y.max_accel_mm_s2),
-            |p, s| p.axis_y.max_accel_mm_s2 = num(s)?
-        ),
-        spec!(
-            "Scanner jump speed (mm/s)",
-            "laser off",
-            |p| fmt(p.scanner.jump_speed_mm_s),
-            |p, s| p.scanner.jump_speed_mm_s = num(s)?
-        ),
-        spec!(
-            "Scanner mark speed (mm/s)",
-            "laser on",
-            |p| fmt(p.scanner.mark_speed_mm_s),
-            |p, s| p.scanner.mark_speed_mm_s = num(s)?
-        ),
-        spec!(
-            "Laser on delay (s)",
-            "",
-            |p| fmt(p.laser.on_delay_s),
-            |p, s| p.laser.on_delay_s = num(s)?
-        ),
-        spec!(
-            "Laser off delay (s)",
-            "",
-            |p| fmt(p.laser.off_delay_s),
-            |p, s| p.laser.off_delay_s = num(s)?
-        ),
-        spec!(
-            "Jump delay (s)",
-            "scanner settling after a jump",
-            |p| fmt(p.laser.jump_delay_s),
-            |p, s| p.laser.jump_delay_s = num(s)?
-        ),
-        spec!(
-            "Laser on word",
-            "M3 or M4",
-            |p| p.gcode.laser_on.clone(),
-            |p, s| p.gcode.laser_on = s.trim().to_string()
-        ),
-        spec!(
-            "Laser off word",
-            "usually M5",
-            |p| p.gcode.laser_off.clone(),
-            |p, s| p.gcode.laser_off = s.trim().to_string()
-        ),
-        spec!(
-            "Power S (empty: none)",
-            "written after the laser-on word",
-            |p| opt_fmt(p.gcode.power),
-            |p, s| p.gcode.power = opt_num(s)?
-        ),
-        spec!(
-            "Feed (mm/min)",
-            "on G1 moves",
-            |p| fmt(p.gcode.feed_mm_min),
-            |p, s| p.gcode.feed_mm_min = num(s)?
-        ),
-        spec!(
-            "Decimals",
-            "digits after the point in G-code",
-            |p| p.gcode.decimals.to_string(),
-            |p, s| p.gcode.decimals = count(s)? as usize
-        ),
-    ]
-}
-
-fn settings_specs() -> Vec<Spec<SolverSettings>> {
-    vec![
-        spec!(
-            "Seed",
-            "all randomised stages are deterministic for a seed",
-            |t| t.seed.to_string(),
-            |t, s| t.seed = count(s)?
-        ),
-        spec!(
-            "Time limit (s, empty: none)",
-            "for the ordering stage",
-            |t| opt_fmt(t.time_limit_s),
-            |t, s| t.time_limit_s = opt_num(s)?
-        ),
-        spec!(
-            "Direction weight",
-            "seed 000 Eq. 7 penalty weight w",
-            |t| fmt(t.direction_weight),
-            |t, s| t.direction_weight = num(s)?
-        ),
-        spec!(
-            "GA population",
-            "initial population size",
-            |t| t.ga.population.to_string(),
-            |t, s| t.ga.population = count(s)? as usize
-        ),
-        spec!(
-            "GA population min",
-            "",
-            |t| t.ga.population_min.to_string(),
-            |t, s| t.ga.population_min = count(s)? as usize
-        ),
-        spec!(
-            "GA population max",
-            "",
-            |t| t.ga.population_max.to_string(),
-            |t, s| t.ga.population_max = count(s)? as usize
-        ),
-        spec!(
-            "GA elite fraction",
-            "0 … 1",
-            |t| fmt(t.ga.elite_fraction),
-            |t, s| t.ga.elite_fraction = num(s)?
-        ),
-        spec!(
-            "GA mutation rate",
-            "0 … 1",
-            |t| fmt(t.ga.mutation_rate),
-            |t, s| t.ga.mutation_rate = num(s)?
-        ),
-        spec!(
-            "GA stall generations",
-            "stop after this many generations without improvement",
-            |t| t.ga.stall_generations.to_string(),
-            |t, s| t.ga.stall_generations = count(s)? as usize
-        ),
-    ]
+/// The settings editor's typed rows (the choices have controls of their own).
+fn settings_specs() -> Vec<FieldSpec<SolverSettings>> {
+    spec::settings_specs()
+        .into_iter()
+        .filter(|s| s.rule != Rule::Choice)
+        .collect()
 }
 
 /// Checks solver settings (the library's [`SolverSettings::validate`]), as a message.
@@ -257,14 +44,14 @@ const MESSAGE_LINES: f32 = 3.0;
 
 /// Text buffers of one form, re-read whenever the value changes from elsewhere (undo, open).
 struct Form<T> {
-    specs: Vec<Spec<T>>,
+    specs: Vec<FieldSpec<T>>,
     synced: Option<T>,
     text: Vec<String>,
     error: Vec<Option<String>>,
 }
 
 impl<T: Clone + PartialEq> Form<T> {
-    fn new(specs: Vec<Spec<T>>) -> Self {
+    fn new(specs: Vec<FieldSpec<T>>) -> Self {
         Self {
             specs,
             synced: None,
@@ -281,7 +68,7 @@ impl<T: Clone + PartialEq> Form<T> {
         validate: fn(&T) -> Result<(), String>,
     ) -> Option<T> {
         if self.synced.as_ref() != Some(value) {
-            self.text = self.specs.iter().map(|s| (s.get)(value)).collect();
+            self.text = self.specs.iter().map(|s| (s.show)(value)).collect();
             self.error = vec![None; self.specs.len()];
             self.synced = Some(value.clone());
         }
@@ -289,7 +76,7 @@ impl<T: Clone + PartialEq> Form<T> {
         self.message(ui);
         ui.end_row();
         for (k, spec) in self.specs.iter().enumerate() {
-            let label = ui.label(spec.label);
+            let label = ui.label(spec.words());
             let bad = self.error[k].is_some();
             let mut edit = egui::TextEdit::singleline(&mut self.text[k]).desired_width(90.0);
             if bad {
@@ -303,8 +90,8 @@ impl<T: Clone + PartialEq> Form<T> {
             // commit on Enter / leaving the field, or when set without focus (accessibility)
             if r.lost_focus() || (r.changed() && !r.has_focus()) {
                 let mut candidate = value.clone();
-                let result = (spec.set)(&mut candidate, &self.text[k])
-                    .map_err(|e| format!("{}: {e}", spec.label))
+                let result = spec
+                    .set_text(&mut candidate, &self.text[k])
                     .and_then(|()| validate(&candidate));
                 match result {
                     Ok(()) if candidate != *value => out = Some(candidate),
@@ -376,8 +163,13 @@ impl Editors {
         let mut out = None;
         ui.horizontal(|ui| {
             let label = ui.label("Built-in");
+            let current = BUILTIN
+                .iter()
+                .map(|(name, _)| *name)
+                .find(|name| MachineProfile::builtin(name).is_ok_and(|b| b == *profile))
+                .map_or_else(|| "custom (edited or loaded)".to_string(), str::to_string);
             egui::ComboBox::from_id_salt("builtin-profile")
-                .selected_text("choose…")
+                .selected_text(current)
                 .show_ui(ui, |ui| {
                     for (name, _) in BUILTIN {
                         if ui.button(*name).clicked() {

@@ -4,7 +4,7 @@
 //! nothing silently.
 
 use super::files::{self, ExportKind, PROJECT_EXT};
-use super::{is_stale, App};
+use super::App;
 use crate::document::{Document, PenLibrary};
 use egui::RichText;
 use std::path::PathBuf;
@@ -24,8 +24,10 @@ pub enum PathAction {
     Open,
     /// Save the project under a new name.
     SaveProject,
-    /// Export the plan shown.
+    /// Export the plan shown, as planned.
     Export(ExportKind),
+    /// Solve the plan shown again on the current document, then export the new plan.
+    ResolveExport(ExportKind),
     /// Load pens for the layers from a TOML library.
     LoadPens,
     /// Save the layers' pens as a TOML library.
@@ -44,9 +46,15 @@ impl PathAction {
             PathAction::SaveProject => {
                 ("Save the project", "Save", PROJECT_EXT, "galvoplan project")
             }
-            PathAction::Export(kind) => {
+            PathAction::Export(kind) | PathAction::ResolveExport(kind) => {
                 let (filter, ext) = kind.filter();
-                ("Export", "Export", ext, filter)
+                let title = match kind {
+                    ExportKind::Gcode => "Export G-code",
+                    ExportKind::Report => "Export the JSON report",
+                    ExportKind::Preview => "Export an SVG preview",
+                    ExportKind::Trajectory => "Export the trajectory (CSV)",
+                };
+                (title, "Export", ext, filter)
             }
             PathAction::LoadPens => ("Load pens", "Load", "toml", "pens"),
             PathAction::SavePens => ("Save pens", "Save", "toml", "pens"),
@@ -156,9 +164,11 @@ impl App {
 
     /// Export the plan shown (asking first when it is stale).
     pub fn request_export(&mut self, kind: ExportKind, ctx: &egui::Context) {
-        match self.active_plan() {
+        match self.active {
             None => self.set_status("no plan to export: run a solver first (Run HHA)", true),
-            Some(p) if is_stale(p, &self.doc) => self.prompt = Some(Prompt::StaleExport(kind)),
+            Some(k) if !self.plan_staleness(k).is_empty() => {
+                self.prompt = Some(Prompt::StaleExport(kind))
+            }
             Some(_) => self.choose_path(PathAction::Export(kind), ctx),
         }
     }
@@ -169,13 +179,26 @@ impl App {
         let default_name = match action {
             PathAction::SavePens => "pens.toml".to_string(),
             PathAction::SaveProfile => "profile.toml".to_string(),
+            PathAction::Export(kind) | PathAction::ResolveExport(kind) => {
+                files::default_name(&self.doc, kind.suffix())
+            }
             _ => files::default_name(&self.doc, ext),
         };
+        let folder = match action {
+            PathAction::Export(kind) | PathAction::ResolveExport(kind) => {
+                self.export_dirs.get(kind).map(std::path::Path::to_path_buf)
+            }
+            _ => None,
+        }
+        .or_else(|| {
+            let source = self.doc.source.as_deref().map(std::path::Path::new)?;
+            source.parent().map(std::path::Path::to_path_buf)
+        });
         if self.dialogs {
             let t0 = Instant::now();
             let picked = match action {
                 PathAction::Open => files::pick_open(),
-                a if a.saves() => files::pick_save(filter, ext, &default_name),
+                a if a.saves() => files::pick_save(filter, ext, &default_name, folder.as_deref()),
                 _ => files::pick_load(filter, ext),
             };
             if let Some(p) = picked {
@@ -189,19 +212,13 @@ impl App {
             }
             self.dialogs = false;
         }
-        let dir = self
-            .doc
-            .source
-            .as_deref()
-            .map(std::path::Path::new)
-            .and_then(std::path::Path::parent)
-            .map(|d| {
-                d.join(if action.saves() {
-                    default_name.as_str()
-                } else {
-                    ""
-                })
-            });
+        let dir = folder.map(|d| {
+            d.join(if action.saves() {
+                default_name.as_str()
+            } else {
+                ""
+            })
+        });
         self.prompt = Some(Prompt::Path {
             action,
             text: dir.map(|d| d.display().to_string()).unwrap_or_default(),
@@ -221,6 +238,10 @@ impl App {
             PathAction::SaveProject => self.save_project(&path),
             PathAction::Export(kind) => {
                 self.export_in_background(kind, &path, ctx);
+                Ok(())
+            }
+            PathAction::ResolveExport(kind) => {
+                self.resolve_and_export(kind, &path, ctx);
                 Ok(())
             }
             PathAction::LoadPens => PenLibrary::load(&path)
@@ -349,17 +370,34 @@ impl App {
                     });
                 }
                 Prompt::StaleExport(kind) => {
-                    ui.heading("Export a stale plan?");
+                    ui.heading("The plan shown is stale");
+                    let why = self.active.map_or(&[][..], |k| self.plan_staleness(k));
                     ui.add(
                         egui::Label::new(
-                            "The plan shown was made on other scan fields than the current ones \
-                             (fields were moved, added or re-placed since). Its G-code marks the \
-                             old fields. Run a solver again to plan the current fields.",
+                            "The document changed since this plan was made. Exported as \
+                             planned, the file is the plan with the settings it was made with, \
+                             not the ones shown now:",
                         )
                         .wrap(),
                     );
+                    for w in why.iter().take(6) {
+                        ui.label(format!("• {w}"));
+                    }
+                    if why.len() > 6 {
+                        ui.label(format!("… and {} more", why.len() - 6));
+                    }
                     ui.horizontal(|ui| {
-                        if ui.button("Export anyway").clicked() {
+                        let resolve = ui
+                            .button("Re-solve and export")
+                            .on_hover_text("solve again with the current settings, then export");
+                        if resolve.clicked() {
+                            keep = false;
+                            let a = PathAction::ResolveExport(*kind);
+                            next = Some(Box::new(move |app: &mut App, ctx: &egui::Context| {
+                                app.choose_path(a, ctx)
+                            }));
+                        }
+                        if ui.button("Export as planned").clicked() {
                             keep = false;
                             let a = PathAction::Export(*kind);
                             next = Some(Box::new(move |app: &mut App, ctx: &egui::Context| {
@@ -368,6 +406,10 @@ impl App {
                         }
                         if ui.button("Cancel").clicked() {
                             keep = false;
+                        }
+                        // the safe answer is the default: Enter re-solves
+                        if ui.memory(|m| m.focused().is_none()) {
+                            resolve.request_focus();
                         }
                     });
                 }

@@ -49,15 +49,6 @@ impl Lowered {
         self.toolpath.route.is_some()
     }
 
-    /// When the plan's stored job time (from its solve) and this toolpath's differ by more
-    /// than 1 %: (stored, toolpath) in s. The toolpath is lowered with the current settings
-    /// and profile, which may not be those the plan was solved with.
-    pub fn job_time_mismatch_s(&self, plan: &Plan) -> Option<(f64, f64)> {
-        let stored_s = plan.metrics.job_time_s?;
-        let now_s = self.duration_s();
-        ((stored_s - now_s).abs() > 0.01 * stored_s.max(now_s)).then_some((stored_s, now_s))
-    }
-
     /// The job time, s.
     pub fn duration_s(&self) -> f64 {
         self.toolpath.duration_s()
@@ -74,28 +65,30 @@ impl Lowered {
     }
 }
 
-/// What a cached toolpath was lowered from; a different key means lowering again.
+/// Which plan a cached toolpath was lowered from; a different key means lowering again. A plan
+/// is lowered on its own inputs only (geometry revision, profile, pens, motion), so the key is
+/// the plan's identity, not the document's settings.
 #[derive(Debug, Clone, PartialEq)]
 struct Key {
     name: String,
     steps: usize,
     job_time_bits: Option<u64>,
     fields: usize,
-    geometries: usize,
+    geometry_rev: u64,
     profile: MachineProfile,
     motion: MotionMode,
 }
 
 impl Key {
-    fn of(doc: &Document, plan: &Plan) -> Self {
+    fn of(plan: &Plan) -> Self {
         Self {
             name: plan.name.clone(),
             steps: plan.order.len(),
             job_time_bits: plan.metrics.job_time_s.map(f64::to_bits),
             fields: plan.fields.len(),
-            geometries: doc.geometries.len(),
-            profile: doc.profile.clone(),
-            motion: doc.settings.motion,
+            geometry_rev: plan.geometry_rev,
+            profile: plan.profile.clone(),
+            motion: plan.motion,
         }
     }
 }
@@ -122,9 +115,9 @@ pub struct Prelowered(Entry);
 impl Prelowered {
     /// Wraps the toolpath `plan` of `doc` was lowered to on the job's thread (by
     /// [`order_document_lowered`](crate::pipeline::order_document_lowered)) and indexes it.
-    pub fn of(doc: &Document, plan: &Plan, toolpath: Toolpath) -> Self {
+    pub fn of(plan: &Plan, toolpath: Toolpath) -> Self {
         Self(Entry {
-            key: Key::of(doc, plan),
+            key: Key::of(plan),
             result: Ok(Arc::new(Lowered::new(toolpath))),
         })
     }
@@ -149,7 +142,7 @@ impl ToolpathCache {
         self.entries.truncate(doc.plans.len());
         let mut lowered = 0;
         for (k, plan) in doc.plans.iter().enumerate() {
-            let key = Key::of(doc, plan);
+            let key = Key::of(plan);
             if self.entries.get(k).is_some_and(|e| e.key == key) {
                 continue;
             }
@@ -193,7 +186,7 @@ impl ToolpathCache {
 mod tests {
     #![allow(clippy::unwrap_used, clippy::expect_used)]
     use super::*;
-    use crate::document::{Algo, Geometry, Metrics, ScanField, Source, Step};
+    use crate::document::{Algo, Geometry, Metrics, PlanInputs, ScanField, Source, Step};
     use crate::geom::Pt;
 
     fn doc_with_plan(bad_geometry: bool) -> Document {
@@ -224,6 +217,11 @@ mod tests {
             motion: MotionMode::Step,
             stage_route: None,
             layers: Vec::new(),
+            ..Plan::new(
+                &PlanInputs::of(&Document::default()),
+                Vec::new(),
+                Vec::new(),
+            )
         };
         Document {
             geometries: vec![line],
@@ -234,7 +232,7 @@ mod tests {
     }
 
     #[test]
-    fn lowers_once_and_again_after_a_profile_or_motion_change() {
+    fn lowers_once_and_again_only_when_the_plan_changes() {
         let mut doc = doc_with_plan(false);
         let mut cache = ToolpathCache::default();
         assert_eq!(cache.sync(&doc), 1);
@@ -245,7 +243,10 @@ mod tests {
         assert!(0.0 < s0 && s0 < s1 && s1 <= l.duration_s());
         assert_eq!(l.strokes_done(s0), 0);
         assert_eq!(l.strokes_done(s1), 1);
+        // a plan is lowered on its own profile: the document's does not matter
         doc.profile.scanner.mark_speed_mm_s *= 2.0;
+        assert_eq!(cache.sync(&doc), 0);
+        doc.plans[0].profile.scanner.mark_speed_mm_s *= 2.0;
         assert_eq!(cache.sync(&doc), 1);
         assert!(!cache.get(0).unwrap().unwrap().on_the_fly());
         // a plan is lowered with the motion it was planned for
@@ -272,19 +273,24 @@ mod tests {
     }
 
     #[test]
-    fn a_job_lowering_is_adopted_and_redone_only_if_the_document_changed() {
+    fn a_job_lowering_is_adopted_and_redone_only_if_the_plan_changed() {
         let mut doc = doc_with_plan(false);
         let job_doc = doc.clone();
         let toolpath = lower_plan(&job_doc, &job_doc.plans[0]).unwrap();
-        let lowered = Prelowered::of(&job_doc, &job_doc.plans[0], toolpath).renamed("P (stopped)");
+        let lowered = Prelowered::of(&job_doc.plans[0], toolpath).renamed("P (stopped)");
         doc.plans[0].name = "P (stopped)".into();
         let mut cache = ToolpathCache::default();
         cache.adopt(0, lowered.clone());
         assert_eq!(cache.sync(&doc), 0, "the job's lowering is taken as it is");
         assert_eq!(cache.get(0).unwrap().unwrap().toolpath.strokes.len(), 1);
-        // the profile changed while the job ran: the job's lowering is stale
+        // the document's profile changed while the job ran: the plan is its own
         let mut cache = ToolpathCache::default();
         doc.profile.scanner.mark_speed_mm_s *= 2.0;
+        cache.adopt(0, lowered.clone());
+        assert_eq!(cache.sync(&doc), 0);
+        // another plan in that place is lowered again
+        let mut cache = ToolpathCache::default();
+        doc.plans[0].profile.scanner.mark_speed_mm_s *= 2.0;
         cache.adopt(0, lowered.clone());
         assert_eq!(cache.sync(&doc), 1);
         // a plan index past the lowered ones is not kept: sync lowers it itself

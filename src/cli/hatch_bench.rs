@@ -3,8 +3,8 @@
 
 use anyhow::{Context, Result};
 use clap::Args;
+use galvoplan::bench::hatch::{format_table, read_contours, run_case};
 use galvoplan::document::write_atomic;
-use galvoplan::hatch::bench::{format_table, read_contours, run_case};
 use galvoplan::hatch::HatchStyle;
 use std::path::PathBuf;
 

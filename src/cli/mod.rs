@@ -194,6 +194,36 @@ enum OutlineArg {
     None,
 }
 
+impl PlanArgs {
+    /// The files the job reads: no output may be one of them.
+    fn inputs(&self) -> Vec<&std::path::Path> {
+        let mut v = vec![self.input.as_path()];
+        v.extend(self.job.pens.as_deref());
+        let profile = std::path::Path::new(&self.job.profile);
+        if profile.exists() {
+            v.push(profile);
+        }
+        v
+    }
+    /// The files the job writes, with what each is.
+    fn outputs(&self) -> Vec<(&'static str, &std::path::Path)> {
+        let mut v = vec![("G-code", self.output.as_path())];
+        let optional = [
+            ("report", &self.report),
+            ("preview", &self.preview),
+            ("rerun recording", &self.rerun),
+            ("geometry SVG", &self.export_geometry),
+            ("trajectory", &self.trajectory),
+        ];
+        v.extend(
+            optional
+                .iter()
+                .filter_map(|(w, p)| Some((*w, p.as_deref()?))),
+        );
+        v
+    }
+}
+
 impl JobOpts {
     fn profile(&self) -> Result<MachineProfile> {
         Ok(MachineProfile::load(&self.profile)?)
@@ -270,7 +300,7 @@ impl JobOpts {
         let Some(spec) = &self.hatch else {
             return Ok(None);
         };
-        let mut h = HatchSettings::parse_spec(spec)?;
+        let mut h = HatchSettings::parse_spec(spec).map_err(|e| anyhow::anyhow!("--hatch {e}"))?;
         h.edge_offset_mm = self.hatch_edge;
         if let Some(o) = self.hatch_outline {
             h.outline = match o {
@@ -279,7 +309,7 @@ impl JobOpts {
                 OutlineArg::None => OutlineMode::None,
             };
         }
-        h.validate()?;
+        h.check().map_err(|e| anyhow::anyhow!("--hatch: {e}"))?;
         Ok(Some(h))
     }
     fn import(&self) -> Result<ImportOptions> {
@@ -369,8 +399,34 @@ pub fn main() -> std::process::ExitCode {
     }
 }
 
-/// The error and its causes on one line, skipping causes already quoted by their parent.
+/// `n` and the noun for it: "1 geometry", "3 geometries".
+fn count(n: usize, one: &str, many: &str) -> String {
+    format!("{n} {}", if n == 1 { one } else { many })
+}
+
+/// What the operator can do about an error, in the command line's words.
+fn hint(e: &anyhow::Error) -> Option<&'static str> {
+    use galvoplan::pipeline::{PipelineError, Remedy};
+    let remedy = e
+        .chain()
+        .find_map(|c| c.downcast_ref::<PipelineError>())?
+        .remedy()?;
+    Some(match remedy {
+        Remedy::SplitOversize => {
+            "use --split-oversize to cut them at field borders, or --motion on-the-fly"
+        }
+    })
+}
+
+/// The error and its causes on one line, skipping causes already quoted by their parent, then
+/// what could help.
 fn one_line(e: &anyhow::Error) -> String {
+    let hint = hint(e).map_or(String::new(), |h| format!(" ({h})"));
+    one_line_causes(e) + &hint
+}
+
+/// The error and its causes on one line.
+fn one_line_causes(e: &anyhow::Error) -> String {
     let mut msg = String::new();
     for cause in e.chain() {
         let text = cause.to_string();

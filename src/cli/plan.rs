@@ -5,7 +5,8 @@ use super::PlanArgs;
 use anyhow::{Context, Result};
 use galvoplan::document::write_atomic;
 use galvoplan::export::{
-    geometry_svg, preview_svg, report_json, trajectory_csv, trajectory_period_s, write_gcode,
+    check_outputs, geometry_svg, preview_svg, report_json, trajectory_csv, trajectory_period_s,
+    write_gcode,
 };
 use galvoplan::job::{CancelToken, JobCtx};
 use galvoplan::pipeline::{apply_pen_library, load_svg, lower_plan_on, plan_document_lowered};
@@ -13,6 +14,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 pub fn run(a: &PlanArgs) -> Result<()> {
+    check_outputs(&a.inputs(), &a.outputs())?;
     let profile = a.job.profile()?;
     let settings = a.job.settings()?;
     let opts = a.job.import()?;
@@ -64,7 +66,7 @@ pub fn run(a: &PlanArgs) -> Result<()> {
         plan.metrics.motion = Some(toolpath.motion_figures(p));
         trajectory_csv(&toolpath, p)
     });
-    let gcode = write_gcode(&toolpath, &plan, &doc.profile, doc.page_mm[1], &source)
+    let gcode = write_gcode(&toolpath, &plan, doc.page_mm[1], &source)
         .with_context(|| format!("{}: cannot write G-code", a.output.display()))?;
     let preview = a
         .preview
@@ -86,10 +88,7 @@ pub fn run(a: &PlanArgs) -> Result<()> {
     write(&a.output, &gcode)?;
     finish_recording(recorder.as_ref())?;
     if let Some(p) = &a.report {
-        write(
-            p,
-            &report_json(&source, &plan, &doc.settings, &doc.warnings),
-        )?;
+        write(p, &report_json(&source, &plan, &doc.warnings))?;
     }
     if let (Some(p), Some(s)) = (&a.preview, &preview) {
         write(p, s)?;
@@ -102,10 +101,10 @@ pub fn run(a: &PlanArgs) -> Result<()> {
     }
     let m = &plan.metrics;
     eprintln!(
-        "galvoplan: {}: {} geometries, {} fields, job time {:.3} s, idle {:.1} mm, base {:.1} mm, marked {:.1} mm, {} direction changes, planned in {:.1} ms",
+        "galvoplan: {}: {}, {}, job time {:.3} s, idle {:.1} mm, base {:.1} mm, marked {:.1} mm, {} direction changes, planned in {:.1} ms",
         source,
-        doc.geometries.len(),
-        m.fields,
+        super::count(doc.geometries.len(), "geometry", "geometries"),
+        super::count(m.fields, "field", "fields"),
         m.job_time_s.unwrap_or(0.0),
         m.idle_mm,
         m.base_mm,

@@ -40,6 +40,14 @@ fn default_layer() -> String {
     DEFAULT_LAYER.to_string()
 }
 
+/// Hatch output geometries have a layer starting with this (then the region's own layer).
+pub const HATCH_LAYER_PREFIX: &str = "hatch:";
+
+/// True for a geometry made by the hatch (see [`HATCH_LAYER_PREFIX`]).
+pub fn is_hatch_output(g: &Geometry) -> bool {
+    g.source.layer.starts_with(HATCH_LAYER_PREFIX)
+}
+
 impl Geometry {
     /// Makes a geometry on the layer its source names ([`DEFAULT_LAYER`] when none); for a
     /// closed one a repeated last point is dropped.

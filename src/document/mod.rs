@@ -1,14 +1,21 @@
 //! The document model: geometries, machine profile, solver settings, scan fields and plans.
 
 mod geometry;
+mod hatch;
+mod inputs;
 mod pens;
 mod plan;
 mod profile;
 mod project;
+mod route;
 mod settings;
+pub mod spec;
 pub mod validate;
+mod warning;
 
-pub use geometry::{Geometry, Source};
+pub use geometry::{is_hatch_output, Geometry, Source, HATCH_LAYER_PREFIX};
+pub use hatch::{FillRule, HatchSettings, HatchSpecError, HatchStyle, OutlineMode, MIN_SPACING_MM};
+pub use inputs::{staleness, GeometryRevision, PlanInputs};
 pub use pens::{
     parse_colour, pen_of, sync_layers, validate_layers, Layer, Pen, PenLibrary, PensError,
     DEFAULT_LAYER, MAX_PASSES, PENS_VERSION,
@@ -23,14 +30,14 @@ pub use profile::{
 pub use project::{
     load_project, parse_project, save_project, write_atomic, ProjectError, PROJECT_VERSION,
 };
+pub use route::TimedRoute;
 pub use settings::{
     Algo, CostModel, FieldsMode, GaParams, MotionMode, RouteGaSettings, SolverSettings,
     StageRouteKind, VertexMode,
 };
 
-use crate::hatch::HatchSettings;
-use crate::import::Warning;
 use serde::{Deserialize, Serialize};
+pub use warning::Warning;
 
 /// The parts of the layer table and profile that decide the marked geometries: per layer its
 /// name, whether it is enabled and its hatch; the field size (hatch is cut at field cells).
@@ -63,7 +70,7 @@ pub struct Document {
     /// Page size of the imported artwork in mm (width, height), used for the Y flip.
     pub page_mm: [f64; 2],
     /// The artwork as imported (outlines only, every layer), from which `geometries` are
-    /// made by the layers' pens (see [`crate::pipeline::derive_geometries`]).
+    /// made by the layers' pens (see `solve::derive_geometries`).
     #[serde(default)]
     pub artwork: Vec<Geometry>,
     /// The layers of the artwork and their pens, in order of first appearance.
@@ -85,6 +92,13 @@ pub struct Document {
     pub fields: Vec<ScanField>,
     /// Results kept for comparison, newest last.
     pub plans: Vec<Plan>,
+    /// Revision of `geometries`, raised whenever they change ([`Document::set_geometries`]);
+    /// each plan names the revision it was planned on.
+    #[serde(default)]
+    pub geometry_rev: u64,
+    /// Earlier geometry lists that plans were planned on and still refer to.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub kept_geometries: Vec<GeometryRevision>,
 }
 
 impl Document {

@@ -6,9 +6,9 @@
 //! `gcode.feed_mm_min`, `gcode.power`), so a document without pens plans and exports exactly as
 //! before. Pens are saved in project files and as a small TOML library ([`PenLibrary`]).
 
-use super::validate::{non_negative, positive, InvalidValue};
+use super::validate::InvalidValue;
+use super::HatchSettings;
 use super::{Geometry, MachineProfile};
-use crate::hatch::HatchSettings;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
@@ -68,23 +68,7 @@ impl Default for Pen {
 impl Pen {
     /// Checks ranges; the error names the first bad value in the GUI's words.
     pub fn validate(&self) -> Result<(), InvalidValue> {
-        if let Some(v) = self.mark_speed_mm_s {
-            positive("Mark speed (mm/s)", "mark_speed_mm_s", v)?;
-        }
-        if let Some(v) = self.power {
-            non_negative("Power", "power", v)?;
-        }
-        if let Some(v) = self.frequency_khz {
-            positive("Pulse frequency (kHz)", "frequency_khz", v)?;
-        }
-        if !(1..=MAX_PASSES).contains(&self.passes) {
-            return Err(InvalidValue::new(
-                "Passes",
-                "passes",
-                self.passes,
-                format!("a whole number from 1 to {MAX_PASSES}"),
-            ));
-        }
+        super::spec::check_all(&super::spec::pen_specs(), self)?;
         if let Some(c) = &self.colour {
             if parse_colour(c).is_none() {
                 return Err(InvalidValue::new(

@@ -141,7 +141,7 @@ pub struct MotionFigures {
     pub scan_peak_offset_mm: f64,
 }
 
-/// Metrics of a plan (definitions in DESIGN.md and [`crate::order::metrics`]).
+/// Metrics of a plan (definitions in DESIGN.md and `order::metrics`).
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct Metrics {
     /// Laser-off travel between consecutive strokes, mm.
@@ -160,7 +160,7 @@ pub struct Metrics {
     pub overlap_pct: f64,
     /// Sign reversals of the travel direction along the base path.
     pub direction_changes: usize,
-    /// Machine time of the job: the lowered toolpath's duration ([`crate::motion`]), s.
+    /// Machine time of the job: the lowered toolpath's duration (`motion`), s.
     pub job_time_s: Option<f64>,
     /// The job time by what the machine does, s.
     #[serde(default)]
@@ -210,15 +210,45 @@ pub struct Plan {
     /// On the fly with seed 001's routes (`lsa`, `cetsp-ga`): the stage route the lowering
     /// follows (none: the taut string, computed by the lowering itself).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub stage_route: Option<crate::motion::cetsp::TimedRoute>,
-    /// The layers and pens it was planned with (mark speeds, powers, passes): it is lowered
-    /// and exported with them whatever the current layer table. Empty (plans from before
-    /// pens): every geometry with the profile's speed, feed and power.
+    pub stage_route: Option<super::TimedRoute>,
+    /// The layers and pens it was planned with (mark speeds, powers, passes, hatch): it is
+    /// lowered and exported with them whatever the current layer table. Empty (plans from
+    /// before pens): every geometry with the profile's speed, feed and power.
     #[serde(default)]
     pub layers: Vec<super::Layer>,
+    /// The machine profile it was planned for: its figures, its lowering and its exports are
+    /// of this profile, whatever the document's current one (project version 3; older
+    /// projects' plans get the document's profile on load).
+    #[serde(default)]
+    pub profile: super::MachineProfile,
+    /// The solver settings it was planned with (cost, motion, route, seed, …; `algo` and
+    /// `motion` are the plan's own).
+    #[serde(default)]
+    pub settings: super::SolverSettings,
+    /// The revision of the document's geometries it was planned on
+    /// ([`super::Document::plan_geometries`]).
+    #[serde(default)]
+    pub geometry_rev: u64,
 }
 
 impl Plan {
+    /// A plan of `order` on `fields` (in visiting order) made from `inputs`, before metrics.
+    pub fn new(inputs: &super::PlanInputs, fields: Vec<ScanField>, order: Vec<Step>) -> Plan {
+        Plan {
+            name: String::new(),
+            algo: inputs.settings.algo,
+            fields,
+            order,
+            metrics: Metrics::default(),
+            history: Vec::new(),
+            motion: inputs.settings.motion,
+            stage_route: None,
+            layers: inputs.layers.clone(),
+            profile: inputs.profile.clone(),
+            settings: inputs.settings.clone(),
+            geometry_rev: inputs.geometry_rev,
+        }
+    }
     /// The pen of geometry `g` in this plan (none: the profile's settings).
     pub fn pen(&self, g: &super::Geometry) -> Option<&super::Pen> {
         super::pen_of(&self.layers, g)

@@ -1,6 +1,6 @@
 //! Machine profiles: stroke, scan field, dynamics, laser timing and G-code dialect (TOML).
 
-use super::validate::{non_negative, positive, InvalidValue};
+use super::validate::InvalidValue;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
@@ -323,107 +323,7 @@ impl MachineProfile {
                 format!("between 1 and {PROFILE_VERSION} (this build)"),
             ));
         }
-        let (x, y) = (&self.axis_x, &self.axis_y);
-        for (what, key, v) in [
-            ("Field width (mm)", "field_mm[0]", self.field_mm[0]),
-            ("Field height (mm)", "field_mm[1]", self.field_mm[1]),
-            (
-                "Base X max velocity (mm/s)",
-                "axis_x.max_velocity_mm_s",
-                x.max_velocity_mm_s,
-            ),
-            (
-                "Base X max accel (mm/s²)",
-                "axis_x.max_accel_mm_s2",
-                x.max_accel_mm_s2,
-            ),
-            (
-                "Base Y max velocity (mm/s)",
-                "axis_y.max_velocity_mm_s",
-                y.max_velocity_mm_s,
-            ),
-            (
-                "Base Y max accel (mm/s²)",
-                "axis_y.max_accel_mm_s2",
-                y.max_accel_mm_s2,
-            ),
-            (
-                "Scanner jump speed (mm/s)",
-                "scanner.jump_speed_mm_s",
-                self.scanner.jump_speed_mm_s,
-            ),
-            (
-                "Scanner mark speed (mm/s)",
-                "scanner.mark_speed_mm_s",
-                self.scanner.mark_speed_mm_s,
-            ),
-            ("Feed (mm/min)", "gcode.feed_mm_min", self.gcode.feed_mm_min),
-        ] {
-            positive(what, key, v)?;
-        }
-        for (what, key, v) in [
-            ("Stroke X (mm)", "stroke_mm[0]", self.stroke_mm[0]),
-            ("Stroke Y (mm)", "stroke_mm[1]", self.stroke_mm[1]),
-            (
-                "On-the-fly margin (mm)",
-                "otf_margin_mm",
-                self.otf_margin_mm,
-            ),
-            ("Base X settling time (s)", "axis_x.settle_s", x.settle_s),
-            ("Base Y settling time (s)", "axis_y.settle_s", y.settle_s),
-            (
-                "Laser on delay (s)",
-                "laser.on_delay_s",
-                self.laser.on_delay_s,
-            ),
-            (
-                "Laser off delay (s)",
-                "laser.off_delay_s",
-                self.laser.off_delay_s,
-            ),
-            (
-                "Jump delay (s)",
-                "laser.jump_delay_s",
-                self.laser.jump_delay_s,
-            ),
-        ] {
-            non_negative(what, key, v)?;
-        }
-        if let Some(power) = self.gcode.power {
-            non_negative("Power S", "gcode.power", power)?;
-        }
-        if self.gcode.decimals > MAX_DECIMALS {
-            return Err(InvalidValue::new(
-                "Decimals",
-                "gcode.decimals",
-                self.gcode.decimals,
-                format!("at most {MAX_DECIMALS}"),
-            ));
-        }
-        for (what, key, w) in [
-            ("Laser on word", "gcode.laser_on", &self.gcode.laser_on),
-            ("Laser off word", "gcode.laser_off", &self.gcode.laser_off),
-            ("Power word", "gcode.power_word", &self.gcode.power_word),
-            (
-                "Scanner X axis word",
-                "gcode.scanner_axes[0]",
-                &self.gcode.scanner_axes[0],
-            ),
-            (
-                "Scanner Y axis word",
-                "gcode.scanner_axes[1]",
-                &self.gcode.scanner_axes[1],
-            ),
-        ] {
-            if w.trim().is_empty() {
-                return Err(InvalidValue::new(
-                    what,
-                    key,
-                    "an empty word",
-                    "a G-code word",
-                ));
-            }
-        }
+        super::spec::check_all(&super::spec::profile_specs(), self)?;
         let half_field_mm = self.field_mm[0].min(self.field_mm[1]) / 2.0;
         if self.otf_margin_mm >= half_field_mm {
             return Err(InvalidValue::new(
@@ -447,9 +347,6 @@ impl MachineProfile {
         Ok(())
     }
 }
-
-/// The most decimal places a G-code number may have (below a nanometre is noise).
-pub const MAX_DECIMALS: usize = 9;
 
 #[cfg(test)]
 mod tests {

@@ -15,7 +15,11 @@ use thiserror::Error;
 ///   is upgraded on load: its geometries (without hatch output) become the artwork, on one
 ///   default layer whose pen hatches as its settings' hatch did, and its geometries, fields
 ///   and plans stay as they were.
-pub const PROJECT_VERSION: u32 = 2;
+/// * 3: each plan records what it was made from (`profile`, `settings`, `geometry_rev`), the
+///   document its geometry revision (`geometry_rev`) and the earlier geometry lists plans
+///   still refer to (`kept_geometries`). Older plans get the document's profile and settings
+///   on load (what they were last shown and exported with).
+pub const PROJECT_VERSION: u32 = 3;
 const FORMAT: &str = "galvoplan-project";
 
 #[derive(Serialize, Deserialize)]
@@ -140,6 +144,10 @@ pub fn parse_project(text: &str, file: &str) -> Result<Document, ProjectError> {
             found: version,
         });
     }
+    let mut value = value;
+    if version < 3 {
+        upgrade_v2_plans(&mut value);
+    }
     let pf: ProjectFile = serde_json::from_value(value).map_err(|e| corrupt(e.to_string()))?;
     let mut doc = pf.document;
     if version == 1 {
@@ -152,6 +160,25 @@ pub fn parse_project(text: &str, file: &str) -> Result<Document, ProjectError> {
     Ok(doc)
 }
 
+/// Version 2 → 3: plans without their own profile and settings get the document's.
+fn upgrade_v2_plans(value: &mut serde_json::Value) {
+    let Some(doc) = value.get_mut("document").and_then(|d| d.as_object_mut()) else {
+        return;
+    };
+    let inherited: Vec<(&str, serde_json::Value)> = ["profile", "settings"]
+        .into_iter()
+        .filter_map(|k| Some((k, doc.get(k)?.clone())))
+        .collect();
+    let Some(plans) = doc.get_mut("plans").and_then(|p| p.as_array_mut()) else {
+        return;
+    };
+    for plan in plans.iter_mut().filter_map(|p| p.as_object_mut()) {
+        for (k, v) in &inherited {
+            plan.entry(k.to_string()).or_insert_with(|| v.clone());
+        }
+    }
+}
+
 /// Version 1 → 2: the geometries (without hatch output) become the artwork on the default
 /// layer, whose pen hatches as the settings said; the geometries count as made from that
 /// table, so fields and plans stay valid.
@@ -159,7 +186,7 @@ fn upgrade_v1(doc: &mut Document) {
     doc.artwork = doc
         .geometries
         .iter()
-        .filter(|g| !crate::hatch::is_hatch_output(g))
+        .filter(|g| !super::is_hatch_output(g))
         .cloned()
         .collect();
     let default_pen = Pen {

@@ -1,6 +1,6 @@
 //! Solver settings: which field placement and ordering to run, seed, limits, GA parameters.
 
-use super::validate::{non_negative, positive, within, InvalidValue};
+use super::validate::InvalidValue;
 use serde::{Deserialize, Serialize};
 
 /// How scan fields are placed.
@@ -112,12 +112,12 @@ pub struct RouteGaSettings {
 
 impl Default for RouteGaSettings {
     fn default() -> Self {
-        let paper = crate::motion::cetsp::GaParams::default();
+        // seed 001 Table II
         Self {
-            population: paper.population,
-            generations: paper.generations,
-            crossover_rate: paper.crossover_rate,
-            mutation_rate: paper.mutation_rate,
+            population: 50,
+            generations: 500,
+            crossover_rate: 1.0,
+            mutation_rate: 0.5,
             padding_radius_mm: None,
         }
     }
@@ -190,7 +190,7 @@ pub struct SolverSettings {
     pub ga: GaParams,
     /// Hatch fills for closed regions (none: outlines only).
     #[serde(default)]
-    pub hatch: Option<crate::hatch::HatchSettings>,
+    pub hatch: Option<super::HatchSettings>,
 }
 
 impl Default for SolverSettings {
@@ -217,23 +217,8 @@ impl Default for SolverSettings {
 impl SolverSettings {
     /// Checks ranges; the error names the first bad value in the GUI's words.
     pub fn validate(&self) -> Result<(), InvalidValue> {
-        non_negative(
-            "Direction weight",
-            "direction_weight",
-            self.direction_weight,
-        )?;
-        if let Some(t) = self.time_limit_s {
-            positive("Time limit (s)", "time_limit_s", t)?;
-        }
+        super::spec::check_all(&super::spec::settings_specs(), self)?;
         let ga = &self.ga;
-        if ga.population_min < MIN_POPULATION {
-            return Err(InvalidValue::new(
-                "GA population min",
-                "ga.population_min",
-                ga.population_min,
-                format!("at least {MIN_POPULATION}"),
-            ));
-        }
         if !(ga.population_min <= ga.population && ga.population <= ga.population_max) {
             return Err(InvalidValue::new(
                 "GA population",
@@ -243,28 +228,6 @@ impl SolverSettings {
                     "between GA population min ({}) and max ({})",
                     ga.population_min, ga.population_max
                 ),
-            ));
-        }
-        within(
-            "GA elite fraction",
-            "ga.elite_fraction",
-            ga.elite_fraction,
-            0.0,
-            1.0,
-        )?;
-        within(
-            "GA mutation rate",
-            "ga.mutation_rate",
-            ga.mutation_rate,
-            0.0,
-            1.0,
-        )?;
-        if ga.stall_generations == 0 {
-            return Err(InvalidValue::new(
-                "GA stall generations",
-                "ga.stall_generations",
-                0,
-                "at least 1",
             ));
         }
         if let Some(h) = &self.hatch {
@@ -310,8 +273,8 @@ mod tests {
         s.ga.stall_generations = 0;
         assert!(s.validate().is_err());
         s.ga.stall_generations = 5;
-        s.hatch = Some(crate::hatch::HatchSettings::new(
-            crate::hatch::HatchStyle::Lines,
+        s.hatch = Some(crate::document::HatchSettings::new(
+            crate::document::HatchStyle::Lines,
             0.0,
         ));
         let e = s.validate().unwrap_err().to_string();

@@ -115,15 +115,16 @@ impl Words<'_> {
     }
 }
 
-/// Writes the toolpath of `plan` as G-code in the profile's dialect; Y is mirrored about
-/// `page_height_mm` when the dialect says `flip_y`.
+/// Writes the toolpath of `plan` as G-code in the dialect of the plan's profile; Y is mirrored
+/// about `page_height_mm` when the dialect says `flip_y`. Fields are numbered 1…n in visiting
+/// order (the plan's field order), as everywhere else.
 pub fn write_gcode(
     toolpath: &Toolpath,
     plan: &Plan,
-    profile: &MachineProfile,
     page_height_mm: f64,
     title: &str,
 ) -> Result<String, GcodeError> {
+    let profile = &plan.profile;
     let d = &profile.gcode;
     let w = Words {
         profile,
@@ -147,18 +148,22 @@ pub fn write_gcode(
     let mut out = String::with_capacity(toolpath.strokes.len() * 64);
     header(&mut out, toolpath, plan, title);
     let _ = writeln!(out, "{}", d.laser_off);
+    let number: std::collections::HashMap<usize, usize> = plan
+        .fields
+        .iter()
+        .enumerate()
+        .map(|(k, f)| (f.id, k + 1))
+        .collect();
     let mut current_field = None;
     for (k, stroke) in toolpath.strokes.iter().enumerate() {
         if current_field != Some(stroke.field) {
             current_field = Some(stroke.field);
             let c = w.position(stroke.stage);
-            let _ = writeln!(
-                out,
-                "; field {} centre {} {}",
-                stroke.field,
-                w.num(c.x),
-                w.num(c.y)
-            );
+            let label = match number.get(&stroke.field) {
+                Some(n) => n.to_string(),
+                None => format!("[id {}]", stroke.field),
+            };
+            let _ = writeln!(out, "; field {label} centre {} {}", w.num(c.x), w.num(c.y));
             if stage_scanner {
                 let _ = writeln!(out, "G0 {}", w.xy(["X", "Y"], c));
             }
@@ -210,6 +215,9 @@ fn header(out: &mut String, toolpath: &Toolpath, plan: &Plan, title: &str) {
         env!("CARGO_PKG_VERSION"),
         title.replace('\n', " ")
     );
+    if !plan.name.is_empty() {
+        let _ = writeln!(out, "; plan {}", plan.name.replace('\n', " "));
+    }
     let _ = writeln!(
         out,
         "; {} strokes in {} fields, marked {:.3} mm, idle {:.3} mm, base {:.3} mm, job time {:.3} s",

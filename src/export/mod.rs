@@ -2,11 +2,13 @@
 //! JSON report, SVG preview, sampled trajectory; and the geometry as SVG.
 
 mod gcode;
+mod guard;
 mod report;
 mod svg_preview;
 mod trajectory;
 
 pub use gcode::{write_gcode, GcodeError};
+pub use guard::{check_outputs, OutputClash};
 pub use report::{report_json, Report};
 pub use svg_preview::{geometry_svg, preview_svg};
 pub use trajectory::{

@@ -1,13 +1,17 @@
 //! The JSON report (`--report`): fields, order, metrics, settings, history, warnings.
 
-use crate::document::{GenerationRecord, Metrics, Plan, SolverSettings};
-use crate::import::Warning;
+use crate::document::{
+    GenerationRecord, Layer, MachineProfile, Metrics, Plan, SolverSettings, Warning,
+};
 use serde::Serialize;
 
 /// One field in the report.
 #[derive(Debug, Serialize)]
 pub struct ReportField {
-    /// Field id.
+    /// Its number, 1…n in visiting order (what the G-code comments, the preview and the GUI
+    /// call it).
+    pub number: usize,
+    /// Field id (what `order[].field` refers to).
     pub id: usize,
     /// Centre (base position), mm.
     pub center: [f64; 2],
@@ -39,37 +43,42 @@ pub struct Report<'a> {
     pub source: &'a str,
     /// galvoplan version.
     pub version: &'static str,
-    /// Algorithm.
-    pub algo: String,
+    /// The plan's name.
+    pub plan: &'a str,
+    /// Algorithm, as the CLI spells it (`hha`, `hga`, `baseline`, `as-is`).
+    pub algo: &'static str,
     /// Fields in visiting order.
     pub fields: Vec<ReportField>,
     /// Strokes in marking order.
     pub order: Vec<ReportStep>,
     /// Metrics.
     pub metrics: &'a Metrics,
-    /// Settings used.
+    /// The solver settings the plan was made with.
     pub settings: &'a SolverSettings,
+    /// The machine profile it was made for.
+    pub profile: &'a MachineProfile,
+    /// The layers and their pens it was made with (speeds, powers, passes, hatch).
+    pub pens: &'a [Layer],
     /// GA convergence history.
     pub history: &'a [GenerationRecord],
     /// Import warnings.
     pub warnings: Vec<String>,
 }
 
-/// Builds the report as pretty JSON text.
-pub fn report_json(
-    source: &str,
-    plan: &Plan,
-    settings: &SolverSettings,
-    warnings: &[Warning],
-) -> String {
+/// Builds the report as pretty JSON text: everything of the plan's own (its inputs, enough to
+/// plan it again, whatever the document's settings are now).
+pub fn report_json(source: &str, plan: &Plan, warnings: &[Warning]) -> String {
     let r = Report {
         source,
         version: env!("CARGO_PKG_VERSION"),
-        algo: format!("{:?}", plan.algo).to_lowercase(),
+        plan: &plan.name,
+        algo: plan.algo.label(),
         fields: plan
             .fields
             .iter()
-            .map(|f| ReportField {
+            .enumerate()
+            .map(|(k, f)| ReportField {
+                number: k + 1,
                 id: f.id,
                 center: [f.center.x, f.center.y],
                 size: f.size,
@@ -88,7 +97,9 @@ pub fn report_json(
             })
             .collect(),
         metrics: &plan.metrics,
-        settings,
+        settings: &plan.settings,
+        profile: &plan.profile,
+        pens: &plan.layers,
         history: &plan.history,
         warnings: warnings.iter().map(|w| w.to_string()).collect(),
     };

@@ -34,7 +34,7 @@ pub const INSIDE_EPS_MM: f64 = 1e-7;
 #[derive(Debug, Error)]
 pub enum FieldError {
     /// Geometries larger than one scan field.
-    #[error("{} {} larger than the {:.1} × {:.1} mm scan field (use --split-oversize to cut them at field borders): {}", .list.len(), if .list.len() == 1 { "geometry is" } else { "geometries are" }, .field_mm[0], .field_mm[1], .list.join("; "))]
+    #[error("{} {} larger than the {:.1} × {:.1} mm scan field: {}", .list.len(), if .list.len() == 1 { "geometry is" } else { "geometries are" }, .field_mm[0], .field_mm[1], .list.join("; "))]
     Oversize {
         /// Each offending geometry, described with its size.
         list: Vec<String>,

@@ -7,9 +7,9 @@
 //! first and last piece are joined when they lie in the same cell.
 
 use super::INSIDE_EPS_MM;
+use crate::document::Warning;
 use crate::document::{Geometry, Source};
 use crate::geom::Pt;
-use crate::import::Warning;
 
 /// Pieces shorter than this (mm) are dropped: below the resolution of the exported G-code.
 pub const MIN_PIECE_MM: f64 = 1e-3;

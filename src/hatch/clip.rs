@@ -412,8 +412,8 @@ fn join_pieces(pieces: Vec<Piece>, b: &BBox) -> Option<Vec<Polyline<f64>>> {
 #[cfg(test)]
 mod tests {
     use super::super::region::{resolve, Frame};
-    use super::super::settings::FillRule;
     use super::*;
+    use crate::document::FillRule;
     use crate::geom::Pt;
 
     fn area(loops: &[Polyline<f64>]) -> f64 {
@@ -497,7 +497,7 @@ mod tests {
     fn clip_matches_a_polygon_clip_on_the_contest_shape() {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("tests/data/hatch/attachment2_graph2.csv");
-        let c = crate::hatch::bench::read_contours(&path).unwrap();
+        let c = crate::bench::hatch::read_contours(&path).unwrap();
         let loops = resolve(&c, FillRule::EvenOdd);
         let frame = Frame::new(&loops, 1.0);
         let q = Region::new(&loops, frame).offset(1.5);

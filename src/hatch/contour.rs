@@ -274,8 +274,8 @@ fn store<T>(slots: &Slots<T>, k: usize, v: T) {
 #[cfg(test)]
 mod tests {
     use super::super::region::{resolve, Frame};
-    use super::super::settings::FillRule;
     use super::*;
+    use crate::document::FillRule;
     use crate::geom::polyline_length;
 
     fn disc(r: f64, n: usize) -> Vec<Pt> {
@@ -371,7 +371,7 @@ mod tests {
             ("tests/data/hatch/attachment2_graph2.csv", 0.4),
         ] {
             let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(file);
-            let c = crate::hatch::bench::read_contours(&path).unwrap();
+            let c = crate::bench::hatch::read_contours(&path).unwrap();
             shapes.push((file.into(), c, s));
         }
         // a star with a star hole and a square hole

@@ -3,20 +3,13 @@
 
 use super::cut::{cut, fits, Grid};
 use super::{hatch_contours, HatchError, HatchSettings, OutlineMode};
-use crate::document::{Geometry, Layer, Source};
+use crate::document::{Geometry, Layer, Source, Warning};
 use crate::geom::{BBox, Pt};
-use crate::import::Warning;
 use crate::job::JobCtx;
 use rayon::prelude::*;
 use std::collections::HashMap;
 
-/// Hatch output geometries have a layer starting with this (then the region's own layer).
-pub const HATCH_LAYER_PREFIX: &str = "hatch:";
-
-/// True for a geometry made by the hatch (see [`HATCH_LAYER_PREFIX`]).
-pub fn is_hatch_output(g: &Geometry) -> bool {
-    g.source.layer.starts_with(HATCH_LAYER_PREFIX)
-}
+pub use crate::document::{is_hatch_output, HATCH_LAYER_PREFIX};
 
 /// The geometries after hatching.
 #[derive(Debug, Clone, Default)]
@@ -43,7 +36,7 @@ pub fn hatch_geometries(
     field_mm: [f64; 2],
     ctx: &JobCtx,
 ) -> Result<HatchedGeometries, HatchError> {
-    settings.validate()?;
+    settings.check()?;
     // regions in order of first appearance
     let mut region_of: HashMap<&str, usize> = HashMap::new();
     let mut regions: Vec<Vec<usize>> = Vec::new();

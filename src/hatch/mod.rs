@@ -18,9 +18,8 @@
 //!
 //! [`hatch_contours`] fills one region; [`hatch_geometries`] fills the closed geometries of a
 //! document (one region per SVG element) and cuts strokes larger than a scan field at field-sized
-//! cells. [`mod@bench`] reproduces seed 003's experiment.
+//! cells. `bench::hatch` reproduces seed 003's experiment.
 
-pub mod bench;
 mod boundary;
 mod clip;
 mod contour;
@@ -30,14 +29,15 @@ mod elems;
 mod gaps;
 mod region;
 mod scan;
-mod settings;
 mod spots;
 mod zigzag;
 
+pub use crate::document::{
+    FillRule, HatchSettings, HatchSpecError, HatchStyle, OutlineMode, MIN_SPACING_MM,
+};
 pub use document::{
     hatch_geometries, is_hatch_output, layer_geometries, HatchedGeometries, HATCH_LAYER_PREFIX,
 };
-pub use settings::{FillRule, HatchSettings, HatchStyle, OutlineMode, MIN_SPACING_MM};
 
 use crate::geom::{polyline_length, BBox, Pt};
 use crate::job::{Cancelled, JobCtx};
@@ -58,17 +58,9 @@ pub const MAX_LINES: usize = 1_000_000;
 /// Why a hatch could not be made.
 #[derive(Debug, Error)]
 pub enum HatchError {
-    /// The `--hatch` argument is malformed.
-    #[error("--hatch {spec:?}: {reason} (expected STYLE:SPACING_MM[:ANGLE_DEG] with STYLE = zigzag | lines | cross | contour)")]
-    Spec {
-        /// The argument as given.
-        spec: String,
-        /// What is wrong.
-        reason: String,
-    },
     /// The settings are out of range.
     #[error("hatch settings: {0}")]
-    Settings(String),
+    Settings(#[from] crate::document::validate::InvalidValue),
     /// The spacing is too fine for the region's size.
     #[error(
         "{element}: hatch spacing {spacing_mm} mm would need {lines} lines (at most {MAX_LINES})"
@@ -175,7 +167,7 @@ pub fn hatch_contours(
     settings: &HatchSettings,
     ctx: &JobCtx,
 ) -> Result<RegionHatch, HatchError> {
-    settings.validate()?;
+    settings.check()?;
     let s = settings.spacing_mm;
     let loops = region::resolve(contours, settings.fill_rule);
     let mut out = RegionHatch::default();

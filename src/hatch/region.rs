@@ -5,7 +5,7 @@
 //! in a scaled frame where one hatch spacing is [`UNITS_PER_SPACING`] units; results are mapped
 //! back to mm when flattened.
 
-use super::settings::FillRule;
+use crate::document::FillRule;
 use crate::geom::Pt;
 use cavalier_contours::polyline::{
     seg_arc_radius_and_center, PlineSource, PlineSourceMut, PlineVertex, Polyline,

@@ -15,7 +15,7 @@
 use super::clip::clip_region;
 use super::elems::ElemTable;
 use super::region::{offset_loop_flattened, resolve, Elem, Region};
-use super::settings::FillRule;
+use crate::document::FillRule;
 use crate::geom::{BBox, Pt};
 
 /// Corners turning less than this (degrees) trim their neighbours harmlessly.

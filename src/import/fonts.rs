@@ -12,6 +12,11 @@ use usvg::{FontResolver, FontStretch, FontStyle};
 
 /// The bundled fallback face (Bitstream Vera licence, `assets/fonts/DejaVuSans-LICENSE.txt`).
 static BUNDLED_FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
+
+/// The bundled DejaVu Sans (TrueType), for the GUI's fallback font too.
+pub fn bundled_font() -> &'static [u8] {
+    BUNDLED_FONT
+}
 /// Family name of the bundled face.
 pub const BUNDLED_FAMILY: &str = "DejaVu Sans";
 /// Cap height of DejaVu Sans in em (1493 / 2048 font units): DXF text heights are cap heights.

@@ -11,12 +11,12 @@ mod guard;
 mod svg;
 
 pub use self::dxf::import_dxf;
-pub use fonts::{BUNDLED_CAP_HEIGHT_EM, BUNDLED_FAMILY};
+pub use fonts::{bundled_font, BUNDLED_CAP_HEIGHT_EM, BUNDLED_FAMILY};
 pub use svg::{import_svg, import_svg_file};
 
 use crate::document::Geometry;
 use crate::geom::{polyline_length, Pt};
-use serde::{Deserialize, Serialize};
+
 use std::path::Path;
 use thiserror::Error;
 
@@ -127,25 +127,7 @@ pub fn import_file(path: &Path, opts: &ImportOptions) -> Result<Imported, Import
     }
 }
 
-/// Something the import skipped or changed, naming the element.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Warning {
-    /// The element, e.g. `<text id="t1">` or `path #12`.
-    pub element: String,
-    /// Source line, when known.
-    pub line: Option<u32>,
-    /// What happened.
-    pub message: String,
-}
-
-impl std::fmt::Display for Warning {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self.line {
-            Some(l) => write!(f, "{} (line {l}): {}", self.element, self.message),
-            None => write!(f, "{}: {}", self.element, self.message),
-        }
-    }
-}
+pub use crate::document::Warning;
 
 /// Why a file could not be imported. Every variant names the file.
 #[derive(Debug, Error)]

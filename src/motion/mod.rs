@@ -37,7 +37,7 @@ pub use toolpath::{
     MachineState, ScanMotion, Segment, SegmentKind, StageMotion, Stroke, Toolpath, TIME_EPS_S,
 };
 
-use crate::document::{Geometry, Layer, MachineProfile, MotionMode, Plan};
+use crate::document::{Geometry, Layer, MotionMode, Plan};
 use crate::job::JobCtx;
 
 /// Why a plan cannot be turned into motion, in either mode.
@@ -51,15 +51,16 @@ pub enum MotionError {
     OnTheFly(#[from] OtfError),
 }
 
-/// Lowers a plan in the motion mode it was planned for; with `clock_s`, on that controller clock
-/// (every mark starts and ends on a tick: what a trajectory sampled at that period can show).
+/// Lowers a plan on the machine it was planned for (`plan.profile`) in the motion mode it was
+/// planned for; with `clock_s`, on that controller clock (every mark starts and ends on a
+/// tick: what a trajectory sampled at that period can show).
 pub fn lower_motion(
     geometries: &[Geometry],
     plan: &Plan,
-    profile: &MachineProfile,
     clock_s: Option<f64>,
     ctx: &JobCtx,
 ) -> Result<Toolpath, MotionError> {
+    let profile = &plan.profile;
     let mut path = match plan.motion {
         MotionMode::Step => {
             let path = lower(geometries, plan, profile)?;

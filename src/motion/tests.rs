@@ -2,7 +2,9 @@
 #![allow(clippy::unwrap_used)]
 
 use super::*;
-use crate::document::{Algo, Geometry, MachineProfile, Metrics, Plan, ScanField, Source, Step};
+use crate::document::{
+    Algo, Geometry, MachineProfile, Metrics, Plan, PlanInputs, ScanField, Source, Step,
+};
 use crate::geom::Pt;
 
 fn line(a: Pt, b: Pt) -> Geometry {
@@ -39,6 +41,7 @@ fn plan(fields: Vec<ScanField>, order: Vec<Step>) -> Plan {
         motion: Default::default(),
         stage_route: None,
         layers: vec![],
+        ..Plan::new(&PlanInputs::of(&Default::default()), vec![], vec![])
     }
 }
 

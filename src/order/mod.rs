@@ -7,16 +7,18 @@ pub mod cost;
 pub mod hga;
 pub mod hha;
 pub mod metrics;
+mod passes;
 pub mod time;
 pub mod tsp;
 pub mod vertex;
 
 pub use as_is::as_is_order;
 pub use baseline::baseline_order;
+pub use passes::expand_passes;
 
 use crate::document::{
-    Algo, CostModel, GenerationRecord, Geometry, MachineProfile, MotionMode, Plan, ScanField,
-    SolverSettings, Step,
+    Algo, CostModel, GenerationRecord, Geometry, MachineProfile, MotionMode, Plan, PlanInputs,
+    ScanField, SolverSettings, Step,
 };
 use crate::job::{Cancelled, JobCtx};
 use crate::motion::{lower_motion, MotionError, OtfError, Toolpath};
@@ -45,17 +47,25 @@ pub struct Ordering {
     pub steps: Vec<Step>,
 }
 
-/// Orders the allocated geometries with the algorithm in `settings` and returns the plan with
-/// its metrics (stage times other than `order` are left for the caller to fill in) and the
-/// toolpath they were computed on, so that the caller need not lower the plan again.
+/// Orders the allocated geometries with the algorithm in `inputs.settings` and returns the
+/// plan with its metrics (stage times other than `order` are left for the caller to fill in)
+/// and the toolpath they were computed on, so that the caller need not lower the plan again.
+/// Every candidate is judged on the inputs' time law, pens and passes included
+/// ([`Candidates`]).
 pub fn order_plan(
     geometries: &[Geometry],
     fields: &[ScanField],
-    profile: &MachineProfile,
-    settings: &SolverSettings,
+    inputs: &PlanInputs,
     ctx: &JobCtx,
 ) -> Result<(Plan, Toolpath), OrderError> {
     check_allocation(geometries.len(), fields)?;
+    let (profile, settings) = (&inputs.profile, &inputs.settings);
+    let lower = Candidates {
+        geometries,
+        fields,
+        inputs,
+        ctx,
+    };
     let t0 = std::time::Instant::now();
     let mut detail = Vec::new();
     let (ordering, seed_ordering, history) =
@@ -63,7 +73,7 @@ pub fn order_plan(
     let (ordering, taut) = if settings.motion == MotionMode::OnTheFly && settings.algo != Algo::AsIs
     {
         let t = std::time::Instant::now();
-        let best = faster_on_the_fly(geometries, fields, profile, settings, ordering, ctx)?;
+        let best = faster_on_the_fly(&lower, ordering)?;
         detail.push(("bands".into(), t.elapsed().as_secs_f64()));
         (best.0, Some(best.1))
     } else {
@@ -78,46 +88,77 @@ pub fn order_plan(
         let until = (settings.algo == Algo::Hha)
             .then(|| hha::deadline(settings, t0, hha::LAST_SEARCH_SHARE))
             .flatten();
-        let mut best = time_ordering(geometries, fields, profile, settings, ordering, until, ctx)?;
+        let mut best = time_ordering(&lower, ordering, until)?;
         if let Some(seed) = seed_ordering {
             // HGA's own objective is idle travel: on time, its HHA seed may still be faster
-            let other = time_ordering(geometries, fields, profile, settings, seed, until, ctx)?;
-            if other.1.duration_s() < best.1.duration_s() {
-                best = other;
-            }
+            let other = time_ordering(&lower, seed, until)?;
+            best = faster(best, other);
         }
         detail.push(("time".into(), t.elapsed().as_secs_f64()));
         best
     } else {
         let toolpath = match taut {
             Some(toolpath) => toolpath,
-            None => lower_ordering(geometries, fields, profile, settings, &ordering, ctx)?,
+            None => lower.toolpath(&ordering)?,
         };
         (ordering, toolpath)
     };
     let order_s = t0.elapsed().as_secs_f64();
-    let plan_fields = fields_in_order(fields, &ordering.field_order);
-    let mut m = metrics::compute(
-        geometries,
-        &plan_fields,
-        &ordering.steps,
-        profile,
-        &toolpath,
-    );
+    let mut plan = lower.plan(&ordering);
+    let mut m = metrics::compute(geometries, &plan.fields, &plan.order, profile, &toolpath);
     m.solve_s.order = order_s;
     m.solve_s.order_detail = detail;
-    let plan = Plan {
-        name: settings.algo.label().into(),
-        algo: settings.algo,
-        fields: plan_fields,
-        order: ordering.steps,
-        metrics: m,
-        history,
-        motion: settings.motion,
-        stage_route: None,
-        layers: Vec::new(),
-    };
+    plan.name = settings.algo.label().into();
+    plan.metrics = m;
+    plan.history = history;
     Ok((plan, toolpath))
+}
+
+/// The one lower-and-compare helper: turns candidate orderings into plans of the solve's
+/// inputs (pens, passes, profile, motion) and lowers them, so that every keep-the-faster
+/// choice is judged on the time law the plan will have.
+struct Candidates<'a> {
+    geometries: &'a [Geometry],
+    fields: &'a [ScanField],
+    inputs: &'a PlanInputs,
+    ctx: &'a JobCtx,
+}
+
+impl Candidates<'_> {
+    /// The plan of an ordering (unnamed, without metrics): its fields in visiting order, its
+    /// strokes repeated for their layers' passes.
+    fn plan(&self, ordering: &Ordering) -> Plan {
+        let order = expand_passes(&ordering.steps, self.geometries, &self.inputs.layers);
+        Plan::new(
+            self.inputs,
+            fields_in_order(self.fields, &ordering.field_order),
+            order,
+        )
+    }
+    /// The toolpath of an ordering. A search cancelled with a result (HGA's best so far) still
+    /// gets its toolpath; a cancel during the lowering itself (on the fly, seconds on large
+    /// jobs) stops it.
+    fn toolpath(&self, ordering: &Ordering) -> Result<Toolpath, OrderError> {
+        let finish = JobCtx::default();
+        let ctx = if self.ctx.is_cancelled() {
+            &finish
+        } else {
+            self.ctx
+        };
+        match lower_motion(self.geometries, &self.plan(ordering), None, ctx) {
+            Err(MotionError::OnTheFly(OtfError::Cancelled(c))) => Err(OrderError::Cancelled(c)),
+            other => Ok(other?),
+        }
+    }
+}
+
+/// The faster of two lowered candidates; the first on a tie.
+fn faster(a: (Ordering, Toolpath), b: (Ordering, Toolpath)) -> (Ordering, Toolpath) {
+    if b.1.duration_s() < a.1.duration_s() {
+        b
+    } else {
+        a
+    }
 }
 
 /// The ordering of the settings' algorithm, HGA's HHA seed ordering (when it had one) and HGA's
@@ -147,25 +188,18 @@ fn run_algorithm(
 /// On the fly: the algorithm's ordering or the sweep of field-wide bands
 /// ([`bands::band_order`]), whichever runs faster on the taut route, with that toolpath.
 fn faster_on_the_fly(
-    geometries: &[Geometry],
-    fields: &[ScanField],
-    profile: &MachineProfile,
-    settings: &SolverSettings,
+    lower: &Candidates,
     ordering: Ordering,
-    ctx: &JobCtx,
 ) -> Result<(Ordering, Toolpath), OrderError> {
-    let by_fields = lower_ordering(geometries, fields, profile, settings, &ordering, ctx)?;
-    let band_mm = profile.field_mm[0].min(profile.field_mm[1]);
-    let bands = bands::band_order(geometries, fields, band_mm, ctx)?;
+    let by_fields = lower.toolpath(&ordering)?;
+    let field_mm = lower.inputs.profile.field_mm;
+    let band_mm = field_mm[0].min(field_mm[1]);
+    let bands = bands::band_order(lower.geometries, lower.fields, band_mm, lower.ctx)?;
     if bands.steps == ordering.steps {
         return Ok((ordering, by_fields));
     }
-    let by_bands = lower_ordering(geometries, fields, profile, settings, &bands, ctx)?;
-    Ok(if by_bands.duration_s() < by_fields.duration_s() {
-        (bands, by_bands)
-    } else {
-        (ordering, by_fields)
-    })
+    let by_bands = lower.toolpath(&bands)?;
+    Ok(faster((ordering, by_fields), (bands, by_bands)))
 }
 
 /// HGA, seeded with the HHA plan when the settings say so; returns the seed plan too.
@@ -209,86 +243,30 @@ fn fields_in_order(fields: &[ScanField], order: &[usize]) -> Vec<ScanField> {
         .collect()
 }
 
-/// The toolpath of an ordering.
-fn lower_ordering(
-    geometries: &[Geometry],
-    fields: &[ScanField],
-    profile: &MachineProfile,
-    settings: &SolverSettings,
-    ordering: &Ordering,
-    ctx: &JobCtx,
-) -> Result<Toolpath, OrderError> {
-    lower_unless_cancelled(
-        geometries,
-        profile,
-        &plan_of(fields, settings, ordering),
-        ctx,
-    )
-}
-
-/// An unnamed plan of an ordering (for lowering it).
-fn plan_of(fields: &[ScanField], settings: &SolverSettings, ordering: &Ordering) -> Plan {
-    Plan {
-        name: String::new(),
-        algo: Algo::default(),
-        fields: fields_in_order(fields, &ordering.field_order),
-        order: ordering.steps.clone(),
-        metrics: Default::default(),
-        history: Vec::new(),
-        motion: settings.motion,
-        stage_route: None,
-        layers: Vec::new(),
-    }
-}
-
-/// The toolpath of `plan`.
-fn lower_unless_cancelled(
-    geometries: &[Geometry],
-    profile: &MachineProfile,
-    plan: &Plan,
-    ctx: &JobCtx,
-) -> Result<Toolpath, OrderError> {
-    // a search cancelled with a result (HGA's best so far) still gets its toolpath; a cancel
-    // during the lowering itself (on the fly, seconds on large jobs) stops it
-    let finish = JobCtx::default();
-    let ctx = if ctx.is_cancelled() { &finish } else { ctx };
-    match lower_motion(geometries, plan, profile, None, ctx) {
-        Err(MotionError::OnTheFly(OtfError::Cancelled(c))) => Err(OrderError::Cancelled(c)),
-        other => Ok(other?),
-    }
-}
-
 /// The distance ordering refined for job time ([`time::refine_for_time`]); the refinement is
 /// kept only when its toolpath is not slower, so `--cost time` never loses to `--cost distance`.
 /// After a cancel the ordering is returned as it is (the best so far).
 fn time_ordering(
-    geometries: &[Geometry],
-    fields: &[ScanField],
-    profile: &MachineProfile,
-    settings: &SolverSettings,
+    lower: &Candidates,
     ordering: Ordering,
     until: Option<std::time::Instant>,
-    ctx: &JobCtx,
 ) -> Result<(Ordering, Toolpath), OrderError> {
-    let by_distance = lower_ordering(geometries, fields, profile, settings, &ordering, ctx)?;
+    let by_distance = lower.toolpath(&ordering)?;
     let refined = match time::refine_for_time(
-        geometries,
-        fields,
+        lower.geometries,
+        lower.fields,
         &ordering,
-        profile,
-        settings.seed,
+        &lower.inputs.profile,
+        lower.inputs.settings.seed,
         until,
-        ctx,
+        lower.ctx,
     ) {
         Ok(refined) => refined,
         Err(Cancelled) => return Ok((ordering, by_distance)),
     };
-    let by_time = lower_ordering(geometries, fields, profile, settings, &refined, ctx)?;
-    Ok(if by_time.duration_s() <= by_distance.duration_s() {
-        (refined, by_time)
-    } else {
-        (ordering, by_distance)
-    })
+    let by_time = lower.toolpath(&refined)?;
+    // the refinement on a tie: it is what the time objective chose
+    Ok(faster((refined, by_time), (ordering, by_distance)))
 }
 
 /// Every geometry must be allocated to exactly one field.

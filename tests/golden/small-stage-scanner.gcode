@@ -1,9 +1,10 @@
 ; galvoplan 0.1.0 — small.svg
+; plan hha
 ; 6 strokes in 3 fields, marked 261.876 mm, idle 206.608 mm, base 191.390 mm, job time 0.845 s
 G21
 G90
 M5
-; field 2 centre 20 95
+; field 1 centre 20 95
 G0 X20 Y95
 G0 U10 V5
 M3
@@ -11,7 +12,7 @@ G1 U-10 V5 F60000
 G1 U0 V-5
 G1 U10 V5
 M5
-; field 0 centre 45 22.5
+; field 2 centre 45 22.5
 G0 X45 Y22.5
 G0 U-15 V-2.5
 M3
@@ -83,7 +84,7 @@ G0 U15 V7.5
 M3
 G1 U35 V12.5 F60000
 M5
-; field 1 centre 155 55
+; field 3 centre 155 55
 G0 X155 Y55
 G0 U-35 V-35
 M3

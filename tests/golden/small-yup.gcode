@@ -1,9 +1,10 @@
 ; galvoplan 0.1.0 — small.svg
+; plan hha
 ; 6 strokes in 5 fields, marked 261.876 mm, idle 253.611 mm, base 301.774 mm, job time 1.666 s
 G21
 G90
 M5
-; field 0 centre 20 105
+; field 1 centre 20 105
 G0 X30 Y100
 M4 S80
 G1 X10 Y100 F48000
@@ -11,14 +12,14 @@ G1 X10 Y110
 G1 X30 Y110
 G1 X30 Y100
 M5
-; field 3 centre 20 25
+; field 2 centre 20 25
 G0 X20 Y30
 M4 S80
 G1 X30 Y20 F48000
 G1 X10 Y20
 G1 X20 Y30
 M5
-; field 1 centre 62.5 97.5
+; field 3 centre 62.5 97.5
 G0 X50.5831 Y100.0336
 M4 S80
 G1 X50 Y100 F48000
@@ -82,14 +83,14 @@ G0 X60 Y90
 M4 S80
 G1 X80 Y85 F48000
 M5
-; field 2 centre 135 95
+; field 4 centre 135 95
 G0 X120 Y100
 M4 S80
 G1 X130 Y90 F48000
 G1 X140 Y100
 G1 X150 Y90
 M5
-; field 4 centre 170 40
+; field 5 centre 170 40
 G0 X150 Y40
 M4 S80
 G1 X150.625 Y41.2109 F48000

@@ -1,9 +1,10 @@
 ; galvoplan 0.1.0 — small.svg
+; plan hha
 ; 6 strokes in 3 fields, marked 261.876 mm, idle 262.294 mm, base 255.502 mm, job time 0.973 s
 G21
 G90
 M5
-; field 0 centre 45 22.5
+; field 1 centre 45 22.5
 G0 X30 Y20
 M3
 G1 X10 Y20 F60000
@@ -74,7 +75,7 @@ G0 X60 Y30
 M3
 G1 X80 Y35 F60000
 M5
-; field 1 centre 155 55
+; field 2 centre 155 55
 G0 X120 Y20
 M3
 G1 X130 Y30 F60000
@@ -148,7 +149,7 @@ G1 X151.25 Y77.6562
 G1 X150.625 Y78.7891
 G1 X150 Y80
 M5
-; field 2 centre 20 95
+; field 3 centre 20 95
 G0 X30 Y100
 M3
 G1 X10 Y100 F60000

@@ -5,8 +5,10 @@
 //! `MainCurveN` line, an `X,Y` header and one `x,y` row per point, in mm) or from an SVG (all
 //! closed geometries as one region).
 
-use super::{hatch_contours, HatchError, HatchSettings, HatchStats, HatchStyle, OutlineMode};
 use crate::geom::Pt;
+use crate::hatch::{
+    hatch_contours, HatchError, HatchSettings, HatchStats, HatchStyle, OutlineMode,
+};
 use crate::import::{import_svg_file, ImportOptions};
 use crate::job::JobCtx;
 use serde::Serialize;

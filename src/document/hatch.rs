@@ -1,11 +1,11 @@
-//! Hatch settings: style, spacing, angle, edge offset, outline handling and fill rule, plus the
+//! Hatch settings (the document's part of a pen): style, spacing, angle, edge offset, outline handling and fill rule, plus the
 //! command-line form `STYLE:SPACING_MM[:ANGLE_DEG]`.
 
-use super::HatchError;
-use crate::document::validate::{non_negative, InvalidValue};
+use super::validate::InvalidValue;
 use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::str::FromStr;
+use thiserror::Error;
 
 /// The smallest hatch spacing accepted, mm (finer spacings are not a laser process).
 pub const MIN_SPACING_MM: f64 = 1e-4;
@@ -126,37 +126,13 @@ impl HatchSettings {
     pub fn edge_offset(&self) -> f64 {
         self.edge_offset_mm.unwrap_or(self.spacing_mm)
     }
-    /// Checks that the numbers make sense.
-    pub fn validate(&self) -> Result<(), HatchError> {
-        self.check()
-            .map_err(|e| HatchError::Settings(e.to_string()))
-    }
-    /// [`HatchSettings::validate`] as a value error naming the setting in the GUI's words.
+    /// Checks that the numbers make sense; the error names the setting in the GUI's words.
     pub fn check(&self) -> Result<(), InvalidValue> {
-        if !(self.spacing_mm.is_finite() && self.spacing_mm >= MIN_SPACING_MM) {
-            return Err(InvalidValue::new(
-                "Hatch spacing (mm)",
-                "spacing_mm",
-                self.spacing_mm,
-                format!("a number of mm of at least {MIN_SPACING_MM}"),
-            ));
-        }
-        if !self.angle_deg.is_finite() {
-            return Err(InvalidValue::new(
-                "Hatch angle (°)",
-                "angle_deg",
-                self.angle_deg,
-                "a finite number",
-            ));
-        }
-        if let Some(d) = self.edge_offset_mm {
-            non_negative("Hatch edge offset (mm)", "edge_offset_mm", d)?;
-        }
-        Ok(())
+        super::spec::check_all(&super::spec::hatch_specs(), self)
     }
     /// Parses the command-line form `STYLE:SPACING_MM[:ANGLE_DEG]`, e.g. `zigzag:0.1:45`.
-    pub fn parse_spec(spec: &str) -> Result<Self, HatchError> {
-        let err = |reason: String| HatchError::Spec {
+    pub fn parse_spec(spec: &str) -> Result<Self, HatchSpecError> {
+        let err = |reason: String| HatchSpecError {
             spec: spec.to_string(),
             reason,
         };
@@ -183,13 +159,23 @@ impl HatchSettings {
             angle_deg,
             ..Self::default()
         };
-        s.validate().map_err(|e| err(e.to_string()))?;
+        s.check().map_err(|e| err(e.to_string()))?;
         Ok(s)
     }
 }
 
+/// A malformed hatch description `STYLE:SPACING_MM[:ANGLE_DEG]` (the CLI's `--hatch`).
+#[derive(Debug, Clone, PartialEq, Error)]
+#[error("{spec:?}: {reason} (expected STYLE:SPACING_MM[:ANGLE_DEG] with STYLE = zigzag | lines | cross | contour)")]
+pub struct HatchSpecError {
+    /// The description as given.
+    pub spec: String,
+    /// What is wrong.
+    pub reason: String,
+}
+
 impl FromStr for HatchSettings {
-    type Err = HatchError;
+    type Err = HatchSpecError;
     fn from_str(s: &str) -> Result<Self, Self::Err> {
         Self::parse_spec(s)
     }

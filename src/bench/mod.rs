@@ -1,10 +1,12 @@
 //! Benchmark runner behind `galvoplan bench`: the whole pipeline per instance, timed per stage.
 
+pub mod hatch;
+
 use crate::document::{MachineProfile, SolverSettings};
 use crate::export::{report_json, write_gcode};
 use crate::import::ImportOptions;
 use crate::job::JobCtx;
-use crate::pipeline::{load_svg, plan_document, PipelineError};
+use crate::pipeline::{load_svg, plan_document_lowered, PipelineError};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -141,16 +143,15 @@ pub fn run_instance(
         for r in 0..repeat.max(1) {
             let t_all = Instant::now();
             let (mut doc, import_s) = load_svg(path, profile.clone(), s.clone(), opts)?;
-            let plan = plan_document(&mut doc, ctx)?;
+            let (plan, toolpath) = plan_document_lowered(&mut doc, ctx)?;
             let t0 = Instant::now();
-            let toolpath = crate::pipeline::lower_plan(&doc, &plan)?;
-            let g = write_gcode(&toolpath, &plan, &doc.profile, doc.page_mm[1], "bench").map_err(
-                |source| crate::pipeline::PipelineError::Gcode {
+            let g = write_gcode(&toolpath, &plan, doc.page_mm[1], "bench").map_err(|source| {
+                crate::pipeline::PipelineError::Gcode {
                     file: path.display().to_string(),
                     source,
-                },
-            )?;
-            let rep = report_json("bench", &plan, &doc.settings, &doc.warnings);
+                }
+            })?;
+            let rep = report_json("bench", &plan, &doc.warnings);
             std::hint::black_box((g.len(), rep.len()));
             let export_s = t0.elapsed().as_secs_f64();
             for (v, x) in times.iter_mut().zip([

@@ -1,0 +1,793 @@
+//! One table per editable type: each value's label, unit, file key, rule and text form,
+//! written once. Validation ([`check_all`]), the GUI's editors and the stale-plan reasons
+//! ([`differences`]) all read these tables.
+
+use super::validate::{InvalidValue, NON_NEGATIVE, POSITIVE};
+use super::{
+    CostModel, FieldsMode, HatchSettings, MachineProfile, MotionMode, Pen, SolverSettings,
+    StageRouteKind, MAX_PASSES,
+};
+
+/// What a value must be.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Rule {
+    /// A finite number above 0.
+    Positive,
+    /// A finite number, 0 or above.
+    NonNegative,
+    /// A number within the bounds (inclusive).
+    Range(f64, f64),
+    /// A number of at least this.
+    AtLeast(f64),
+    /// Any finite number.
+    Finite,
+    /// A whole number within the bounds (inclusive).
+    Whole(u64, u64),
+    /// Text that is not blank.
+    Text,
+    /// Any text.
+    AnyText,
+    /// One of a fixed set, chosen from a list (not typed).
+    Choice,
+}
+
+/// One editable value of a `T`.
+pub struct FieldSpec<T> {
+    /// The setting in words, without its unit (`Base X max velocity`).
+    pub label: &'static str,
+    /// Unit (`mm/s`), empty for none.
+    pub unit: &'static str,
+    /// Key in a profile, settings or pens file (`axis_x.max_velocity_mm_s`).
+    pub key: &'static str,
+    /// One line of help.
+    pub help: &'static str,
+    /// What the value must be.
+    pub rule: Rule,
+    /// An empty text unsets it (optional values).
+    pub optional: bool,
+    /// The value changes the job a plan makes (its motion, marks or time): a change since a
+    /// plan makes the plan stale.
+    pub shapes_plan: bool,
+    /// The value as text (empty: unset).
+    pub show: fn(&T) -> String,
+    /// The number the rule checks (none: unset, or not a number).
+    pub number: fn(&T) -> Option<f64>,
+    /// Sets the value from text (a choice is not set from text).
+    pub parse: fn(&mut T, &str) -> Result<(), String>,
+}
+
+impl<T> Clone for FieldSpec<T> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<T> Copy for FieldSpec<T> {}
+
+impl<T> FieldSpec<T> {
+    /// The label with its unit, as the editors show it: `Base X max velocity (mm/s)`.
+    pub fn words(&self) -> String {
+        if self.unit.is_empty() {
+            self.label.to_string()
+        } else {
+            format!("{} ({})", self.label, self.unit)
+        }
+    }
+    /// Checks the value against the rule.
+    pub fn check(&self, t: &T) -> Result<(), InvalidValue> {
+        let bad = |rule: String| InvalidValue::new(self.words(), self.key, (self.show)(t), rule);
+        let v = (self.number)(t);
+        let unset_ok = self.optional && (self.show)(t).is_empty();
+        match self.rule {
+            _ if unset_ok => Ok(()),
+            Rule::Positive if !v.is_some_and(|v| v.is_finite() && v > 0.0) => {
+                Err(bad(POSITIVE.into()))
+            }
+            Rule::NonNegative if !v.is_some_and(|v| v.is_finite() && v >= 0.0) => {
+                Err(bad(NON_NEGATIVE.into()))
+            }
+            Rule::Range(lo, hi) if !v.is_some_and(|v| (lo..=hi).contains(&v)) => {
+                Err(bad(format!("between {lo} and {hi}")))
+            }
+            Rule::AtLeast(lo) if !v.is_some_and(|v| v.is_finite() && v >= lo) => {
+                Err(bad(format!("a number of at least {lo}")))
+            }
+            Rule::Finite if !v.is_some_and(f64::is_finite) => Err(bad("a finite number".into())),
+            Rule::Whole(lo, hi) if !v.is_some_and(|v| (lo as f64..=hi as f64).contains(&v)) => {
+                Err(bad(if hi == u64::MAX {
+                    format!("a whole number of at least {lo}")
+                } else {
+                    format!("a whole number from {lo} to {hi}")
+                }))
+            }
+            Rule::Text if (self.show)(t).trim().is_empty() => Err(bad("a word".into())),
+            _ => Ok(()),
+        }
+    }
+    /// Sets the value from the text an operator typed; the message names the setting.
+    pub fn set_text(&self, t: &mut T, text: &str) -> Result<(), String> {
+        (self.parse)(t, text).map_err(|e| format!("{} {e}", self.words()))
+    }
+}
+
+/// Checks every value of `t` against its table.
+pub fn check_all<T>(specs: &[FieldSpec<T>], t: &T) -> Result<(), InvalidValue> {
+    specs.iter().try_for_each(|s| s.check(t))
+}
+
+/// What changed from `old` to `new` among the values that shape a plan, in words:
+/// `Base X max velocity: 500 → 100 mm/s`.
+pub fn differences<T>(specs: &[FieldSpec<T>], old: &T, new: &T) -> Vec<String> {
+    specs
+        .iter()
+        .filter(|s| s.shapes_plan)
+        .filter_map(|s| {
+            let (a, b) = ((s.show)(old), (s.show)(new));
+            (a != b).then(|| {
+                let a = if a.is_empty() { "unset".into() } else { a };
+                let b = if b.is_empty() { "unset".into() } else { b };
+                let unit = if s.unit.is_empty() || s.rule == Rule::Choice {
+                    String::new()
+                } else {
+                    format!(" {}", s.unit)
+                };
+                format!("{} {a} → {b}{unit}", s.label.to_lowercase())
+            })
+        })
+        .collect()
+}
+
+/// A number typed by the operator.
+pub fn parse_number(s: &str) -> Result<f64, String> {
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("must be a number, not '{}'", s.trim()))?;
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(format!("must be a finite number, not '{}'", s.trim()))
+    }
+}
+
+/// An optional number: empty text is none.
+pub fn parse_optional(s: &str) -> Result<Option<f64>, String> {
+    if s.trim().is_empty() {
+        Ok(None)
+    } else {
+        parse_number(s).map(Some)
+    }
+}
+
+/// A whole number typed by the operator.
+pub fn parse_whole(s: &str) -> Result<u64, String> {
+    s.trim()
+        .parse()
+        .map_err(|_| format!("must be a whole number (0 or more), not '{}'", s.trim()))
+}
+
+fn show(v: f64) -> String {
+    format!("{v}")
+}
+
+fn show_opt(v: Option<f64>) -> String {
+    v.map(show).unwrap_or_default()
+}
+
+fn no_text<T>(_: &mut T, _: &str) -> Result<(), String> {
+    Err("chosen from a list".into())
+}
+
+fn no_number<T>(_: &T) -> Option<f64> {
+    None
+}
+
+/// A number spec: `$label`, `$unit`, `$key`, `$help`, `$rule`, a place `|x| x.field`.
+macro_rules! number {
+    ($label:expr, $unit:expr, $key:expr, $help:expr, $rule:expr, |$t:ident| $place:expr) => {
+        FieldSpec {
+            label: $label,
+            unit: $unit,
+            key: $key,
+            help: $help,
+            rule: $rule,
+            optional: false,
+            shapes_plan: true,
+            show: |$t| show($place),
+            number: |$t| Some($place),
+            parse: |$t, s| {
+                $place = parse_number(s)?;
+                Ok(())
+            },
+        }
+    };
+}
+
+/// An optional number spec (empty text unsets it).
+macro_rules! optional {
+    ($label:expr, $unit:expr, $key:expr, $help:expr, $rule:expr, |$t:ident| $place:expr) => {
+        FieldSpec {
+            label: $label,
+            unit: $unit,
+            key: $key,
+            help: $help,
+            rule: $rule,
+            optional: true,
+            shapes_plan: true,
+            show: |$t| show_opt($place),
+            number: |$t| $place,
+            parse: |$t, s| {
+                $place = parse_optional(s)?;
+                Ok(())
+            },
+        }
+    };
+}
+
+/// A whole-number spec from `$lo` to `$hi`, stored as `$ty`.
+macro_rules! whole {
+    ($label:expr, $key:expr, $help:expr, $lo:expr, $hi:expr, $ty:ty, |$t:ident| $place:expr) => {
+        FieldSpec {
+            label: $label,
+            unit: "",
+            key: $key,
+            help: $help,
+            rule: Rule::Whole($lo as u64, $hi as u64),
+            optional: false,
+            shapes_plan: true,
+            show: |$t| $place.to_string(),
+            number: |$t| Some($place as f64),
+            parse: |$t, s| {
+                let v = parse_whole(s)?;
+                $place = <$ty>::try_from(v).map_err(|_| format!("must be smaller, not {v}"))?;
+                Ok(())
+            },
+        }
+    };
+}
+
+/// A text spec (`Rule::Text`: not blank).
+macro_rules! text {
+    ($label:expr, $key:expr, $help:expr, $rule:expr, |$t:ident| $place:expr) => {
+        FieldSpec {
+            label: $label,
+            unit: "",
+            key: $key,
+            help: $help,
+            rule: $rule,
+            optional: false,
+            shapes_plan: true,
+            show: |$t| $place.clone(),
+            number: no_number,
+            parse: |$t, s| {
+                $place = s.trim().to_string();
+                Ok(())
+            },
+        }
+    };
+}
+
+/// A value chosen from a list, shown in words.
+macro_rules! choice {
+    ($label:expr, $key:expr, |$t:ident| $words:expr) => {
+        FieldSpec {
+            label: $label,
+            unit: "",
+            key: $key,
+            help: "",
+            rule: Rule::Choice,
+            optional: false,
+            shapes_plan: true,
+            show: |$t| $words,
+            number: no_number,
+            parse: no_text,
+        }
+    };
+}
+
+/// The most decimal places a G-code number may have (below a nanometre is noise).
+pub const MAX_DECIMALS: usize = 9;
+
+/// The machine profile's values (the profile editor's rows, in order, then the ones only a
+/// profile file sets).
+pub fn profile_specs() -> Vec<FieldSpec<MachineProfile>> {
+    use Rule::{NonNegative, Positive};
+    let mut name: FieldSpec<MachineProfile> =
+        text!("Name", "name", "display name", Rule::AnyText, |p| p.name);
+    name.shapes_plan = false;
+    vec![
+        name,
+        number!(
+            "Stroke X",
+            "mm",
+            "stroke_mm[0]",
+            "base-stage travel in x: field centres range over [0, stroke]",
+            NonNegative,
+            |p| p.stroke_mm[0]
+        ),
+        number!(
+            "Stroke Y",
+            "mm",
+            "stroke_mm[1]",
+            "base-stage travel in y",
+            NonNegative,
+            |p| p.stroke_mm[1]
+        ),
+        number!(
+            "Field width",
+            "mm",
+            "field_mm[0]",
+            "scan-field size in x",
+            Positive,
+            |p| p.field_mm[0]
+        ),
+        number!(
+            "Field height",
+            "mm",
+            "field_mm[1]",
+            "scan-field size in y",
+            Positive,
+            |p| p.field_mm[1]
+        ),
+        number!(
+            "Base X max velocity",
+            "mm/s",
+            "axis_x.max_velocity_mm_s",
+            "",
+            Positive,
+            |p| p.axis_x.max_velocity_mm_s
+        ),
+        number!(
+            "Base X max accel",
+            "mm/s²",
+            "axis_x.max_accel_mm_s2",
+            "",
+            Positive,
+            |p| p.axis_x.max_accel_mm_s2
+        ),
+        number!(
+            "Base X settling time",
+            "s",
+            "axis_x.settle_s",
+            "after every move",
+            NonNegative,
+            |p| p.axis_x.settle_s
+        ),
+        number!(
+            "Base Y max velocity",
+            "mm/s",
+            "axis_y.max_velocity_mm_s",
+            "",
+            Positive,
+            |p| p.axis_y.max_velocity_mm_s
+        ),
+        number!(
+            "Base Y max accel",
+            "mm/s²",
+            "axis_y.max_accel_mm_s2",
+            "",
+            Positive,
+            |p| p.axis_y.max_accel_mm_s2
+        ),
+        number!(
+            "Base Y settling time",
+            "s",
+            "axis_y.settle_s",
+            "after every move",
+            NonNegative,
+            |p| p.axis_y.settle_s
+        ),
+        number!(
+            "Scanner jump speed",
+            "mm/s",
+            "scanner.jump_speed_mm_s",
+            "laser off",
+            Positive,
+            |p| p.scanner.jump_speed_mm_s
+        ),
+        number!(
+            "Scanner mark speed",
+            "mm/s",
+            "scanner.mark_speed_mm_s",
+            "laser on",
+            Positive,
+            |p| p.scanner.mark_speed_mm_s
+        ),
+        number!(
+            "Laser on delay",
+            "s",
+            "laser.on_delay_s",
+            "",
+            NonNegative,
+            |p| p.laser.on_delay_s
+        ),
+        number!(
+            "Laser off delay",
+            "s",
+            "laser.off_delay_s",
+            "",
+            NonNegative,
+            |p| p.laser.off_delay_s
+        ),
+        number!(
+            "Jump delay",
+            "s",
+            "laser.jump_delay_s",
+            "scanner settling after a jump",
+            NonNegative,
+            |p| p.laser.jump_delay_s
+        ),
+        number!(
+            "On-the-fly margin",
+            "mm",
+            "otf_margin_mm",
+            "kept free at the field's edge while the stage moves",
+            NonNegative,
+            |p| p.otf_margin_mm
+        ),
+        text!(
+            "Laser on word",
+            "gcode.laser_on",
+            "M3 or M4",
+            Rule::Text,
+            |p| p.gcode.laser_on
+        ),
+        text!(
+            "Laser off word",
+            "gcode.laser_off",
+            "usually M5",
+            Rule::Text,
+            |p| p.gcode.laser_off
+        ),
+        text!(
+            "Power word",
+            "gcode.power_word",
+            "written before the power, usually S",
+            Rule::Text,
+            |p| p.gcode.power_word
+        ),
+        optional!(
+            "Power",
+            "",
+            "gcode.power",
+            "written after the laser-on word; empty: none",
+            NonNegative,
+            |p| p.gcode.power
+        ),
+        number!(
+            "Feed",
+            "mm/min",
+            "gcode.feed_mm_min",
+            "on G1 moves",
+            Positive,
+            |p| p.gcode.feed_mm_min
+        ),
+        whole!(
+            "Decimals",
+            "gcode.decimals",
+            "digits after the point in G-code",
+            0,
+            MAX_DECIMALS,
+            usize,
+            |p| p.gcode.decimals
+        ),
+        text!(
+            "Scanner X axis word",
+            "gcode.scanner_axes[0]",
+            "stage-and-scanner G-code",
+            Rule::Text,
+            |p| p.gcode.scanner_axes[0]
+        ),
+        text!(
+            "Scanner Y axis word",
+            "gcode.scanner_axes[1]",
+            "stage-and-scanner G-code",
+            Rule::Text,
+            |p| p.gcode.scanner_axes[1]
+        ),
+    ]
+}
+
+/// The solver settings' values: the typed ones (the settings editor's rows), then the ones
+/// chosen from lists.
+pub fn settings_specs() -> Vec<FieldSpec<SolverSettings>> {
+    use Rule::{NonNegative, Positive, Range};
+    let mut search: Vec<FieldSpec<SolverSettings>> = vec![
+        whole!(
+            "Seed",
+            "seed",
+            "all randomised stages are deterministic for a seed",
+            0,
+            u64::MAX,
+            u64,
+            |t| t.seed
+        ),
+        optional!(
+            "Time limit",
+            "s",
+            "time_limit_s",
+            "for the ordering stage; empty: none",
+            Positive,
+            |t| t.time_limit_s
+        ),
+        number!(
+            "Direction weight",
+            "",
+            "direction_weight",
+            "seed 000 Eq. 7 penalty weight w",
+            NonNegative,
+            |t| t.direction_weight
+        ),
+        whole!(
+            "GA population",
+            "ga.population",
+            "initial population size",
+            super::settings::MIN_POPULATION,
+            u64::MAX,
+            usize,
+            |t| t.ga.population
+        ),
+        whole!(
+            "GA population min",
+            "ga.population_min",
+            "",
+            super::settings::MIN_POPULATION,
+            u64::MAX,
+            usize,
+            |t| t.ga.population_min
+        ),
+        whole!(
+            "GA population max",
+            "ga.population_max",
+            "",
+            super::settings::MIN_POPULATION,
+            u64::MAX,
+            usize,
+            |t| t.ga.population_max
+        ),
+        number!(
+            "GA elite fraction",
+            "",
+            "ga.elite_fraction",
+            "0 … 1",
+            Range(0.0, 1.0),
+            |t| t.ga.elite_fraction
+        ),
+        number!(
+            "GA mutation rate",
+            "",
+            "ga.mutation_rate",
+            "0 … 1",
+            Range(0.0, 1.0),
+            |t| t.ga.mutation_rate
+        ),
+        whole!(
+            "GA stall generations",
+            "ga.stall_generations",
+            "stop after this many generations without improvement",
+            1,
+            u64::MAX,
+            usize,
+            |t| t.ga.stall_generations
+        ),
+    ];
+    // how hard a solve searches, not what job it makes: a plan is not stale for them
+    for s in &mut search {
+        s.shapes_plan = matches!(s.key, "direction_weight");
+    }
+    let choices: [FieldSpec<SolverSettings>; 7] = [
+        choice!("Cost", "cost_model", |t| match t.cost_model {
+            CostModel::Time => "job time".into(),
+            CostModel::Distance => "idle distance".into(),
+        }),
+        choice!("Motion", "motion", |t| match t.motion {
+            MotionMode::Step => "step-and-scan".into(),
+            MotionMode::OnTheFly => "on the fly".into(),
+        }),
+        choice!(
+            "Stage route",
+            "stage_route",
+            |t| match (t.motion, t.stage_route) {
+                (MotionMode::Step, _) => "none (step-and-scan)".into(),
+                (_, StageRouteKind::Taut) => "shortest (taut)".into(),
+                (_, StageRouteKind::Lsa) => "simplified pattern (lsa)".into(),
+                (_, StageRouteKind::CetspGa) => "genetic algorithm (cetsp-ga)".into(),
+            }
+        ),
+        choice!(
+            "Route GA",
+            "route_ga",
+            |t| match (t.motion, t.stage_route) {
+                (MotionMode::OnTheFly, StageRouteKind::Lsa | StageRouteKind::CetspGa) => {
+                    let g = &t.route_ga;
+                    format!(
+                        "population {}, generations {}, crossover {}, mutation {}, padding {}",
+                        g.population,
+                        g.generations,
+                        g.crossover_rate,
+                        g.mutation_rate,
+                        g.padding_radius_mm
+                            .map_or("half the field".into(), |r| format!("{r} mm"))
+                    )
+                }
+                _ => String::new(),
+            }
+        ),
+        choice!("Scan fields", "fields", |t| match t.fields {
+            FieldsMode::Auto => "automatic".into(),
+            FieldsMode::Paper => "seed 000's placement".into(),
+            FieldsMode::Greedy => "greedy".into(),
+        }),
+        choice!("Split oversize geometries", "split_oversize", |t| yes_no(
+            t.split_oversize
+        )),
+        choice!("Default hatch", "hatch", |t| hatch_words(t.hatch.as_ref())),
+    ];
+    search.extend(choices);
+    search
+}
+
+/// A pen's values (the layers panel's rows).
+pub fn pen_specs() -> Vec<FieldSpec<Pen>> {
+    use Rule::Positive;
+    let mut colour = FieldSpec {
+        label: "Colour",
+        unit: "",
+        key: "colour",
+        help: "display colour #rrggbb; empty: from the layer's name",
+        rule: Rule::AnyText,
+        optional: true,
+        shapes_plan: false,
+        show: |p: &Pen| p.colour.clone().unwrap_or_default(),
+        number: no_number,
+        parse: |p: &mut Pen, s: &str| {
+            let s = s.trim();
+            p.colour = (!s.is_empty()).then(|| s.to_string());
+            Ok(())
+        },
+    };
+    colour.shapes_plan = false;
+    vec![
+        choice!("Marked", "enabled", |p| yes_no(p.enabled)),
+        optional!(
+            "Mark speed",
+            "mm/s",
+            "mark_speed_mm_s",
+            "scanner mark speed; empty: the profile's",
+            Positive,
+            |p| p.mark_speed_mm_s
+        ),
+        optional!(
+            "Power",
+            "",
+            "power",
+            "written with the profile's power word; empty: the profile's",
+            Rule::NonNegative,
+            |p| p.power
+        ),
+        optional!(
+            "Pulse frequency",
+            "kHz",
+            "frequency_khz",
+            "written as a comment; empty: unset",
+            Positive,
+            |p| p.frequency_khz
+        ),
+        whole!(
+            "Passes",
+            "passes",
+            "how many times the layer is marked",
+            1,
+            MAX_PASSES,
+            u32,
+            |p| p.passes
+        ),
+        choice!("Hatch", "hatch", |p| hatch_words(p.hatch.as_ref())),
+        colour,
+    ]
+}
+
+/// A hatch's typed values (the layers panel's hatch rows).
+pub fn hatch_specs() -> Vec<FieldSpec<HatchSettings>> {
+    vec![
+        number!(
+            "Hatch spacing",
+            "mm",
+            "spacing_mm",
+            "distance between hatch lines",
+            Rule::AtLeast(super::MIN_SPACING_MM),
+            |h| h.spacing_mm
+        ),
+        number!(
+            "Hatch angle",
+            "°",
+            "angle_deg",
+            "direction of the hatch lines",
+            Rule::Finite,
+            |h| h.angle_deg
+        ),
+        optional!(
+            "Hatch edge offset",
+            "mm",
+            "edge_offset_mm",
+            "kept free inside the outline; empty: the spacing",
+            Rule::NonNegative,
+            |h| h.edge_offset_mm
+        ),
+    ]
+}
+
+fn yes_no(b: bool) -> String {
+    if b { "yes" } else { "no" }.into()
+}
+
+/// A hatch in words: `zigzag every 0.1 mm at 45°, edge 0.1 mm, outlines after`.
+pub fn hatch_words(h: Option<&HatchSettings>) -> String {
+    match h {
+        None => "none".into(),
+        Some(h) => format!(
+            "{} every {} mm at {}°, edge {} mm, outlines {:?}",
+            h.style,
+            h.spacing_mm,
+            h.angle_deg,
+            h.edge_offset(),
+            h.outline
+        )
+        .to_lowercase(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn keys_are_unique_and_words_carry_units() {
+        let keys: Vec<&str> = profile_specs().iter().map(|s| s.key).collect();
+        let mut sorted = keys.clone();
+        sorted.sort_unstable();
+        sorted.dedup();
+        assert_eq!(sorted.len(), keys.len());
+        let v = profile_specs()
+            .into_iter()
+            .find(|s| s.key == "axis_x.max_velocity_mm_s")
+            .unwrap();
+        assert_eq!(v.words(), "Base X max velocity (mm/s)");
+    }
+
+    #[test]
+    fn rules_and_differences() {
+        let specs = profile_specs();
+        let mut p = MachineProfile::default();
+        assert!(check_all(&specs, &p).is_ok());
+        let old = p.clone();
+        p.axis_x.max_velocity_mm_s = 100.0;
+        p.name = "other".into();
+        let d = differences(&specs, &old, &p);
+        assert_eq!(d.len(), 1, "{d:?}");
+        assert!(d[0].starts_with("base x max velocity ") && d[0].ends_with(" → 100 mm/s"));
+        p.field_mm[0] = -1.0;
+        let e = check_all(&specs, &p).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "Field width (mm) must be a positive number, not -1"
+        );
+        assert_eq!(e.key, "field_mm[0]");
+        let pen = pen_specs();
+        let mut a = Pen::default();
+        let b = a.clone();
+        a.mark_speed_mm_s = Some(300.0);
+        assert_eq!(
+            differences(&pen, &b, &a),
+            vec!["mark speed unset → 300 mm/s"]
+        );
+        let passes = pen.iter().find(|s| s.key == "passes").unwrap();
+        let mut bad = Pen::default();
+        assert_eq!(
+            passes.set_text(&mut bad, "x").unwrap_err(),
+            "Passes must be a whole number (0 or more), not 'x'"
+        );
+        bad.passes = 0;
+        assert!(passes.check(&bad).is_err());
+    }
+}
