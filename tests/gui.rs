@@ -23,7 +23,7 @@ fn demo() -> PathBuf {
 /// uncovered) and its geometry count.
 fn opened_oversize() -> (Harness<'static, App>, usize) {
     let h = opened(&common::root().join("assets/examples/oversize.svg"));
-    let n = h.state().doc.geometries.len();
+    let n = h.state().session.doc.geometries.len();
     (h, n)
 }
 
@@ -78,8 +78,8 @@ fn ctrl() -> Modifiers {
 #[test]
 fn open_demo_run_hha_shows_metrics() {
     let mut h = opened(&demo());
-    assert_eq!(h.state().doc.geometries.len(), 122);
-    assert!(!h.state().doc.fields.is_empty());
+    assert_eq!(h.state().session.doc.geometries.len(), 122);
+    assert!(!h.state().session.doc.fields.is_empty());
     assert!(h.state().uncovered().is_empty());
     assert!(h.query_by_label("Idle travel (mm)").is_none());
     h.get_by_label("Run HHA").click();
@@ -89,7 +89,7 @@ fn open_demo_run_hha_shows_metrics() {
     let plan = h.state().active_plan().expect("a plan").clone();
     assert_eq!(plan.algo, Algo::Hha);
     assert_eq!(plan.name, "HHA #1");
-    common::check_plan(&h.state().doc, &plan);
+    common::check_plan(&h.state().session.doc, &plan);
     // the metrics table: worded rows with units, the job time first with the plan's value
     h.get_by_label("Idle travel (mm)");
     h.get_by_label(&format!("{:.1}", plan.metrics.idle_mm));
@@ -114,7 +114,7 @@ fn dragging_a_field_reallocates_and_undoes() {
     h.step();
     wait_idle(&mut h, Duration::from_secs(120));
     assert!(h.query_by_label("stale").is_none());
-    let field = h.state().doc.fields[0].clone();
+    let field = h.state().session.doc.fields[0].clone();
     assert!(!field.geometries.is_empty());
     let p0 = h.state().field_screen_pos(field.id).unwrap();
     let d = Vec2::new(-120.0, 90.0);
@@ -130,6 +130,7 @@ fn dragging_a_field_reallocates_and_undoes() {
     h.run();
     let moved = h
         .state()
+        .session
         .doc
         .fields
         .iter()
@@ -154,6 +155,7 @@ fn dragging_a_field_reallocates_and_undoes() {
     h.run();
     let back = h
         .state()
+        .session
         .doc
         .fields
         .iter()
@@ -167,6 +169,7 @@ fn dragging_a_field_reallocates_and_undoes() {
     h.run();
     let again = h
         .state()
+        .session
         .doc
         .fields
         .iter()
@@ -178,7 +181,7 @@ fn dragging_a_field_reallocates_and_undoes() {
 #[test]
 fn add_lock_delete_and_replace_fields() {
     let mut h = opened(&demo());
-    let n = h.state().doc.fields.len();
+    let n = h.state().session.doc.fields.len();
     h.get_by_label("Add field").click();
     h.run();
     let canvas = h.get_by_label("Work area").rect();
@@ -194,29 +197,41 @@ fn add_lock_delete_and_replace_fields() {
         });
     }
     h.run();
-    assert_eq!(h.state().doc.fields.len(), n + 1);
+    assert_eq!(h.state().session.doc.fields.len(), n + 1);
     let id = h
         .state()
         .selected_field()
         .expect("the new field is selected");
     h.get_by_label("Lock").click();
     h.run();
-    assert!(h.state().doc.fields.iter().any(|f| f.id == id && f.locked));
+    assert!(h
+        .state()
+        .session
+        .doc
+        .fields
+        .iter()
+        .any(|f| f.id == id && f.locked));
     // re-placing keeps the locked field (a background job)
     h.get_by_label("Re-place automatically").click();
     h.step();
     wait_idle(&mut h, Duration::from_secs(60));
-    assert!(h.state().doc.fields.iter().any(|f| f.id == id && f.locked));
+    assert!(h
+        .state()
+        .session
+        .doc
+        .fields
+        .iter()
+        .any(|f| f.id == id && f.locked));
     assert!(h.state().uncovered().is_empty());
     h.get_by_label("Delete field").click();
     h.run();
-    assert!(!h.state().doc.fields.iter().any(|f| f.id == id));
+    assert!(!h.state().session.doc.fields.iter().any(|f| f.id == id));
     // undo the delete, the re-placement, the lock and the add
     for _ in 0..4 {
         h.get_by_label("Undo").click();
         h.run();
     }
-    assert_eq!(h.state().doc.fields.len(), n);
+    assert_eq!(h.state().session.doc.fields.len(), n);
 }
 
 /// Types `text` into the `n`-th field labelled `label` and presses Enter; steps once (a
@@ -249,15 +264,15 @@ fn invalid_profile_and_settings_input_is_rejected() {
     // worded, without file keys
     h.get_by_label("Field width (mm) must be a positive number, not -5");
     assert!(h.query_by_label_contains("field_mm").is_none());
-    assert_eq!(h.state().doc.profile.field_mm, [70.0, 70.0]);
+    assert_eq!(h.state().session.doc.profile.field_mm, [70.0, 70.0]);
     set_text(&mut h, "Field width (mm)", "abc");
     h.get_by_label_contains("Field width (mm) must be a number, not 'abc'");
-    assert_eq!(h.state().doc.profile.field_mm, [70.0, 70.0]);
+    assert_eq!(h.state().session.doc.profile.field_mm, [70.0, 70.0]);
     section(&mut h, "Solver settings");
     set_text(&mut h, "GA mutation rate", "1.5");
     h.get_by_label("GA mutation rate must be between 0 and 1, not 1.5");
     assert_eq!(
-        h.state().doc.settings.ga.mutation_rate,
+        h.state().session.doc.settings.ga.mutation_rate,
         SolverSettings::default().ga.mutation_rate
     );
     // a valid value is applied, resizes the fields and can be undone
@@ -266,23 +281,30 @@ fn invalid_profile_and_settings_input_is_rejected() {
     assert!(h
         .query_by_label_contains("must be a positive number")
         .is_none());
-    assert_eq!(h.state().doc.profile.field_mm, [60.0, 70.0]);
-    assert!(h.state().doc.fields.iter().all(|f| f.size == [60.0, 70.0]));
+    assert_eq!(h.state().session.doc.profile.field_mm, [60.0, 70.0]);
+    assert!(h
+        .state()
+        .session
+        .doc
+        .fields
+        .iter()
+        .all(|f| f.size == [60.0, 70.0]));
     h.get_by_label("Undo").click();
     h.run();
-    assert_eq!(h.state().doc.profile.field_mm, [70.0, 70.0]);
+    assert_eq!(h.state().session.doc.profile.field_mm, [70.0, 70.0]);
     // a built-in profile is selectable
     h.get_by_label("Built-in").click();
     h.run();
     h.get_by_label("small-field").click();
     h.run();
-    assert_ne!(h.state().doc.profile.field_mm, [70.0, 70.0]);
+    assert_ne!(h.state().session.doc.profile.field_mm, [70.0, 70.0]);
     assert!(h
         .state()
+        .session
         .doc
         .fields
         .iter()
-        .all(|f| f.size == h.state().doc.profile.field_mm));
+        .all(|f| f.size == h.state().session.doc.profile.field_mm));
 }
 
 /// Runs the CLI on the demo with `algo` and seed 7, the GUI likewise; the plans must agree.
@@ -308,7 +330,7 @@ fn same_plan_as_cli(algo: &str, button: &str) {
     let mut h = opened(&demo());
     section(&mut h, "Solver settings");
     set_text(&mut h, "Seed", "7");
-    assert_eq!(h.state().doc.settings.seed, 7);
+    assert_eq!(h.state().session.doc.settings.seed, 7);
     h.get_by_label(button).click();
     h.step();
     wait_idle(&mut h, Duration::from_secs(300));
@@ -353,7 +375,7 @@ fn gui_and_cli_make_the_same_hga_plan() {
 fn cancel_an_hga_run() {
     let mut h = opened(&demo());
     // settings under which HGA would run for minutes
-    let mut s = h.state().doc.settings.clone();
+    let mut s = h.state().session.doc.settings.clone();
     s.ga.stall_generations = 1_000_000;
     s.time_limit_s = Some(600.0);
     h.state_mut()
@@ -386,7 +408,7 @@ fn cancel_an_hga_run() {
     assert_eq!(plan.algo, Algo::Hga);
     assert!(plan.name.contains("stopped"), "{}", plan.name);
     assert!(!plan.history.is_empty());
-    common::check_plan(&h.state().doc, &plan);
+    common::check_plan(&h.state().session.doc, &plan);
 }
 
 #[test]
@@ -402,7 +424,7 @@ fn compare_view_shows_both_plans_and_the_difference() {
     h.get_by_label("B vs A");
     // the compare table and the active plan's table in the side panel
     assert_eq!(h.get_all_by_label("Direction changes").count(), 2);
-    let plans = &h.state().doc.plans;
+    let plans = &h.state().session.doc.plans;
     let (a, b) = (&plans[0].metrics, &plans[1].metrics);
     let pct = (b.idle_mm - a.idle_mm) / a.idle_mm * 100.0;
     h.get_by_label(&format!("{pct:+.1} %"));
@@ -417,7 +439,7 @@ fn compare_view_shows_both_plans_and_the_difference() {
     let longer_s = a.job_time_s.unwrap().max(b.job_time_s.unwrap());
     h.get_by_label("Time").set_value_accesskit(1.5);
     h.run();
-    assert_eq!(h.state().compare.playback.t_s, 1.5);
+    assert_eq!(h.state().compare_state().playback.t_s, 1.5);
     h.get_by_label(&time_text(1.5, longer_s));
     assert_eq!(h.state().playback().t_s, 0.0, "the workbench keeps its own");
     h.get_by_label("Overlay").click();
@@ -448,7 +470,7 @@ fn project_round_trip_and_drag_and_drop() {
         .push(std::sync::Arc::new(Dropped(project.clone())));
     h2.step();
     wait_idle(&mut h2, Duration::from_secs(60));
-    let (a, b) = (&h.state().doc, &h2.state().doc);
+    let (a, b) = (&h.state().session.doc, &h2.state().session.doc);
     assert_eq!(a.fields, b.fields);
     assert_eq!(a.plans, b.plans);
     assert_eq!(h2.state().active_plan().unwrap().name, "Baseline #1");
@@ -479,20 +501,20 @@ fn oversize_geometries_are_shown_uncovered_until_split() {
     h.get_by_label("Split oversize geometries (on re-place)")
         .click();
     h.run();
-    assert!(h.state().doc.settings.split_oversize);
+    assert!(h.state().session.doc.settings.split_oversize);
     h.get_by_label("Re-place automatically").click();
     h.step();
     wait_idle(&mut h, Duration::from_secs(60));
-    assert!(h.state().doc.geometries.len() > n);
+    assert!(h.state().session.doc.geometries.len() > n);
     assert!(h.state().uncovered().is_empty());
     // the split pieces are reported as warnings in the panel
-    let w = h.state().doc.warnings.len();
+    let w = h.state().session.doc.warnings.len();
     assert!(w > 0);
     h.get_by_label(&format!("Import warnings ({w})"));
     // undo restores the unsplit geometries
     h.get_by_label("Undo").click();
     h.run();
-    assert_eq!(h.state().doc.geometries.len(), n);
+    assert_eq!(h.state().session.doc.geometries.len(), n);
     assert_eq!(h.state().uncovered().len(), n);
 }
 
@@ -519,7 +541,7 @@ fn switching_to_on_the_fly_places_fields_for_what_was_uncovered() {
         "{}",
         h.state().status()
     );
-    assert!(!h.state().doc.fields.is_empty());
+    assert!(!h.state().session.doc.fields.is_empty());
     // counts read as words: "1 geometry", not "1 geometries"
     assert!(h.query_by_label_contains("1 geometries").is_none());
 }
@@ -536,7 +558,7 @@ fn import_warnings_are_listed() {
     )
     .unwrap();
     let h = opened(&svg);
-    assert_eq!(h.state().doc.warnings.len(), 1);
+    assert_eq!(h.state().session.doc.warnings.len(), 1);
     h.get_by_label("Import warnings (1)");
     h.get_by_label_contains("photo");
 }
@@ -596,18 +618,23 @@ fn frame_time_while_solving() {
 
 /// Runs `button`'s solver to the end; returns the new plan.
 fn solve(h: &mut Harness<'_, App>, button: &str) -> galvoplan::document::Plan {
-    let n = h.state().doc.plans.len();
+    let n = h.state().session.doc.plans.len();
     h.get_by_label(button).click();
     h.step();
     wait_idle(h, Duration::from_secs(120));
-    assert_eq!(h.state().doc.plans.len(), n + 1, "{}", h.state().status());
+    assert_eq!(
+        h.state().session.doc.plans.len(),
+        n + 1,
+        "{}",
+        h.state().status()
+    );
     h.state().active_plan().unwrap().clone()
 }
 
 #[test]
 fn the_cost_switch_decides_what_the_solve_minimises() {
     let mut h = opened(&demo());
-    assert_eq!(h.state().doc.settings.cost_model, CostModel::Time);
+    assert_eq!(h.state().session.doc.settings.cost_model, CostModel::Time);
     section(&mut h, "Solver settings");
     h.get_by_label("Cost model").hover();
     h.run();
@@ -617,7 +644,10 @@ fn the_cost_switch_decides_what_the_solve_minimises() {
     h.run();
     h.get_by_label("Idle distance (seed 000)").click();
     h.run();
-    assert_eq!(h.state().doc.settings.cost_model, CostModel::Distance);
+    assert_eq!(
+        h.state().session.doc.settings.cost_model,
+        CostModel::Distance
+    );
     let by_distance = solve(&mut h, "Run HHA");
     assert_eq!(by_distance.name, "HHA #2");
     assert_ne!(by_time.order, by_distance.order);
@@ -631,7 +661,7 @@ fn the_cost_switch_decides_what_the_solve_minimises() {
     // the change is one undoable settings step
     h.get_by_label("Undo").click();
     h.run();
-    assert_eq!(h.state().doc.settings.cost_model, CostModel::Time);
+    assert_eq!(h.state().session.doc.settings.cost_model, CostModel::Time);
 }
 
 #[test]
@@ -640,7 +670,7 @@ fn run_as_is_keeps_the_document_order() {
     let plan = solve(&mut h, "Run as-is");
     assert_eq!(plan.algo, Algo::AsIs);
     assert_eq!(plan.name, "As-is #1");
-    common::check_plan(&h.state().doc, &plan);
+    common::check_plan(&h.state().session.doc, &plan);
     let hha = solve(&mut h, "Run HHA");
     assert!(hha.metrics.job_time_s.unwrap() < plan.metrics.job_time_s.unwrap());
 }
@@ -739,7 +769,7 @@ fn set_motion(h: &mut Harness<'_, App>, option: &str) {
 #[test]
 fn the_motion_switch_plans_on_the_fly() {
     let mut h = opened(&demo());
-    assert_eq!(h.state().doc.settings.motion, MotionMode::Step);
+    assert_eq!(h.state().session.doc.settings.motion, MotionMode::Step);
     section(&mut h, "Solver settings");
     h.get_by_label("Motion").hover();
     h.run();
@@ -747,7 +777,7 @@ fn the_motion_switch_plans_on_the_fly() {
     let step = solve(&mut h, "Run HHA");
     assert!(!h.state().toolpath(0).unwrap().unwrap().on_the_fly());
     set_motion(&mut h, "On the fly (stage moves while marking)");
-    assert_eq!(h.state().doc.settings.motion, MotionMode::OnTheFly);
+    assert_eq!(h.state().session.doc.settings.motion, MotionMode::OnTheFly);
     // the step plan keeps the motion it was planned for
     let kept = h.state().toolpath(0).unwrap().unwrap().clone();
     assert!(!kept.on_the_fly());
@@ -779,7 +809,7 @@ fn the_motion_switch_plans_on_the_fly() {
     h.run();
     h.get_by_label("Undo").click();
     h.run();
-    assert_eq!(h.state().doc.settings.motion, MotionMode::Step);
+    assert_eq!(h.state().session.doc.settings.motion, MotionMode::Step);
     // the on-the-fly plan stays on the fly
     assert!(h.state().toolpath(1).unwrap().unwrap().on_the_fly());
 }
@@ -797,7 +827,7 @@ fn motion_plots_show_an_on_the_fly_plan() {
         "{}",
         s.t_s.len()
     );
-    let reach_mm = 35.0 - h.state().doc.profile.otf_margin_mm;
+    let reach_mm = 35.0 - h.state().session.doc.profile.otf_margin_mm;
     assert!(
         s.peak_offset_mm() <= reach_mm + 1e-6,
         "{}",
@@ -838,7 +868,10 @@ fn the_stage_route_switch_plans_seed001_routes() {
     h.run();
     h.get_by_label("Simplified pattern (seed 001 LSA)").click();
     h.run();
-    assert_eq!(h.state().doc.settings.stage_route, StageRouteKind::Lsa);
+    assert_eq!(
+        h.state().session.doc.settings.stage_route,
+        StageRouteKind::Lsa
+    );
     let plan = solve(&mut h, "Run HHA");
     assert!(plan.stage_route.is_some());
     assert!(h.state().toolpath(0).unwrap().unwrap().on_the_fly());
@@ -858,13 +891,14 @@ fn hatch_settings_in_the_layers_panel_rehatch_the_document() {
     let mut h = opened(&two_layers());
     let names: Vec<String> = h
         .state()
+        .session
         .doc
         .layers
         .iter()
         .map(|l| l.name.clone())
         .collect();
     assert_eq!(names, ["outline", "fill"]);
-    let outlines = h.state().doc.geometries.len();
+    let outlines = h.state().session.doc.geometries.len();
     h.get_by_label("Layers (2)");
     // choose a hatch for the second layer: a background job hatches and places fields again
     nth_by_label(&h, "Hatch", 1).click();
@@ -872,7 +906,7 @@ fn hatch_settings_in_the_layers_panel_rehatch_the_document() {
     h.get_by_label("zigzag").click();
     h.step();
     wait_idle(&mut h, Duration::from_secs(60));
-    let doc = &h.state().doc;
+    let doc = &h.state().session.doc;
     let hatch = doc.layers[1].pen.hatch.clone().expect("a hatch");
     assert_eq!(hatch.style, galvoplan::hatch::HatchStyle::Zigzag);
     let hatched = doc.geometries.len();
@@ -886,12 +920,12 @@ fn hatch_settings_in_the_layers_panel_rehatch_the_document() {
     // a finer spacing hatches again with more strokes
     enter_nth(&mut h, "Hatch spacing (mm)", 0, "0.25");
     wait_idle(&mut h, Duration::from_secs(60));
-    let finer = h.state().doc.geometries.len();
+    let finer = h.state().session.doc.geometries.len();
     let len = |doc: &galvoplan::document::Document| -> f64 {
         doc.geometries.iter().map(|g| g.length_mm()).sum()
     };
     assert_eq!(
-        h.state().doc.layers[1]
+        h.state().session.doc.layers[1]
             .pen
             .hatch
             .as_ref()
@@ -900,24 +934,25 @@ fn hatch_settings_in_the_layers_panel_rehatch_the_document() {
         0.25
     );
     assert!(finer >= hatched);
-    let fine_mm = len(&h.state().doc);
+    let fine_mm = len(&h.state().session.doc);
     // undo goes back to the coarser hatch, then to outlines only
     h.key_press_modifiers(ctrl(), Key::Z);
     h.run();
-    assert!(len(&h.state().doc) < fine_mm);
-    assert_eq!(h.state().doc.geometries.len(), hatched);
+    assert!(len(&h.state().session.doc) < fine_mm);
+    assert_eq!(h.state().session.doc.geometries.len(), hatched);
     h.key_press_modifiers(ctrl(), Key::Z);
     h.run();
-    assert_eq!(h.state().doc.geometries.len(), outlines);
-    assert!(h.state().doc.layers[1].pen.hatch.is_none());
+    assert_eq!(h.state().session.doc.geometries.len(), outlines);
+    assert!(h.state().session.doc.layers[1].pen.hatch.is_none());
 }
 
 #[test]
 fn a_disabled_layer_is_left_out_and_pens_change_at_once() {
     let mut h = opened(&two_layers());
-    let all = h.state().doc.geometries.len();
+    let all = h.state().session.doc.geometries.len();
     let fill = h
         .state()
+        .session
         .doc
         .geometries
         .iter()
@@ -926,31 +961,34 @@ fn a_disabled_layer_is_left_out_and_pens_change_at_once() {
     h.get_by_label("fill").click();
     h.step();
     wait_idle(&mut h, Duration::from_secs(60));
-    assert!(!h.state().doc.layers[1].pen.enabled);
-    assert_eq!(h.state().doc.geometries.len(), all - fill);
+    assert!(!h.state().session.doc.layers[1].pen.enabled);
+    assert_eq!(h.state().session.doc.geometries.len(), all - fill);
     // a speed is a pen change only: no job, the geometries stay
     enter_nth(&mut h, "Mark speed (mm/s)", 0, "750");
     h.run();
     assert!(!h.state().is_busy());
-    assert_eq!(h.state().doc.layers[0].pen.mark_speed_mm_s, Some(750.0));
-    assert_eq!(h.state().doc.geometries.len(), all - fill);
+    assert_eq!(
+        h.state().session.doc.layers[0].pen.mark_speed_mm_s,
+        Some(750.0)
+    );
+    assert_eq!(h.state().session.doc.geometries.len(), all - fill);
 }
 
 #[test]
 fn a_rejected_pen_value_shows_a_worded_error() {
     let mut h = opened(&two_layers());
-    let before = h.state().doc.layers.clone();
+    let before = h.state().session.doc.layers.clone();
     let passes = h.get_all_by_label("Passes").count();
     assert_eq!(passes, 2);
     // the second layer's passes
     enter_nth(&mut h, "Passes", 1, "0");
     h.run();
     h.get_by_label("Layer 'fill': Passes must be a whole number from 1 to 100, not 0");
-    assert_eq!(h.state().doc.layers, before);
+    assert_eq!(h.state().session.doc.layers, before);
     enter_nth(&mut h, "Mark speed (mm/s)", 0, "fast");
     h.run();
     h.get_by_label("Layer 'outline': Mark speed (mm/s) must be a number, not 'fast'");
-    assert_eq!(h.state().doc.layers, before);
+    assert_eq!(h.state().session.doc.layers, before);
 }
 
 #[test]
@@ -965,7 +1003,7 @@ fn without_a_file_dialog_a_path_field_is_offered() {
     enter_nth(&mut h, "File path", 0, &demo().display().to_string());
     wait_idle(&mut h, Duration::from_secs(60));
     assert!(h.state().prompt().is_none());
-    assert_eq!(h.state().doc.geometries.len(), 122);
+    assert_eq!(h.state().session.doc.geometries.len(), 122);
     // Ctrl+S asks for the project's path the same way
     h.key_press_modifiers(ctrl(), Key::S);
     h.run();
@@ -988,7 +1026,7 @@ fn without_a_file_dialog_a_path_field_is_offered() {
 fn quitting_after_an_edit_asks_about_unsaved_changes() {
     let mut h = opened(&demo());
     assert!(!h.state().has_unsaved_changes());
-    let id = h.state().doc.fields[0].id;
+    let id = h.state().session.doc.fields[0].id;
     h.state_mut()
         .execute(Command::SetLocked { id, locked: true })
         .unwrap();
@@ -1019,8 +1057,8 @@ fn exporting_a_stale_plan_asks_first() {
     h.get_by_label("Run HHA").click();
     h.step();
     wait_idle(&mut h, Duration::from_secs(120));
-    let id = h.state().doc.fields[0].id;
-    let c = h.state().doc.fields[0].center;
+    let id = h.state().session.doc.fields[0].id;
+    let c = h.state().session.doc.fields[0].center;
     h.state_mut()
         .execute(Command::MoveField {
             id,
@@ -1038,7 +1076,7 @@ fn exporting_a_stale_plan_asks_first() {
 fn fields_are_numbered_from_one_in_placement_then_visiting_order() {
     use galvoplan::app::field_number;
     let mut h = opened(&demo());
-    let fields = h.state().doc.fields.clone();
+    let fields = h.state().session.doc.fields.clone();
     for (k, f) in fields.iter().enumerate() {
         assert_eq!(field_number(&fields, None, f.id), k + 1);
     }
@@ -1063,7 +1101,7 @@ fn a_dropped_dxf_opens_with_its_layers() {
         .push(std::sync::Arc::new(Dropped(path)));
     h.step();
     wait_idle(&mut h, Duration::from_secs(60));
-    let doc = &h.state().doc;
+    let doc = &h.state().session.doc;
     assert_eq!(doc.geometries.len(), 26, "{}", h.state().status());
     assert!(doc.geometries.iter().any(|g| g.source.layer == "CUT"));
     assert!(!doc.fields.is_empty());
@@ -1107,10 +1145,10 @@ fn a_pen_edit_makes_the_plan_stale_and_re_solve_and_export_writes_the_new_feed()
     wait_idle(&mut h, Duration::from_secs(120));
     let g = std::fs::read_to_string(&out).unwrap_or_else(|e| panic!("{e}: {}", h.state().status()));
     assert!(g.contains(" F18000"), "no feed of 300 mm/s in the G-code");
-    assert_eq!(h.state().doc.plans.len(), 2);
+    assert_eq!(h.state().session.doc.plans.len(), 2);
     assert!(h.state().plan_staleness(1).is_empty());
     assert!(h.state().plan_staleness(0).len() == 1);
-    let job_s = h.state().doc.plans[1].metrics.job_time_s.unwrap();
+    let job_s = h.state().session.doc.plans[1].metrics.job_time_s.unwrap();
     assert!(g.contains(&format!("job time {job_s:.3} s")));
 }
 
@@ -1120,14 +1158,17 @@ fn a_profile_edit_makes_the_headline_stale() {
     section(&mut h, "Machine profile");
     set_text(&mut h, "Base X max velocity (mm/s)", "100");
     h.run();
-    assert_eq!(h.state().doc.profile.axis_x.max_velocity_mm_s, 100.0);
+    assert_eq!(
+        h.state().session.doc.profile.axis_x.max_velocity_mm_s,
+        100.0
+    );
     let why = h.state().plan_staleness(0).to_vec();
     assert_eq!(why.len(), 1, "{why:?}");
     assert!(why[0].starts_with("base x max velocity ") && why[0].ends_with("→ 100 mm/s"));
     h.get_by_label_contains("HHA #1 is stale: base x max velocity");
     h.get_by_label("stale");
     // the plan keeps the figures and the toolpath of its own profile
-    let plan = h.state().doc.plans[0].clone();
+    let plan = h.state().session.doc.plans[0].clone();
     let l = h.state().toolpath(0).unwrap().unwrap().clone();
     assert_eq!(Some(l.duration_s()), plan.metrics.job_time_s);
 }
@@ -1176,7 +1217,7 @@ fn a_hatch_edit_keeps_the_plans_and_marks_them_stale() {
     h.get_by_label("zigzag").click();
     h.step();
     wait_idle(&mut h, Duration::from_secs(60));
-    assert_eq!(h.state().doc.plans.len(), 1);
+    assert_eq!(h.state().session.doc.plans.len(), 1);
     let why = h.state().plan_staleness(0);
     assert!(
         why.iter().any(|w| w.starts_with("the geometries changed")),
@@ -1188,7 +1229,7 @@ fn a_hatch_edit_keeps_the_plans_and_marks_them_stale() {
         "{why:?}"
     );
     // the plan is still drawn and exported on the geometries it was planned on
-    let plan = h.state().doc.plans[0].clone();
+    let plan = h.state().session.doc.plans[0].clone();
     assert_eq!(
         Some(h.state().toolpath(0).unwrap().unwrap().duration_s()),
         plan.metrics.job_time_s
@@ -1209,7 +1250,7 @@ fn the_status_of_a_delete_names_the_field_as_the_canvas_does() {
     use galvoplan::app::field_number;
     let mut h = opened(&demo());
     solve(&mut h, "Run HHA");
-    let fields = h.state().doc.fields.clone();
+    let fields = h.state().session.doc.fields.clone();
     let visiting = h.state().active_plan().unwrap().fields.clone();
     // a field whose visiting number is not its placement number
     let f = fields
@@ -1229,5 +1270,5 @@ fn the_status_of_a_delete_names_the_field_as_the_canvas_does() {
         "{}",
         h.state().status()
     );
-    assert_eq!(h.state().doc.plans.len(), 1);
+    assert_eq!(h.state().session.doc.plans.len(), 1);
 }

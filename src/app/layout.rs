@@ -16,7 +16,7 @@ impl App {
         egui::Panel::top("menu").show(ui, |ui| self.menu_bar(ui));
         egui::Panel::top("toolbar").show(ui, |ui| self.toolbar(ui));
         egui::Panel::bottom("status").show(ui, |ui| self.status_bar(ui));
-        if self.tab == Tab::Workbench {
+        if self.view.tab == Tab::Workbench {
             egui::Panel::left("left")
                 .resizable(true)
                 .default_size(370.0)
@@ -30,17 +30,17 @@ impl App {
             .show(ui, |ui| {
                 egui::ScrollArea::vertical().show(ui, |ui| self.right_panel(ui));
             });
-        egui::CentralPanel::default().show(ui, |ui| match self.tab {
+        egui::CentralPanel::default().show(ui, |ui| match self.view.tab {
             Tab::Workbench => self.workbench_view(ui),
             Tab::Compare => {
                 if self.has_document() {
                     compare::show(
                         ui,
-                        &mut self.compare,
-                        &self.doc,
-                        &self.toolpaths,
-                        &self.stale,
-                        self.layers,
+                        &mut self.view.compare,
+                        &self.session.doc,
+                        &self.session.toolpaths,
+                        &self.session.stale,
+                        self.view.layers,
                     );
                 } else {
                     ui.label("Open a document first.");
@@ -66,10 +66,10 @@ impl App {
                     self.request_open(None, &ctx);
                 }
                 ui.menu_button("Open recent", |ui| {
-                    if self.recent.0.is_empty() {
+                    if self.view.recent.0.is_empty() {
                         ui.label("(none)");
                     }
-                    for p in self.recent.0.clone() {
+                    for p in self.view.recent.0.clone() {
                         if ui.button(p.display().to_string()).clicked() {
                             self.request_open(Some(p), &ctx);
                         }
@@ -121,7 +121,11 @@ impl App {
                 }
             });
             ui.menu_button("Edit", |ui| {
-                let u = self.history.undo_label().map(|w| format!("Undo {w}"));
+                let u = self
+                    .session
+                    .history
+                    .undo_label()
+                    .map(|w| format!("Undo {w}"));
                 if ui
                     .add_enabled(
                         u.is_some(),
@@ -131,7 +135,11 @@ impl App {
                 {
                     self.undo();
                 }
-                let r = self.history.redo_label().map(|w| format!("Redo {w}"));
+                let r = self
+                    .session
+                    .history
+                    .redo_label()
+                    .map(|w| format!("Redo {w}"));
                 if ui
                     .add_enabled(
                         r.is_some(),
@@ -148,21 +156,24 @@ impl App {
                     .add(egui::Button::new("Fit to view").shortcut_text("F"))
                     .clicked()
                 {
-                    self.workbench.fit_requested = true;
-                    self.compare.canvas.fit_requested = true;
+                    self.view.workbench.fit_requested = true;
+                    self.view.compare.canvas.fit_requested = true;
                 }
             });
         });
     }
 
     fn layer_toggles(&mut self, ui: &mut egui::Ui) {
-        let l = &mut self.layers;
+        let l = &mut self.view.layers;
         ui.checkbox(&mut l.fields, "Scan fields");
         ui.checkbox(&mut l.path, "Planned path");
         ui.checkbox(&mut l.arrows, "Direction arrows");
         ui.checkbox(&mut l.base_path, "Base path / stage route");
         ui.checkbox(&mut l.order_colours, "Colour marks by order");
-        ui.checkbox(&mut self.frame_times, "Frame timings in the status bar");
+        ui.checkbox(
+            &mut self.view.frame_times,
+            "Frame timings in the status bar",
+        );
     }
 
     fn toolbar(&mut self, ui: &mut egui::Ui) {
@@ -185,7 +196,7 @@ impl App {
                 self.request_save(false, &ctx);
             }
             ui.separator();
-            let can_undo = self.history.undo_label().is_some();
+            let can_undo = self.session.history.undo_label().is_some();
             if ui
                 .add_enabled(can_undo, egui::Button::new("Undo"))
                 .on_hover_text("Ctrl+Z")
@@ -193,7 +204,7 @@ impl App {
             {
                 self.undo();
             }
-            let can_redo = self.history.redo_label().is_some();
+            let can_redo = self.session.history.redo_label().is_some();
             if ui
                 .add_enabled(can_redo, egui::Button::new("Redo"))
                 .on_hover_text("Ctrl+Shift+Z")
@@ -202,17 +213,18 @@ impl App {
                 self.redo();
             }
             ui.separator();
-            ui.selectable_value(&mut self.add_tool, false, "Select")
+            ui.selectable_value(&mut self.view.add_tool, false, "Select")
                 .on_hover_text(
                     "Click a field to select it, drag it to move it; drag empty space to pan",
                 );
-            ui.selectable_value(&mut self.add_tool, true, "Add field")
+            ui.selectable_value(&mut self.view.add_tool, true, "Add field")
                 .on_hover_text(
                     "Click to add a field (double-click also adds one with the select tool)",
                 );
             let sel = self
+                .view
                 .selected
-                .and_then(|id| self.doc.fields.iter().find(|f| f.id == id))
+                .and_then(|id| self.session.doc.fields.iter().find(|f| f.id == id))
                 .map(|f| (f.id, f.locked));
             if ui
                 .add_enabled(sel.is_some(), egui::Button::new("Delete field"))
@@ -242,7 +254,7 @@ impl App {
             }
             if ui
                 .add_enabled(
-                    self.has_document() && self.job.is_none(),
+                    self.has_document() && self.runtime.job.is_none(),
                     egui::Button::new("Re-place automatically"),
                 )
                 .on_hover_text(
@@ -267,30 +279,30 @@ impl App {
                 }
             }
             ui.separator();
-            ui.selectable_value(&mut self.tab, Tab::Workbench, "Workbench");
-            ui.selectable_value(&mut self.tab, Tab::Compare, "Compare");
+            ui.selectable_value(&mut self.view.tab, Tab::Workbench, "Workbench");
+            ui.selectable_value(&mut self.view.tab, Tab::Compare, "Compare");
         });
     }
 
     fn status_bar(&mut self, ui: &mut egui::Ui) {
         ui.horizontal(|ui| {
-            if let Some(job) = &self.job {
+            if let Some(job) = &self.runtime.job {
                 job.show(ui);
                 ui.separator();
             }
             ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
                 if self.has_document() {
-                    let u = self.uncovered.len();
+                    let u = self.session.uncovered.len();
                     let t = RichText::new(format!(
                         "{} · {} uncovered",
-                        super::count(self.doc.fields.len(), "field", "fields"),
+                        super::count(self.session.doc.fields.len(), "field", "fields"),
                         u
                     ));
                     ui.label(if u > 0 { t.color(ERROR) } else { t });
                     ui.separator();
                 }
-                if self.frame_times {
-                    let f = &self.frames;
+                if self.view.frame_times {
+                    let f = &self.view.frames;
                     let cpu = f
                         .cpu_ms
                         .map_or(String::new(), |c| format!(", whole frame {c:.1} ms"));
@@ -310,8 +322,12 @@ impl App {
                     ui.separator();
                 }
                 ui.with_layout(egui::Layout::left_to_right(egui::Align::Center), |ui| {
-                    let t = RichText::new(&self.status.text);
-                    let t = if self.status.error { t.color(ERROR) } else { t };
+                    let t = RichText::new(&self.view.status.text);
+                    let t = if self.view.status.error {
+                        t.color(ERROR)
+                    } else {
+                        t
+                    };
                     ui.add(egui::Label::new(t).wrap());
                 });
             });
@@ -319,12 +335,12 @@ impl App {
     }
 
     fn layers_ui(&mut self, ui: &mut egui::Ui) {
-        let busy = self.job.as_ref().map(|j| j.name.clone());
-        let action = self.layer_editor.ui(
+        let busy = self.runtime.job.as_ref().map(|j| j.name.clone());
+        let action = self.view.layer_editor.ui(
             ui,
-            &self.doc.layers,
-            &self.layer_counts,
-            &self.doc.profile,
+            &self.session.doc.layers,
+            &self.session.layer_counts,
+            &self.session.doc.profile,
             busy.as_deref(),
         );
         let ctx = ui.ctx().clone();
@@ -337,31 +353,36 @@ impl App {
 
     fn left_panel(&mut self, ui: &mut egui::Ui) {
         ui.horizontal_wrapped(|ui| {
-            let layers = format!("Layers ({})", self.doc.layers.len());
-            ui.selectable_value(&mut self.section, Section::Layers, layers)
+            let layers = format!("Layers ({})", self.session.doc.layers.len());
+            ui.selectable_value(&mut self.view.section, Section::Layers, layers)
                 .on_hover_text("Layers and their pens: speed, power, passes, hatch");
-            ui.selectable_value(&mut self.section, Section::Settings, "Solver settings");
-            ui.selectable_value(&mut self.section, Section::Profile, "Machine profile");
+            ui.selectable_value(&mut self.view.section, Section::Settings, "Solver settings");
+            ui.selectable_value(&mut self.view.section, Section::Profile, "Machine profile");
         });
         ui.separator();
-        match self.section {
+        match self.view.section {
             Section::Layers => self.layers_ui(ui),
             Section::Settings => {
-                if let Some(cmd) = self.editors.settings_ui(ui, &self.doc.settings) {
-                    let motion = self.doc.settings.motion;
-                    let changed = self.execute(cmd).is_ok() && self.doc.settings.motion != motion;
+                if let Some(cmd) = self
+                    .view
+                    .editors
+                    .settings_ui(ui, &self.session.doc.settings)
+                {
+                    let motion = self.session.doc.settings.motion;
+                    let changed =
+                        self.execute(cmd).is_ok() && self.session.doc.settings.motion != motion;
                     // on the fly holds what no scan field could (and back): fields placed for
                     // the other motion that leave geometries uncovered are placed again at once
-                    if changed && !self.uncovered.is_empty() && !self.is_busy() {
+                    if changed && !self.session.uncovered.is_empty() && !self.is_busy() {
                         self.replace_fields(ui.ctx());
                     }
                 }
             }
             Section::Profile => {
-                if let Some(cmd) = self.editors.profile_ui(ui, &self.doc.profile) {
+                if let Some(cmd) = self.view.editors.profile_ui(ui, &self.session.doc.profile) {
                     let _ = self.execute(cmd);
                 }
-                if let Some(a) = self.editors.take_file_request() {
+                if let Some(a) = self.view.editors.take_file_request() {
                     let ctx = ui.ctx().clone();
                     self.choose_path(a, &ctx);
                 }
@@ -375,7 +396,7 @@ impl App {
 
     fn right_panel(&mut self, ui: &mut egui::Ui) {
         ui.heading("Document");
-        match &self.doc.source {
+        match &self.session.doc.source {
             Some(s) => {
                 ui.label(RichText::new(s).small());
             }
@@ -384,15 +405,21 @@ impl App {
             }
         }
         if self.has_document() {
-            let closed = self.doc.geometries.iter().filter(|g| g.closed).count();
+            let closed = self
+                .session
+                .doc
+                .geometries
+                .iter()
+                .filter(|g| g.closed)
+                .count();
             ui.label(format!(
                 "{} ({closed} closed, {} open), {}",
-                super::count(self.doc.geometries.len(), "geometry", "geometries"),
-                self.doc.geometries.len() - closed,
-                super::count(self.doc.fields.len(), "field", "fields")
+                super::count(self.session.doc.geometries.len(), "geometry", "geometries"),
+                self.session.doc.geometries.len() - closed,
+                super::count(self.session.doc.fields.len(), "field", "fields")
             ));
-            let far = self.out_of_reach.len();
-            let near = self.uncovered.len() - far;
+            let far = self.session.out_of_reach.len();
+            let near = self.session.uncovered.len() - far;
             if far > 0 {
                 ui.add(
                     egui::Label::new(
@@ -425,7 +452,7 @@ impl App {
                 );
             }
         }
-        if let Some(p) = &self.problem {
+        if let Some(p) = &self.session.problem {
             ui.add(egui::Label::new(RichText::new(p).color(ERROR)).wrap());
         }
         self.selected_field_ui(ui);
@@ -435,11 +462,14 @@ impl App {
             ui.separator();
             ui.heading("Metrics");
             compare::metrics_table(ui, "active-metrics", plan, None);
-            let stale = self.active.map_or(&[][..], |k| self.plan_staleness(k));
+            let stale = self
+                .session
+                .active
+                .map_or(&[][..], |k| self.plan_staleness(k));
             compare::stale_notes(ui, &[(plan, stale)]);
         }
         ui.separator();
-        let n = self.doc.warnings.len();
+        let n = self.session.doc.warnings.len();
         let title = if n > 0 {
             RichText::new(format!("Import warnings ({n})"))
                 .strong()
@@ -449,13 +479,13 @@ impl App {
         };
         // a new id per import: the list opens on each import that has warnings
         egui::CollapsingHeader::new(title)
-            .id_salt(("warnings", self.imports))
+            .id_salt(("warnings", self.view.imports))
             .default_open(n > 0)
             .show(ui, |ui| {
                 if n == 0 {
                     ui.label("none");
                 }
-                for w in &self.doc.warnings {
+                for w in &self.session.doc.warnings {
                     ui.add(
                         egui::Label::new(
                             RichText::new(w.to_string()).color(Color32::from_rgb(180, 83, 9)),
@@ -467,7 +497,7 @@ impl App {
         egui::CollapsingHeader::new("Recent files")
             .default_open(false)
             .show(ui, |ui| {
-                for p in self.recent.0.clone() {
+                for p in self.view.recent.0.clone() {
                     if ui.link(p.display().to_string()).clicked() {
                         let ctx = ui.ctx().clone();
                         self.request_open(Some(p), &ctx);
@@ -478,8 +508,9 @@ impl App {
 
     fn selected_field_ui(&mut self, ui: &mut egui::Ui) {
         let Some(f) = self
+            .view
             .selected
-            .and_then(|id| self.doc.fields.iter().find(|f| f.id == id))
+            .and_then(|id| self.session.doc.fields.iter().find(|f| f.id == id))
         else {
             return;
         };
@@ -487,7 +518,7 @@ impl App {
         let visiting = self.active_plan().map(|p| p.fields.as_slice());
         ui.heading(format!(
             "Field {}",
-            super::field_number(&self.doc.fields, visiting, f.id)
+            super::field_number(&self.session.doc.fields, visiting, f.id)
         ));
         ui.label(format!(
             "centre ({:.2}, {:.2}) mm, {} geometries{}",
@@ -500,20 +531,23 @@ impl App {
 
     fn plans_ui(&mut self, ui: &mut egui::Ui) {
         ui.heading("Plans");
-        if self.doc.plans.is_empty() {
+        if self.session.doc.plans.is_empty() {
             ui.label("none yet: run a solver");
         }
         let mut remove = None;
-        for k in 0..self.doc.plans.len() {
-            let p = &self.doc.plans[k];
+        for k in 0..self.session.doc.plans.len() {
+            let p = &self.session.doc.plans[k];
             let stale = self.plan_staleness(k).to_vec();
             ui.horizontal(|ui| {
                 let text = match p.metrics.job_time_s {
                     Some(t) => format!("{}  job time {t:.2} s", p.name),
                     None => format!("{}  idle travel {:.1} mm", p.name, p.metrics.idle_mm),
                 };
-                if ui.selectable_label(self.active == Some(k), text).clicked() {
-                    self.active = Some(k);
+                if ui
+                    .selectable_label(self.session.active == Some(k), text)
+                    .clicked()
+                {
+                    self.session.active = Some(k);
                 }
                 if !stale.is_empty() {
                     ui.label(RichText::new("stale").color(STALE))
@@ -528,22 +562,11 @@ impl App {
                 }
             });
         }
-        if let Some(k) = remove {
-            let p = self.doc.plans.remove(k);
-            self.toolpaths.sync(&self.doc);
-            self.compare = super::CompareState {
-                canvas: std::mem::take(&mut self.compare.canvas),
+        if let Some(p) = remove.and_then(|k| self.session.remove_plan(k)) {
+            self.view.compare = super::CompareState {
+                canvas: std::mem::take(&mut self.view.compare.canvas),
                 ..Default::default()
             };
-            self.active = self.active.and_then(|a| {
-                if a == k {
-                    None
-                } else if a > k {
-                    Some(a - 1)
-                } else {
-                    Some(a)
-                }
-            });
             self.set_status(format!("removed {}", p.name), false);
         }
     }
@@ -557,26 +580,38 @@ impl App {
             });
             return;
         }
-        let plan = self.active.and_then(|k| self.doc.plans.get(k));
-        let lowered = self.active.and_then(|k| self.toolpaths.get(k));
-        playback::controls(ui, "workbench", &mut self.playback, lowered, true);
+        let plan = self
+            .session
+            .active
+            .and_then(|k| self.session.doc.plans.get(k));
+        let lowered = self
+            .session
+            .active
+            .and_then(|k| self.session.toolpaths.get(k));
+        playback::controls(ui, "workbench", &mut self.view.playback, lowered, true);
         let stale = self
+            .session
             .active
             .map_or_else(Vec::new, |k| self.plan_staleness(k).to_vec());
         let playback_t_s = lowered
             .and_then(Result::ok)
-            .and_then(|_| self.playback.shown_t_s());
+            .and_then(|_| self.view.playback.shown_t_s());
         let canvas = Canvas {
             label: "Work area",
-            geometries: &self.doc.geometries,
-            profile: &self.doc.profile,
-            fields: &self.doc.fields,
+            geometries: &self.session.doc.geometries,
+            profile: &self.session.doc.profile,
+            fields: &self.session.doc.fields,
             visiting: plan.map(|p| p.fields.as_slice()),
             // layer colours when the layers tell something apart (several, or a hatch)
-            colours: (self.doc.layers.len() > 1
-                || self.doc.layers.iter().any(|l| l.pen.hatch.is_some()))
-            .then_some(self.colours.as_slice()),
-            out_of_reach: &self.out_of_reach,
+            colours: (self.session.doc.layers.len() > 1
+                || self
+                    .session
+                    .doc
+                    .layers
+                    .iter()
+                    .any(|l| l.pen.hatch.is_some()))
+            .then_some(self.view.colours.as_slice()),
+            out_of_reach: &self.session.out_of_reach,
             paths: plan
                 .zip(lowered)
                 .map(|(p, lowered)| PathLayer {
@@ -586,11 +621,11 @@ impl App {
                 })
                 .into_iter()
                 .collect(),
-            uncovered: &self.uncovered,
-            selected: self.selected,
+            uncovered: &self.session.uncovered,
+            selected: self.view.selected,
             editable: true,
-            add_tool: self.add_tool,
-            layers: self.layers,
+            add_tool: self.view.add_tool,
+            layers: self.view.layers,
             stale: &stale,
             playback_t_s,
         };
@@ -598,22 +633,31 @@ impl App {
         let header_px = 2.0 * ui.spacing().interact_size.y;
         let plots_px = motion_plots::PLOTS_HEIGHT_PX.min(ui.available_height() * 0.4);
         let below_px = match motion {
-            Some(_) if self.motion_plots_open => header_px + plots_px,
+            Some(_) if self.view.motion_plots_open => header_px + plots_px,
             Some(_) => header_px,
             None => 0.0,
         };
-        let below = (motion.is_some(), motion.is_some() && self.motion_plots_open);
-        if below != self.workbench_below {
+        let below = (
+            motion.is_some(),
+            motion.is_some() && self.view.motion_plots_open,
+        );
+        if below != self.view.workbench_below {
             // the canvas changes height when the plots come or go: fit the content again
-            self.workbench_below = below;
-            self.workbench.fit_requested = true;
+            self.view.workbench_below = below;
+            self.view.workbench.fit_requested = true;
         }
         let size = ui.available_size() - egui::Vec2::Y * below_px;
-        let (_, actions) = canvas.show(ui, &mut self.workbench, Some(size));
+        let (_, actions) = canvas.show(ui, &mut self.view.workbench, Some(size));
         if let Some(samples) = motion {
-            motion_plots_header(ui, &mut self.motion_plots_open);
-            if self.motion_plots_open {
-                motion_plots::show(ui, samples, &self.doc.profile, playback_t_s, plots_px);
+            motion_plots_header(ui, &mut self.view.motion_plots_open);
+            if self.view.motion_plots_open {
+                motion_plots::show(
+                    ui,
+                    samples,
+                    &self.session.doc.profile,
+                    playback_t_s,
+                    plots_px,
+                );
             }
         }
         self.on_canvas(actions);

@@ -25,26 +25,27 @@ mod paint;
 pub mod panels;
 pub mod playback;
 mod prompts;
+pub mod session;
 pub mod toolpaths;
 
 pub use canvas::{Canvas, CanvasAction, CanvasState, Layers, View};
 
 use crate::document::{
-    staleness, Algo, DerivedKey, Document, Layer, MachineProfile, MotionMode, Plan, ScanField,
-    SolverSettings,
+    Algo, DerivedKey, Document, Layer, MachineProfile, MotionMode, Plan, ScanField, SolverSettings,
 };
 use crate::job::JobCtx;
 use crate::pipeline::{derive_geometries, place_document_fields};
-use commands::{Command, History, Outcome};
+use commands::{Command, Outcome};
 use compare::CompareState;
 use files::{ExportKind, Recent};
 use jobs::{Job, JobOutcome, JobResult};
 use playback::Playback;
 pub use prompts::{PathAction, Prompt};
 use serde::{Deserialize, Serialize};
+use session::Session;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
-use toolpaths::{Lowered, ToolpathCache};
+use toolpaths::Lowered;
 
 /// Key of the preferences in eframe's storage.
 const PREFS_KEY: &str = "galvoplan-prefs";
@@ -96,7 +97,7 @@ pub fn run(file: Option<PathBuf>) -> anyhow::Result<()> {
                 .and_then(|s| eframe::get_value::<Prefs>(s, PREFS_KEY))
                 .unwrap_or_default();
             let mut app = App::with_prefs(prefs);
-            app.frame_log =
+            app.view.frame_log =
                 std::env::var_os("GALVOPLAN_FRAME_LOG").and_then(|p| std::fs::File::create(p).ok());
             if let Some(f) = file {
                 app.open_in_background(&f, &cc.egui_ctx);
@@ -166,35 +167,30 @@ struct Status {
     error: bool,
 }
 
-/// Application state.
+/// The window: the session (document and what derives from it, no egui), the view state
+/// (panels, canvases, prompts, status, preferences shown) and the job runtime (the background
+/// work and what follows it).
 pub struct App {
-    /// The open document (empty until a file is opened).
-    pub doc: Document,
-    /// Where the project was loaded from or saved to.
-    project_path: Option<PathBuf>,
-    history: History,
-    job: Option<Job>,
+    /// The open document, its history, plans and caches.
+    pub session: Session,
+    view: ViewState,
+    runtime: Runtime,
+}
+
+/// What the window shows and how: panels, canvases, prompts, the status line, preferences.
+struct ViewState {
     editors: panels::Editors,
-    /// Compare view state.
-    pub compare: CompareState,
+    compare: CompareState,
     workbench: CanvasState,
     selected: Option<usize>,
     add_tool: bool,
-    /// The central view.
-    pub tab: Tab,
-    /// Index of the plan drawn on the workbench.
-    active: Option<usize>,
-    /// Each plan's lowered toolpath (run time only).
-    toolpaths: ToolpathCache,
-    /// Playback on the workbench canvas (run time only).
+    tab: Tab,
+    /// Playback on the workbench canvas.
     playback: Playback,
     /// The motion plots below the workbench canvas are shown (on-the-fly plans).
     motion_plots_open: bool,
     /// What was under the workbench canvas in the last frame: (plots header, plots).
     workbench_below: (bool, bool),
-    uncovered: Vec<usize>,
-    /// A problem with the open document (e.g. fields could not be placed).
-    problem: Option<String>,
     recent: Recent,
     layers: Layers,
     status: Status,
@@ -214,30 +210,26 @@ pub struct App {
     prompt: Option<Prompt>,
     /// Native file dialogs can be shown (else a path field is offered).
     dialogs: bool,
-    /// Counts changes of the document (edits, plans, layers).
-    revision: u64,
-    /// `revision` when the document was last opened or saved.
-    saved_revision: u64,
     /// The operator chose to quit without saving.
     quit_confirmed: bool,
     /// Counts imports: the warnings list opens again on each one.
     imports: u64,
-    /// (imported, marked) geometries per layer.
-    layer_counts: Vec<(usize, usize)>,
     /// Each geometry's layer colour.
     colours: Vec<egui::Color32>,
-    /// Uncovered geometries no scan field can ever hold (larger than a field, or beyond the
-    /// stage's stroke plus half a field).
-    out_of_reach: Vec<usize>,
-    /// Per plan, what changed since it was planned, in words (empty: current).
-    stale: Vec<Vec<String>>,
+    /// The folder last exported to, per kind of export.
+    export_dirs: files::ExportDirs,
     /// DejaVu Sans is installed as the fallback font (arrows, symbols, layer names in other
     /// scripts would otherwise miss glyphs).
     fonts_installed: bool,
+}
+
+/// The background work and what is to follow it.
+#[derive(Default)]
+struct Runtime {
+    /// The running job (one at a time).
+    job: Option<Job>,
     /// An export to write once the solve running now ends (re-solve and export).
     export_after_solve: Option<(ExportKind, PathBuf)>,
-    /// The folder last exported to, per kind of export.
-    export_dirs: files::ExportDirs,
 }
 
 impl Default for App {
@@ -250,92 +242,85 @@ impl App {
     /// A new window state with stored preferences.
     pub fn with_prefs(prefs: Prefs) -> Self {
         Self {
-            doc: Document {
-                profile: prefs.profile,
-                settings: prefs.settings,
-                ..Document::default()
+            session: Session {
+                doc: Document {
+                    profile: prefs.profile,
+                    settings: prefs.settings,
+                    ..Document::default()
+                },
+                ..Session::default()
             },
-            project_path: None,
-            history: History::default(),
-            job: None,
-            editors: panels::Editors::default(),
-            compare: CompareState::default(),
-            workbench: CanvasState::default(),
-            selected: None,
-            add_tool: false,
-            tab: Tab::Workbench,
-            active: None,
-            toolpaths: ToolpathCache::default(),
-            playback: Playback::default(),
-            motion_plots_open: true,
-            workbench_below: (false, false),
-            uncovered: Vec::new(),
-            problem: None,
-            recent: prefs.recent,
-            layers: prefs.layers,
-            status: Status {
-                text: "Open an SVG, a DXF or a project (File menu, or drag and drop) to start."
-                    .into(),
-                error: false,
+            view: ViewState {
+                editors: panels::Editors::default(),
+                compare: CompareState::default(),
+                workbench: CanvasState::default(),
+                selected: None,
+                add_tool: false,
+                tab: Tab::Workbench,
+                playback: Playback::default(),
+                motion_plots_open: true,
+                workbench_below: (false, false),
+                recent: prefs.recent,
+                layers: prefs.layers,
+                status: Status {
+                    text: "Open an SVG, a DXF or a project (File menu, or drag and drop) to start."
+                        .into(),
+                    error: false,
+                },
+                frames: FrameStats::default(),
+                drag_group: 0,
+                dragging: false,
+                title: String::new(),
+                frame_log: None,
+                layer_editor: layers::LayerEditor::default(),
+                section: Section::Layers,
+                frame_times: prefs.frame_times,
+                prompt: None,
+                dialogs: files::native_dialogs_available(),
+                quit_confirmed: false,
+                imports: 0,
+                colours: Vec::new(),
+                export_dirs: prefs.export_dirs,
+                fonts_installed: false,
             },
-            frames: FrameStats::default(),
-            drag_group: 0,
-            dragging: false,
-            title: String::new(),
-            frame_log: None,
-            layer_editor: layers::LayerEditor::default(),
-            section: Section::Layers,
-            frame_times: prefs.frame_times,
-            prompt: None,
-            dialogs: files::native_dialogs_available(),
-            revision: 0,
-            saved_revision: 0,
-            quit_confirmed: false,
-            imports: 0,
-            layer_counts: Vec::new(),
-            colours: Vec::new(),
-            out_of_reach: Vec::new(),
-            stale: Vec::new(),
-            fonts_installed: false,
-            export_after_solve: None,
-            export_dirs: prefs.export_dirs,
+            runtime: Runtime::default(),
         }
     }
 
     /// The preferences to store.
     pub fn prefs(&self) -> Prefs {
         Prefs {
-            profile: self.doc.profile.clone(),
-            settings: self.doc.settings.clone(),
-            recent: self.recent.clone(),
-            layers: self.layers,
-            frame_times: self.frame_times,
-            export_dirs: self.export_dirs.clone(),
+            profile: self.session.doc.profile.clone(),
+            settings: self.session.doc.settings.clone(),
+            recent: self.view.recent.clone(),
+            layers: self.view.layers,
+            frame_times: self.view.frame_times,
+            export_dirs: self.view.export_dirs.clone(),
         }
     }
 
     /// Whether native file dialogs are tried (without them every file action asks for a path
     /// in a text field).
     pub fn set_native_dialogs(&mut self, on: bool) {
-        self.dialogs = on;
+        self.view.dialogs = on;
     }
 
     /// The question or path field shown, if any.
     pub fn prompt(&self) -> Option<&Prompt> {
-        self.prompt.as_ref()
+        self.view.prompt.as_ref()
     }
 
     /// True when the document has changes that are not saved in a project file.
     pub fn has_unsaved_changes(&self) -> bool {
-        self.has_document() && self.revision != self.saved_revision
+        self.session.has_unsaved_changes()
     }
 
     fn changed(&mut self) {
-        self.revision += 1;
+        self.session.changed();
     }
 
     fn set_status(&mut self, text: impl Into<String>, error: bool) {
-        self.status = Status {
+        self.view.status = Status {
             text: text.into(),
             error,
         };
@@ -343,12 +328,12 @@ impl App {
 
     /// The status line text.
     pub fn status(&self) -> &str {
-        &self.status.text
+        &self.view.status.text
     }
 
     /// True when a document is open.
     pub fn has_document(&self) -> bool {
-        !self.doc.geometries.is_empty()
+        self.session.has_document()
     }
 
     /// Opens an SVG or DXF (fields placed automatically) or a project file on this thread (the
@@ -356,8 +341,8 @@ impl App {
     pub fn open(&mut self, path: &Path) -> bool {
         match files::open(
             path,
-            &self.doc.profile,
-            &self.doc.settings,
+            &self.session.doc.profile,
+            &self.session.doc.settings,
             &JobCtx::default(),
         ) {
             Ok(o) => {
@@ -375,8 +360,8 @@ impl App {
     pub fn open_in_background(&mut self, path: &Path, repaint: &egui::Context) {
         let (file, profile, settings) = (
             path.to_path_buf(),
-            self.doc.profile.clone(),
-            self.doc.settings.clone(),
+            self.session.doc.profile.clone(),
+            self.session.doc.settings.clone(),
         );
         let name = format!("opening {}", path.display());
         self.start_job(name, "open", repaint, move |ctx| {
@@ -389,36 +374,40 @@ impl App {
 
     /// Takes an opened document into the window.
     fn opened(&mut self, path: &Path, o: files::Opened) {
-        self.job = None;
-        self.doc = o.doc;
-        self.project_path = o.is_project.then(|| path.to_path_buf());
-        self.history.clear();
-        self.selected = None;
-        self.active = self.doc.plans.len().checked_sub(1);
-        self.compare = CompareState::default();
-        self.playback = Playback::default();
-        self.workbench.fit_requested = true;
-        self.compare.canvas.fit_requested = true;
-        self.recent.push(path);
-        self.imports += 1;
+        self.runtime.job = None;
+        self.session.doc = o.doc;
+        self.session.project_path = o.is_project.then(|| path.to_path_buf());
+        self.session.history.clear();
+        self.view.selected = None;
+        self.session.active = self.session.doc.plans.len().checked_sub(1);
+        self.view.compare = CompareState::default();
+        self.view.playback = Playback::default();
+        self.view.workbench.fit_requested = true;
+        self.view.compare.canvas.fit_requested = true;
+        self.view.recent.push(path);
+        self.view.imports += 1;
         self.refresh();
         self.changed();
-        self.saved_revision = self.revision;
+        self.session.saved_revision = self.session.revision;
         let msg = format!(
             "{}: {} on {}, {}, {}",
             path.display(),
-            count(self.doc.geometries.len(), "geometry", "geometries"),
-            count(self.doc.layers.len(), "layer", "layers"),
-            count(self.doc.fields.len(), "scan field", "scan fields"),
-            count(self.doc.warnings.len(), "import warning", "import warnings")
+            count(self.session.doc.geometries.len(), "geometry", "geometries"),
+            count(self.session.doc.layers.len(), "layer", "layers"),
+            count(self.session.doc.fields.len(), "scan field", "scan fields"),
+            count(
+                self.session.doc.warnings.len(),
+                "import warning",
+                "import warnings"
+            )
         );
         match o.problem {
             Some(p) => {
                 self.set_status(format!("{msg}; scan fields not placed: {p}"), true);
-                self.problem = Some(p);
+                self.session.problem = Some(p);
             }
             None => {
-                self.problem = None;
+                self.session.problem = None;
                 self.set_status(msg, false);
             }
         }
@@ -432,14 +421,14 @@ impl App {
         repaint: &egui::Context,
         work: impl FnOnce(&JobCtx) -> Result<JobResult, String> + Send + 'static,
     ) {
-        if let Some(j) = &self.job {
+        if let Some(j) = &self.runtime.job {
             let msg = format!("cannot start {name}: {} is running", j.name);
             self.set_status(msg, true);
             return;
         }
         match Job::spawn(name.clone(), thread, None, repaint, work) {
             Ok(job) => {
-                self.job = Some(job);
+                self.runtime.job = Some(job);
                 self.set_status(format!("{name}…"), false);
             }
             Err(e) => self.set_status(format!("cannot start {name}: {e}"), true),
@@ -448,7 +437,7 @@ impl App {
 
     /// Re-places the unlocked fields automatically in a background job (undoable).
     pub fn replace_fields(&mut self, repaint: &egui::Context) {
-        let mut work = self.doc.clone();
+        let mut work = self.session.doc.clone();
         self.start_job(
             "re-placing scan fields".into(),
             "place",
@@ -471,11 +460,13 @@ impl App {
             self.set_status(e.to_string(), true);
             return;
         }
-        if Some(DerivedKey::of(&layers, self.doc.profile.field_mm)) == self.doc.derived_with {
+        if Some(DerivedKey::of(&layers, self.session.doc.profile.field_mm))
+            == self.session.doc.derived_with
+        {
             let _ = self.execute(Command::SetLayers(layers));
             return;
         }
-        let mut work = self.doc.clone();
+        let mut work = self.session.doc.clone();
         work.layers = layers;
         self.start_job("hatching".into(), "hatch", repaint, move |ctx| {
             let before = work.geometries.len();
@@ -496,24 +487,17 @@ impl App {
 
     /// Saves the document (with its plans) as a project file, atomically.
     pub fn save_project(&mut self, path: &Path) -> Result<(), String> {
-        crate::document::save_project(&self.doc, path).map_err(|e| e.to_string())?;
-        self.project_path = Some(path.to_path_buf());
-        self.saved_revision = self.revision;
-        self.recent.push(path);
+        crate::document::save_project(&self.session.doc, path).map_err(|e| e.to_string())?;
+        self.session.project_path = Some(path.to_path_buf());
+        self.session.saved_revision = self.session.revision;
+        self.view.recent.push(path);
         self.set_status(format!("saved {}", path.display()), false);
         Ok(())
     }
 
-    /// The files the document was read from (artwork, project): no export may overwrite them.
-    pub fn input_files(&self) -> Vec<PathBuf> {
-        let mut v: Vec<PathBuf> = self.doc.source.iter().map(PathBuf::from).collect();
-        v.extend(self.project_path.clone());
-        v
-    }
-
     /// Refuses an export path that is one of the document's input files.
     fn check_export_path(&self, kind: ExportKind, path: &Path) -> Result<(), String> {
-        let inputs = self.input_files();
+        let inputs = self.session.input_files();
         let inputs: Vec<&Path> = inputs.iter().map(PathBuf::as_path).collect();
         crate::export::check_outputs(&inputs, &[(kind.filter().0, path)]).map_err(|e| e.to_string())
     }
@@ -522,20 +506,25 @@ impl App {
     /// thread.
     pub fn export(&mut self, kind: ExportKind, path: &Path) -> Result<(), String> {
         self.check_export_path(kind, path)?;
-        let k = self.active.ok_or("no plan to export: run a solver first")?;
+        let k = self
+            .session
+            .active
+            .ok_or("no plan to export: run a solver first")?;
         let plan = self
+            .session
             .doc
             .plans
             .get(k)
             .ok_or("no plan to export: run a solver first")?;
         let toolpath = self
+            .session
             .toolpaths
             .get(k)
             .and_then(Result::ok)
             .map(|l| &l.toolpath);
-        files::export(&self.doc, plan, toolpath, kind, path)?;
-        self.export_dirs.remember(kind, path);
-        let note = match self.stale.get(k) {
+        files::export(&self.session.doc, plan, toolpath, kind, path)?;
+        self.view.export_dirs.remember(kind, path);
+        let note = match self.session.stale.get(k) {
             Some(why) if !why.is_empty() => " as planned (stale: the document changed since)",
             _ => "",
         };
@@ -550,19 +539,20 @@ impl App {
             return;
         }
         let Some((k, plan)) = self
+            .session
             .active
-            .and_then(|k| Some((k, self.doc.plans.get(k)?.clone())))
+            .and_then(|k| Some((k, self.session.doc.plans.get(k)?.clone())))
         else {
             self.set_status("no plan to export: run a solver first", true);
             return;
         };
-        let lowered = self.toolpaths.get(k).and_then(Result::ok).cloned();
+        let lowered = self.session.toolpaths.get(k).and_then(Result::ok).cloned();
         let doc = Document {
             plans: Vec::new(),
             artwork: Vec::new(),
-            ..self.doc.clone()
+            ..self.session.doc.clone()
         };
-        self.export_dirs.remember(kind, path);
+        self.view.export_dirs.remember(kind, path);
         let file = path.to_path_buf();
         let name = format!("exporting {}", path.display());
         self.start_job(name, "export", repaint, move |_| {
@@ -584,8 +574,8 @@ impl App {
             return;
         };
         self.start_solve(algo, repaint);
-        if self.job.is_some() {
-            self.export_after_solve = Some((kind, path.to_path_buf()));
+        if self.runtime.job.is_some() {
+            self.runtime.export_after_solve = Some((kind, path.to_path_buf()));
         }
     }
 
@@ -595,14 +585,8 @@ impl App {
     }
 
     fn execute_grouped(&mut self, cmd: Command, group: Option<u64>) -> Result<Outcome, String> {
-        let what = cmd.describe(&|id| self.field_label(id));
-        let r = self
-            .history
-            .execute(&mut self.doc, cmd, group, what.clone());
-        self.refresh();
-        if r.is_ok() {
-            self.changed();
-        }
+        let (what, r) = self.session.execute(cmd, group);
+        self.refresh_view();
         match &r {
             Ok(o) => {
                 if group.is_none() {
@@ -614,8 +598,8 @@ impl App {
                         false,
                     );
                 }
-                if o.uncovered.is_empty() && self.problem.is_some() {
-                    self.problem = None;
+                if o.uncovered.is_empty() && self.session.problem.is_some() {
+                    self.session.problem = None;
                 }
             }
             Err(e) => self.set_status(format!("cannot {what}: {e}"), true),
@@ -625,156 +609,117 @@ impl App {
 
     /// Undoes the last edit.
     pub fn undo(&mut self) {
-        match self.history.undo(&mut self.doc) {
-            Some(w) => {
-                self.changed();
-                self.set_status(format!("undid: {w}"), false)
-            }
+        match self.session.undo() {
+            Some(w) => self.set_status(format!("undid: {w}"), false),
             None => self.set_status("nothing to undo", false),
         }
-        self.refresh();
+        self.refresh_view();
     }
 
     /// Redoes the last undone edit.
     pub fn redo(&mut self) {
-        match self.history.redo(&mut self.doc) {
-            Some(w) => {
-                self.changed();
-                self.set_status(format!("redid: {w}"), false)
-            }
+        match self.session.redo() {
+            Some(w) => self.set_status(format!("redid: {w}"), false),
             None => self.set_status("nothing to redo", false),
         }
-        self.refresh();
+        self.refresh_view();
     }
 
     /// Recomputes what derives from the document after a change.
     fn refresh(&mut self) {
-        let mut held = vec![false; self.doc.geometries.len()];
-        for f in &self.doc.fields {
-            for &g in &f.geometries {
-                if let Some(h) = held.get_mut(g) {
-                    *h = true;
-                }
-            }
-        }
-        self.uncovered = (0..held.len()).filter(|&g| !held[g]).collect();
-        self.out_of_reach = self
-            .uncovered
-            .iter()
-            .copied()
-            .filter(|&k| !can_be_covered(&self.doc.geometries[k], &self.doc.profile))
-            .collect();
-        self.refresh_layers();
-        if self
-            .selected
-            .is_some_and(|id| !self.doc.fields.iter().any(|f| f.id == id))
-        {
-            self.selected = None;
-        }
-        if self.active.is_some_and(|k| k >= self.doc.plans.len()) {
-            self.active = self.doc.plans.len().checked_sub(1);
-        }
-        self.toolpaths.sync(&self.doc);
-        self.refresh_staleness();
+        self.session.refresh();
+        self.refresh_view();
     }
 
-    /// What changed since each plan was planned.
-    fn refresh_staleness(&mut self) {
-        self.stale = self
-            .doc
-            .plans
+    /// The view's part of a refresh (the session's is done): layer colours, the selection.
+    fn refresh_view(&mut self) {
+        let doc = &self.session.doc;
+        let rgb: std::collections::HashMap<&str, egui::Color32> = doc
+            .layers
             .iter()
-            .map(|p| staleness(p, &self.doc))
+            .map(|l| {
+                let [r, g, b] = l.rgb();
+                (l.name.as_str(), egui::Color32::from_rgb(r, g, b))
+            })
             .collect();
+        self.view.colours = doc
+            .geometries
+            .iter()
+            .map(|g| {
+                rgb.get(g.layer.as_str())
+                    .copied()
+                    .unwrap_or(paint::colour::CLOSED)
+            })
+            .collect();
+        if self
+            .view
+            .selected
+            .is_some_and(|id| !doc.fields.iter().any(|f| f.id == id))
+        {
+            self.view.selected = None;
+        }
     }
 
     /// What changed since plan `k` was planned, in words (empty: it is current).
     pub fn plan_staleness(&self, k: usize) -> &[String] {
-        self.stale.get(k).map_or(&[], Vec::as_slice)
+        self.session.plan_staleness(k)
     }
 
     /// The number the canvas shows for field `id`: 1…n in the visiting order of the plan
     /// shown, else in placement order.
     pub fn field_label(&self, id: usize) -> usize {
-        let visiting = self.active_plan().map(|p| p.fields.as_slice());
-        field_number(&self.doc.fields, visiting, id)
-    }
-
-    /// Layer counts and colours after the geometries or layers changed.
-    fn refresh_layers(&mut self) {
-        let index: std::collections::HashMap<&str, usize> = self
-            .doc
-            .layers
-            .iter()
-            .enumerate()
-            .map(|(k, l)| (l.name.as_str(), k))
-            .collect();
-        let mut counts = vec![(0, 0); self.doc.layers.len()];
-        for g in &self.doc.artwork {
-            if let Some(&k) = index.get(g.layer.as_str()) {
-                counts[k].0 += 1;
-            }
-        }
-        let rgb: Vec<egui::Color32> = self
-            .doc
-            .layers
-            .iter()
-            .map(|l| {
-                let [r, g, b] = l.rgb();
-                egui::Color32::from_rgb(r, g, b)
-            })
-            .collect();
-        self.colours.clear();
-        for g in &self.doc.geometries {
-            match index.get(g.layer.as_str()) {
-                Some(&k) => {
-                    counts[k].1 += 1;
-                    self.colours.push(rgb[k]);
-                }
-                None => self.colours.push(paint::colour::CLOSED),
-            }
-        }
-        self.layer_counts = counts;
+        self.session.field_label(id)
     }
 
     /// Uncovered geometries that no scan field can hold.
     pub fn out_of_reach(&self) -> &[usize] {
-        &self.out_of_reach
+        &self.session.out_of_reach
     }
 
     /// Geometries no field holds.
     pub fn uncovered(&self) -> &[usize] {
-        &self.uncovered
+        &self.session.uncovered
     }
 
     /// The selected field id.
     pub fn selected_field(&self) -> Option<usize> {
-        self.selected
+        self.view.selected
     }
 
     /// The plan drawn on the workbench.
     pub fn active_plan(&self) -> Option<&Plan> {
-        self.active.and_then(|k| self.doc.plans.get(k))
+        self.session.active_plan()
     }
 
     /// Plan `k`'s lowered toolpath, or why it could not be lowered (`None`: no such plan).
     pub fn toolpath(&self, k: usize) -> Option<Result<&Lowered, &str>> {
-        self.toolpaths.get(k)
+        self.session.toolpath(k)
     }
 
     /// The workbench playback (time, playing, speed).
     pub fn playback(&self) -> &Playback {
-        &self.playback
+        &self.view.playback
+    }
+
+    /// The compare view's state (plans shown, playback).
+    pub fn compare_state(&self) -> &CompareState {
+        &self.view.compare
+    }
+
+    /// The central view shown.
+    pub fn tab(&self) -> Tab {
+        self.view.tab
     }
 
     /// True while a background job (solve, import, hatch, placement, export) runs.
     pub fn is_busy(&self) -> bool {
-        self.job.is_some()
+        self.runtime.job.is_some()
     }
 
     /// The latest progress message of the running solve.
     pub fn job_message(&self) -> Option<String> {
-        self.job
+        self.runtime
+            .job
             .as_ref()
             .and_then(|j| j.progress())
             .map(|p| p.message)
@@ -782,24 +727,24 @@ impl App {
 
     /// Frame durations.
     pub fn frame_stats(&self) -> &FrameStats {
-        &self.frames
+        &self.view.frames
     }
 
     /// Screen position of a field's centre on the workbench canvas (after the first frame).
     pub fn field_screen_pos(&self, id: usize) -> Option<egui::Pos2> {
-        let f = self.doc.fields.iter().find(|f| f.id == id)?;
-        let rect = self.workbench.rect?;
-        Some(self.workbench.view.to_screen(rect, f.center))
+        let f = self.session.doc.fields.iter().find(|f| f.id == id)?;
+        let rect = self.view.workbench.rect?;
+        Some(self.view.workbench.view.to_screen(rect, f.center))
     }
 
     /// Why a solve cannot start now, if it cannot.
     pub fn solve_blocker(&self) -> Option<String> {
-        if let Some(j) = &self.job {
+        if let Some(j) = &self.runtime.job {
             Some(format!("{} is running", j.name))
         } else if !self.has_document() {
             Some("no document open".into())
-        } else if !self.uncovered.is_empty() {
-            Some(match self.uncovered.len() {
+        } else if !self.session.uncovered.is_empty() {
+            Some(match self.session.uncovered.len() {
                 1 => "1 geometry is not covered by a scan field".to_string(),
                 n => format!("{n} geometries are not covered by a scan field"),
             })
@@ -815,9 +760,9 @@ impl App {
             return;
         }
         let name = self.next_plan_name(algo);
-        match Job::solve(&self.doc, algo, name.clone(), repaint) {
+        match Job::solve(&self.session.doc, algo, name.clone(), repaint) {
             Ok(job) => {
-                self.job = Some(job);
+                self.runtime.job = Some(job);
                 self.set_status(format!("{name}: solving…"), false);
             }
             Err(e) => self.set_status(format!("cannot start the solver thread: {e}"), true),
@@ -826,7 +771,7 @@ impl App {
 
     /// Asks the running solve to stop.
     pub fn cancel_solve(&mut self) {
-        if let Some(j) = &self.job {
+        if let Some(j) = &self.runtime.job {
             j.cancel();
         }
     }
@@ -841,6 +786,7 @@ impl App {
             .map(|n| format!("{label} #{n}"))
             .find(|n| {
                 !self
+                    .session
                     .doc
                     .plans
                     .iter()
@@ -850,15 +796,15 @@ impl App {
     }
 
     fn poll_job(&mut self, ui_ctx: &egui::Context) {
-        let Some(job) = &self.job else { return };
+        let Some(job) = &self.runtime.job else { return };
         let Some(outcome) = job.poll() else { return };
         let (name, cancelled, elapsed) = (job.name.clone(), job.is_cancelled(), job.elapsed());
-        self.job = None;
+        self.runtime.job = None;
         match outcome {
             JobOutcome::Done(JobResult::Opened { path, opened }) => self.opened(&path, *opened),
             JobOutcome::Done(JobResult::Placed { doc, what }) => {
                 if self.execute(Command::SetContent { doc, what }).is_ok() {
-                    self.layer_editor.clear_error();
+                    self.view.layer_editor.clear_error();
                 }
             }
             JobOutcome::Done(JobResult::Exported { path, kind }) => {
@@ -888,22 +834,16 @@ impl App {
                     m.idle_mm,
                     elapsed.as_secs_f64()
                 );
-                self.doc.plans.push(*plan);
-                self.changed();
-                let k = self.doc.plans.len() - 1;
-                self.toolpaths.adopt(k, lowered);
-                self.toolpaths.sync(&self.doc);
-                self.refresh_staleness();
-                self.active = Some(k);
-                self.compare.push(k);
-                match self.toolpaths.get(k) {
+                let k = self.session.add_plan(*plan, lowered);
+                self.view.compare.push(k);
+                match self.session.toolpaths.get(k) {
                     Some(Err(why)) => {
                         let msg = format!("{msg}; {why}");
                         self.set_status(msg, true);
                     }
                     _ => self.set_status(msg.clone(), false),
                 }
-                if let Some((kind, path)) = self.export_after_solve.take() {
+                if let Some((kind, path)) = self.runtime.export_after_solve.take() {
                     if cancelled {
                         self.set_status(
                             format!("{msg}; stopped, so {} was not written", path.display()),
@@ -915,11 +855,11 @@ impl App {
                 }
             }
             JobOutcome::Failed(e) if cancelled => {
-                self.export_after_solve = None;
+                self.runtime.export_after_solve = None;
                 self.set_status(format!("{name}: cancelled ({e})"), false)
             }
             JobOutcome::Failed(e) => {
-                self.export_after_solve = None;
+                self.runtime.export_after_solve = None;
                 self.set_status(format!("{name} failed: {e}"), true)
             }
         }
@@ -928,33 +868,41 @@ impl App {
     fn on_canvas(&mut self, actions: Vec<CanvasAction>) {
         for a in actions {
             match a {
-                CanvasAction::Select(id) => self.selected = id,
+                CanvasAction::Select(id) => self.view.selected = id,
                 CanvasAction::Move { id, center } => {
-                    if !self.dragging {
-                        self.dragging = true;
-                        self.drag_group += 1;
+                    if !self.view.dragging {
+                        self.view.dragging = true;
+                        self.view.drag_group += 1;
                     }
-                    let _ = self
-                        .execute_grouped(Command::MoveField { id, center }, Some(self.drag_group));
+                    let _ = self.execute_grouped(
+                        Command::MoveField { id, center },
+                        Some(self.view.drag_group),
+                    );
                 }
                 CanvasAction::EndDrag => {
-                    self.dragging = false;
-                    self.history.close_group();
-                    if let Some(f) = self.doc.fields.iter().find(|f| Some(f.id) == self.selected) {
+                    self.view.dragging = false;
+                    self.session.history.close_group();
+                    if let Some(f) = self
+                        .session
+                        .doc
+                        .fields
+                        .iter()
+                        .find(|f| Some(f.id) == self.view.selected)
+                    {
                         let msg = format!(
                             "moved field {} to ({:.1}, {:.1}) mm: {} geometries, {} uncovered",
                             self.field_label(f.id),
                             f.center.x,
                             f.center.y,
                             f.geometries.len(),
-                            self.uncovered.len()
+                            self.session.uncovered.len()
                         );
                         self.set_status(msg, false);
                     }
                 }
                 CanvasAction::Add(center) => {
                     if let Ok(o) = self.execute(Command::AddField { center }) {
-                        self.selected = o.added;
+                        self.view.selected = o.added;
                     }
                 }
             }
@@ -964,32 +912,33 @@ impl App {
     /// Draws one frame.
     pub fn ui(&mut self, ui: &mut egui::Ui) {
         let t0 = Instant::now();
-        if !self.fonts_installed {
+        if !self.view.fonts_installed {
             install_fallback_font(ui.ctx());
-            self.fonts_installed = true;
+            self.view.fonts_installed = true;
         }
         self.poll_job(ui.ctx());
         self.handle_input(ui.ctx());
         // plans added, loaded or removed, the profile or the geometries changed
-        self.toolpaths.sync(&self.doc);
+        self.session.toolpaths.sync(&self.session.doc);
         self.layout(ui);
         self.prompt_ui(ui);
-        if self.job.is_some() {
+        if self.runtime.job.is_some() {
             // keep the elapsed time ticking between progress reports
             ui.ctx().request_repaint_after(Duration::from_millis(100));
         }
-        let title = match (&self.project_path, &self.doc.source) {
+        let title = match (&self.session.project_path, &self.session.doc.source) {
             (Some(p), _) => format!("galvoplan — {}", p.display()),
             (None, Some(s)) => format!("galvoplan — {s}"),
             (None, None) => "galvoplan".into(),
         };
-        if title != self.title {
+        if title != self.view.title {
             ui.ctx()
                 .send_viewport_cmd(egui::ViewportCommand::Title(title.clone()));
-            self.title = title;
+            self.view.title = title;
         }
-        self.frames
-            .push(t0.elapsed().as_secs_f64() * 1e3, self.job.is_some());
+        self.view
+            .frames
+            .push(t0.elapsed().as_secs_f64() * 1e3, self.runtime.job.is_some());
     }
 
     fn handle_input(&mut self, ctx: &egui::Context) {
@@ -1004,11 +953,11 @@ impl App {
             self.request_open(Some(p.clone()), ctx);
         }
         let closing = ctx.input(|i| i.viewport().close_requested());
-        if closing && !self.quit_confirmed && self.has_unsaved_changes() {
+        if closing && !self.view.quit_confirmed && self.has_unsaved_changes() {
             ctx.send_viewport_cmd(egui::ViewportCommand::CancelClose);
-            self.prompt = Some(Prompt::Unsaved(prompts::Then::Quit));
+            self.view.prompt = Some(Prompt::Unsaved(prompts::Then::Quit));
         }
-        if ctx.egui_wants_keyboard_input() || self.prompt.is_some() {
+        if ctx.egui_wants_keyboard_input() || self.view.prompt.is_some() {
             return;
         }
         use egui::{Key, KeyboardShortcut, Modifiers};
@@ -1052,21 +1001,15 @@ impl App {
             )
         });
         if delete {
-            if let Some(id) = self.selected {
+            if let Some(id) = self.view.selected {
                 let _ = self.execute(Command::DeleteField { id });
             }
         }
         if fit {
-            self.workbench.fit_requested = true;
-            self.compare.canvas.fit_requested = true;
+            self.view.workbench.fit_requested = true;
+            self.view.compare.canvas.fit_requested = true;
         }
     }
-}
-
-/// True when some scan-field position within the stage's stroke holds all of `g`.
-fn can_be_covered(g: &crate::document::Geometry, profile: &MachineProfile) -> bool {
-    let (x, y) = crate::fields::center_range(&g.bbox(), profile);
-    !x.is_empty() && !y.is_empty()
 }
 
 /// Adds the bundled DejaVu Sans after egui's own fonts, for the glyphs they lack (→, ≤, …);
@@ -1121,17 +1064,17 @@ pub fn field_number(fields: &[ScanField], visiting: Option<&[ScanField]>, id: us
 
 impl eframe::App for App {
     fn ui(&mut self, ui: &mut egui::Ui, frame: &mut eframe::Frame) {
-        self.frames.cpu_ms = frame.info().cpu_usage.map(|s| f64::from(s) * 1e3);
+        self.view.frames.cpu_ms = frame.info().cpu_usage.map(|s| f64::from(s) * 1e3);
         App::ui(self, ui);
-        if let Some(log) = &mut self.frame_log {
+        if let Some(log) = &mut self.view.frame_log {
             use std::io::Write;
             // ui ms of this frame, whole-frame CPU ms of the previous one, solving 0/1
             let _ = writeln!(
                 log,
                 "{:.3} {:.3} {}",
-                self.frames.last_ms(),
-                self.frames.cpu_ms.unwrap_or(f64::NAN),
-                u8::from(self.job.is_some())
+                self.view.frames.last_ms(),
+                self.view.frames.cpu_ms.unwrap_or(f64::NAN),
+                u8::from(self.runtime.job.is_some())
             );
         }
     }

@@ -103,7 +103,7 @@ impl App {
     /// Open (a file, or ask for one), after asking about unsaved changes.
     pub fn request_open(&mut self, path: Option<PathBuf>, ctx: &egui::Context) {
         if self.has_unsaved_changes() {
-            self.prompt = Some(Prompt::Unsaved(Then::Open(path)));
+            self.view.prompt = Some(Prompt::Unsaved(Then::Open(path)));
             return;
         }
         match path {
@@ -115,32 +115,32 @@ impl App {
     /// Start an empty document, after asking about unsaved changes.
     pub fn request_new(&mut self) {
         if self.has_unsaved_changes() {
-            self.prompt = Some(Prompt::Unsaved(Then::New));
+            self.view.prompt = Some(Prompt::Unsaved(Then::New));
             return;
         }
-        self.job = None;
-        self.doc = Document {
-            profile: self.doc.profile.clone(),
-            settings: self.doc.settings.clone(),
+        self.runtime.job = None;
+        self.session.doc = Document {
+            profile: self.session.doc.profile.clone(),
+            settings: self.session.doc.settings.clone(),
             ..Document::default()
         };
-        self.project_path = None;
-        self.history.clear();
-        self.problem = None;
-        self.active = None;
+        self.session.project_path = None;
+        self.session.history.clear();
+        self.session.problem = None;
+        self.session.active = None;
         self.refresh();
         self.changed();
-        self.saved_revision = self.revision;
+        self.session.saved_revision = self.session.revision;
         self.set_status("new empty document: open an SVG or a project", false);
     }
 
     /// Close the window, after asking about unsaved changes.
     pub fn request_quit(&mut self, ctx: &egui::Context) {
-        if self.has_unsaved_changes() && !self.quit_confirmed {
-            self.prompt = Some(Prompt::Unsaved(Then::Quit));
+        if self.has_unsaved_changes() && !self.view.quit_confirmed {
+            self.view.prompt = Some(Prompt::Unsaved(Then::Quit));
             return;
         }
-        self.quit_confirmed = true;
+        self.view.quit_confirmed = true;
         // eframe stores the preferences on the way out
         ctx.send_viewport_cmd(egui::ViewportCommand::Close);
     }
@@ -151,7 +151,7 @@ impl App {
             self.set_status("nothing to save: open an SVG or a project first", true);
             return;
         }
-        match (&self.project_path, save_as) {
+        match (&self.session.project_path, save_as) {
             (Some(p), false) => {
                 let p = p.clone();
                 if let Err(e) = self.save_project(&p) {
@@ -164,10 +164,10 @@ impl App {
 
     /// Export the plan shown (asking first when it is stale).
     pub fn request_export(&mut self, kind: ExportKind, ctx: &egui::Context) {
-        match self.active {
+        match self.session.active {
             None => self.set_status("no plan to export: run a solver first (Run HHA)", true),
             Some(k) if !self.plan_staleness(k).is_empty() => {
-                self.prompt = Some(Prompt::StaleExport(kind))
+                self.view.prompt = Some(Prompt::StaleExport(kind))
             }
             Some(_) => self.choose_path(PathAction::Export(kind), ctx),
         }
@@ -180,21 +180,28 @@ impl App {
             PathAction::SavePens => "pens.toml".to_string(),
             PathAction::SaveProfile => "profile.toml".to_string(),
             PathAction::Export(kind) | PathAction::ResolveExport(kind) => {
-                files::default_name(&self.doc, kind.suffix())
+                files::default_name(&self.session.doc, kind.suffix())
             }
-            _ => files::default_name(&self.doc, ext),
+            _ => files::default_name(&self.session.doc, ext),
         };
         let folder = match action {
-            PathAction::Export(kind) | PathAction::ResolveExport(kind) => {
-                self.export_dirs.get(kind).map(std::path::Path::to_path_buf)
-            }
+            PathAction::Export(kind) | PathAction::ResolveExport(kind) => self
+                .view
+                .export_dirs
+                .get(kind)
+                .map(std::path::Path::to_path_buf),
             _ => None,
         }
         .or_else(|| {
-            let source = self.doc.source.as_deref().map(std::path::Path::new)?;
+            let source = self
+                .session
+                .doc
+                .source
+                .as_deref()
+                .map(std::path::Path::new)?;
             source.parent().map(std::path::Path::to_path_buf)
         });
-        if self.dialogs {
+        if self.view.dialogs {
             let t0 = Instant::now();
             let picked = match action {
                 PathAction::Open => files::pick_open(),
@@ -210,7 +217,7 @@ impl App {
                 self.set_status(format!("{title}: cancelled"), false);
                 return;
             }
-            self.dialogs = false;
+            self.view.dialogs = false;
         }
         let dir = folder.map(|d| {
             d.join(if action.saves() {
@@ -219,7 +226,7 @@ impl App {
                 ""
             })
         });
-        self.prompt = Some(Prompt::Path {
+        self.view.prompt = Some(Prompt::Path {
             action,
             text: dir.map(|d| d.display().to_string()).unwrap_or_default(),
             note: "No file dialog can be shown on this desktop (no desktop portal is running). \
@@ -247,7 +254,7 @@ impl App {
             PathAction::LoadPens => PenLibrary::load(&path)
                 .map_err(|e| e.to_string())
                 .map(|lib| {
-                    let mut layers = self.doc.layers.clone();
+                    let mut layers = self.session.doc.layers.clone();
                     let missing = lib.apply(&mut layers);
                     self.set_layers(layers, ctx);
                     if !missing.is_empty() {
@@ -259,7 +266,7 @@ impl App {
                         self.set_status(msg, false);
                     }
                 }),
-            PathAction::SavePens => PenLibrary::of(&self.doc.layers)
+            PathAction::SavePens => PenLibrary::of(&self.session.doc.layers)
                 .save(&path)
                 .map_err(|e| e.to_string())
                 .map(|()| self.set_status(format!("saved pens to {}", path.display()), false)),
@@ -272,6 +279,7 @@ impl App {
                     })
             }
             PathAction::SaveProfile => self
+                .session
                 .doc
                 .profile
                 .to_toml()
@@ -290,7 +298,7 @@ impl App {
     /// Continues what the unsaved-changes prompt held back.
     fn then(&mut self, then: Then, ctx: &egui::Context) {
         // the operator has answered for the current changes
-        self.saved_revision = self.revision;
+        self.session.saved_revision = self.session.revision;
         match then {
             Then::Quit => self.request_quit(ctx),
             Then::Open(p) => self.request_open(p, ctx),
@@ -300,7 +308,7 @@ impl App {
 
     /// Draws the prompt, if any, as a modal window.
     pub(super) fn prompt_ui(&mut self, ui: &mut egui::Ui) {
-        let Some(prompt) = self.prompt.take() else {
+        let Some(prompt) = self.view.prompt.take() else {
             return;
         };
         let ctx = ui.ctx().clone();
@@ -371,7 +379,10 @@ impl App {
                 }
                 Prompt::StaleExport(kind) => {
                     ui.heading("The plan shown is stale");
-                    let why = self.active.map_or(&[][..], |k| self.plan_staleness(k));
+                    let why = self
+                        .session
+                        .active
+                        .map_or(&[][..], |k| self.plan_staleness(k));
                     ui.add(
                         egui::Label::new(
                             "The document changed since this plan was made. Exported as \
@@ -420,7 +431,7 @@ impl App {
             keep = false;
         }
         if keep {
-            self.prompt = Some(shown);
+            self.view.prompt = Some(shown);
         }
         if let Some(f) = next {
             f(self, &ctx);

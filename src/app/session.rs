@@ -1,0 +1,288 @@
+//! The open document and everything derived from it, without egui: the document, where it
+//! came from, its undo history, its plans' toolpaths and staleness, coverage and the plan
+//! shown. The window ([`super::App`]) draws it and sends it commands; the tests below drive it
+//! without a window.
+
+use super::commands::{Command, History, Outcome};
+use super::field_number;
+use super::toolpaths::{Lowered, Prelowered, ToolpathCache};
+use crate::document::{staleness, Document, MachineProfile, Plan};
+use std::path::PathBuf;
+
+/// The open document and its derived state.
+#[derive(Default)]
+pub struct Session {
+    /// The open document (empty until a file is opened).
+    pub doc: Document,
+    /// Where the project was loaded from or saved to.
+    pub project_path: Option<PathBuf>,
+    /// Undo and redo.
+    pub history: History,
+    /// Index of the plan shown (workbench, exports, field numbers).
+    pub active: Option<usize>,
+    /// Each plan's lowered toolpath (run time only).
+    pub toolpaths: ToolpathCache,
+    /// Counts changes of the document (edits, plans, layers).
+    pub revision: u64,
+    /// `revision` when the document was last opened or saved.
+    pub saved_revision: u64,
+    /// Geometries no field holds.
+    pub uncovered: Vec<usize>,
+    /// Uncovered geometries no scan field can ever hold (larger than a field, or beyond the
+    /// stage's stroke plus half a field).
+    pub out_of_reach: Vec<usize>,
+    /// (imported, marked) geometries per layer.
+    pub layer_counts: Vec<(usize, usize)>,
+    /// Per plan, what changed since it was planned, in words (empty: current).
+    pub stale: Vec<Vec<String>>,
+    /// A problem with the open document (e.g. fields could not be placed).
+    pub problem: Option<String>,
+}
+
+impl Session {
+    /// True when a document is open.
+    pub fn has_document(&self) -> bool {
+        !self.doc.geometries.is_empty()
+    }
+
+    /// True when the document has changes that are not saved in a project file.
+    pub fn has_unsaved_changes(&self) -> bool {
+        self.has_document() && self.revision != self.saved_revision
+    }
+
+    /// Counts a change of the document.
+    pub fn changed(&mut self) {
+        self.revision += 1;
+    }
+
+    /// The plan shown.
+    pub fn active_plan(&self) -> Option<&Plan> {
+        self.active.and_then(|k| self.doc.plans.get(k))
+    }
+
+    /// What changed since plan `k` was planned, in words (empty: it is current).
+    pub fn plan_staleness(&self, k: usize) -> &[String] {
+        self.stale.get(k).map_or(&[], Vec::as_slice)
+    }
+
+    /// The number the canvas shows for field `id`: 1…n in the visiting order of the plan
+    /// shown, else in placement order.
+    pub fn field_label(&self, id: usize) -> usize {
+        let visiting = self.active_plan().map(|p| p.fields.as_slice());
+        field_number(&self.doc.fields, visiting, id)
+    }
+
+    /// Plan `k`'s lowered toolpath, or why it could not be lowered (`None`: no such plan).
+    pub fn toolpath(&self, k: usize) -> Option<Result<&Lowered, &str>> {
+        self.toolpaths.get(k)
+    }
+
+    /// The files the document was read from (artwork, project): no export may overwrite them.
+    pub fn input_files(&self) -> Vec<PathBuf> {
+        let mut v: Vec<PathBuf> = self.doc.source.iter().map(PathBuf::from).collect();
+        v.extend(self.project_path.clone());
+        v
+    }
+
+    /// Applies an edit through the undo history, described with the canvas's field numbers;
+    /// returns the description and the outcome.
+    pub fn execute(
+        &mut self,
+        cmd: Command,
+        group: Option<u64>,
+    ) -> (String, Result<Outcome, String>) {
+        let what = cmd.describe(&|id| self.field_label(id));
+        let r = self
+            .history
+            .execute(&mut self.doc, cmd, group, what.clone());
+        self.refresh();
+        if r.is_ok() {
+            self.changed();
+        }
+        (what, r)
+    }
+
+    /// Undoes the last edit; returns its description.
+    pub fn undo(&mut self) -> Option<String> {
+        let w = self.history.undo(&mut self.doc);
+        if w.is_some() {
+            self.changed();
+        }
+        self.refresh();
+        w
+    }
+
+    /// Redoes the last undone edit; returns its description.
+    pub fn redo(&mut self) -> Option<String> {
+        let w = self.history.redo(&mut self.doc);
+        if w.is_some() {
+            self.changed();
+        }
+        self.refresh();
+        w
+    }
+
+    /// Adds a solved plan with the toolpath its job lowered, shows it; returns its index.
+    pub fn add_plan(&mut self, plan: Plan, lowered: Prelowered) -> usize {
+        self.doc.plans.push(plan);
+        self.changed();
+        let k = self.doc.plans.len() - 1;
+        self.toolpaths.adopt(k, lowered);
+        self.active = Some(k);
+        self.refresh();
+        k
+    }
+
+    /// Removes plan `k` (the plan shown moves with the list); returns it.
+    pub fn remove_plan(&mut self, k: usize) -> Option<Plan> {
+        if k >= self.doc.plans.len() {
+            return None;
+        }
+        let p = self.doc.plans.remove(k);
+        self.doc.prune_kept_geometries();
+        self.active = self
+            .active
+            .and_then(|a| (a != k).then(|| if a > k { a - 1 } else { a }));
+        self.changed();
+        self.refresh();
+        Some(p)
+    }
+
+    /// Recomputes what derives from the document after a change: coverage, layer counts,
+    /// each plan's toolpath and staleness.
+    pub fn refresh(&mut self) {
+        let mut held = vec![false; self.doc.geometries.len()];
+        for f in &self.doc.fields {
+            for &g in &f.geometries {
+                if let Some(h) = held.get_mut(g) {
+                    *h = true;
+                }
+            }
+        }
+        self.uncovered = (0..held.len()).filter(|&g| !held[g]).collect();
+        self.out_of_reach = self
+            .uncovered
+            .iter()
+            .copied()
+            .filter(|&k| !can_be_covered(&self.doc.geometries[k], &self.doc.profile))
+            .collect();
+        self.layer_counts = layer_counts(&self.doc);
+        if self.active.is_some_and(|k| k >= self.doc.plans.len()) {
+            self.active = self.doc.plans.len().checked_sub(1);
+        }
+        self.toolpaths.sync(&self.doc);
+        self.stale = self
+            .doc
+            .plans
+            .iter()
+            .map(|p| staleness(p, &self.doc))
+            .collect();
+    }
+}
+
+/// (imported, marked) geometries per layer of the table.
+fn layer_counts(doc: &Document) -> Vec<(usize, usize)> {
+    let index: std::collections::HashMap<&str, usize> = doc
+        .layers
+        .iter()
+        .enumerate()
+        .map(|(k, l)| (l.name.as_str(), k))
+        .collect();
+    let mut counts = vec![(0, 0); doc.layers.len()];
+    for g in &doc.artwork {
+        if let Some(&k) = index.get(g.layer.as_str()) {
+            counts[k].0 += 1;
+        }
+    }
+    for g in &doc.geometries {
+        if let Some(&k) = index.get(g.layer.as_str()) {
+            counts[k].1 += 1;
+        }
+    }
+    counts
+}
+
+/// True when some scan-field position within the stage's stroke holds all of `g`.
+fn can_be_covered(g: &crate::document::Geometry, profile: &MachineProfile) -> bool {
+    let (x, y) = crate::fields::center_range(&g.bbox(), profile);
+    !x.is_empty() && !y.is_empty()
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used, clippy::expect_used)]
+    use super::*;
+    use crate::job::JobCtx;
+    use crate::pipeline::{load_svg, order_document_lowered, place_document_fields};
+
+    fn demo() -> Session {
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/examples/demo.svg");
+        let (mut doc, _) = load_svg(
+            &path,
+            MachineProfile::default(),
+            Default::default(),
+            &Default::default(),
+        )
+        .unwrap();
+        place_document_fields(&mut doc, &JobCtx::default()).unwrap();
+        let mut s = Session {
+            doc,
+            ..Session::default()
+        };
+        s.refresh();
+        s
+    }
+
+    fn solve(s: &mut Session) -> usize {
+        let (plan, toolpath) = order_document_lowered(&s.doc, &JobCtx::default()).unwrap();
+        let lowered = Prelowered::of(&plan, toolpath);
+        s.add_plan(plan, lowered)
+    }
+
+    #[test]
+    fn edits_keep_plans_and_say_what_changed() {
+        let mut s = demo();
+        let k = solve(&mut s);
+        assert!(s.plan_staleness(k).is_empty());
+        let mut p = s.doc.profile.clone();
+        p.axis_y.max_velocity_mm_s = 100.0;
+        let (what, r) = s.execute(Command::SetProfile(Box::new(p)), None);
+        assert!(r.is_ok() && what == "change machine profile");
+        assert_eq!(s.doc.plans.len(), 1);
+        let why = s.plan_staleness(k);
+        assert_eq!(why.len(), 1, "{why:?}");
+        assert!(why[0].starts_with("base y max velocity "), "{why:?}");
+        // the plan keeps its own machine: its toolpath is the one it was measured on
+        let l = s.toolpath(k).unwrap().unwrap();
+        assert_eq!(Some(l.duration_s()), s.doc.plans[k].metrics.job_time_s);
+        // undo brings the document back to the plan's inputs: current again
+        assert!(s.undo().is_some());
+        assert!(s.plan_staleness(k).is_empty());
+        assert!(s.has_unsaved_changes());
+    }
+
+    #[test]
+    fn field_numbers_in_messages_follow_the_plan_shown() {
+        let mut s = demo();
+        solve(&mut s);
+        let visiting = s.active_plan().unwrap().fields.clone();
+        let last = visiting.last().unwrap().id;
+        let (what, r) = s.execute(Command::DeleteField { id: last }, None);
+        assert!(r.is_ok());
+        assert_eq!(what, format!("delete field {}", visiting.len()));
+        assert_eq!(s.history.undo_label(), Some(what.as_str()));
+    }
+
+    #[test]
+    fn removing_a_plan_keeps_the_one_shown() {
+        let mut s = demo();
+        solve(&mut s);
+        let second = solve(&mut s);
+        assert_eq!(s.active, Some(second));
+        assert!(s.remove_plan(0).is_some());
+        assert_eq!(s.active, Some(0));
+        assert_eq!(s.stale.len(), 1);
+        assert!(s.remove_plan(5).is_none());
+    }
+}
