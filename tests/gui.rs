@@ -642,7 +642,7 @@ fn the_cost_switch_decides_what_the_solve_minimises() {
     let by_time = solve(&mut h, "Run HHA");
     h.get_by_label("Cost model").click();
     h.run();
-    h.get_by_label("Idle distance (seed 000)").click();
+    h.get_by_label("Idle travel distance").click();
     h.run();
     assert_eq!(
         h.state().session.doc.settings.cost_model,
@@ -866,7 +866,8 @@ fn the_stage_route_switch_plans_seed001_routes() {
     set_motion(&mut h, "On the fly (stage moves while marking)");
     h.get_by_label("Stage route").click();
     h.run();
-    h.get_by_label("Simplified pattern (seed 001 LSA)").click();
+    h.get_by_label("Follow a simplified path of the marks")
+        .click();
     h.run();
     assert_eq!(
         h.state().session.doc.settings.stage_route,
@@ -1271,4 +1272,46 @@ fn the_status_of_a_delete_names_the_field_as_the_canvas_does() {
         h.state().status()
     );
     assert_eq!(h.state().session.doc.plans.len(), 1);
+}
+
+#[test]
+fn stage_routes_and_settings_are_offered_in_an_operators_words() {
+    let mut h = opened(&demo());
+    set_motion(&mut h, "On the fly (stage moves while marking)");
+    h.get_by_label("Stage route").click();
+    h.run();
+    for option in [
+        "Shortest route (taut, default)",
+        "Follow a simplified path of the marks",
+        "Genetic algorithm route (slow)",
+    ] {
+        h.get_by_label(option);
+    }
+    // the research names are gone from the words; the command line's names are in the hover
+    assert!(h.query_by_label_contains("seed 001").is_none());
+    assert!(h.query_by_label_contains("LSA)").is_none());
+    h.get_by_label("Follow a simplified path of the marks")
+        .hover();
+    h.run();
+    h.get_by_label_contains("--stage-route lsa");
+    h.get_by_label("Genetic algorithm route (slow)").click();
+    h.run();
+    assert_eq!(
+        h.state().session.doc.settings.stage_route,
+        galvoplan::document::StageRouteKind::CetspGa
+    );
+    // the other choices: words, with the command line in the hover
+    h.get_by_label("Field placement").click();
+    h.run();
+    h.get_by_label("Fewest fields (automatic)");
+    h.get_by_label("Quick greedy cover").hover();
+    h.run();
+    h.get_by_label_contains("--fields greedy");
+    h.key_press(Key::Escape);
+    h.run();
+    h.get_by_label("Start points").click();
+    h.run();
+    h.get_by_label("Best start points (exact)");
+    h.get_by_label("Quick start points (estimate)");
+    assert!(h.query_by_label_contains("(seed 000)").is_none());
 }

@@ -217,35 +217,9 @@ impl Editors {
     /// The solver-settings editor; returns the command for an accepted change.
     pub fn settings_ui(&mut self, ui: &mut egui::Ui, settings: &SolverSettings) -> Option<Command> {
         let mut s = settings.clone();
-        combo(
-            ui,
-            "Field placement",
-            &mut s.fields,
-            &[
-                (FieldsMode::Auto, "auto (set cover)"),
-                (FieldsMode::Paper, "paper (seed 000 §3.1)"),
-                (FieldsMode::Greedy, "greedy (baseline)"),
-            ],
-        );
-        combo(
-            ui,
-            "Start vertices",
-            &mut s.vertex,
-            &[
-                (VertexMode::Exact, "exact (VEA + DP)"),
-                (VertexMode::Vea, "VEA only"),
-            ],
-        );
-        combo(
-            ui,
-            "Cost model",
-            &mut s.cost_model,
-            &[
-                (CostModel::Time, "Job time (machine dynamics)"),
-                (CostModel::Distance, "Idle distance (seed 000)"),
-            ],
-        )
-        .on_hover_text(COST_MODEL_HELP);
+        combo(ui, "Field placement", &mut s.fields, FIELD_PLACEMENTS).on_hover_text(FIELDS_HELP);
+        combo(ui, "Start points", &mut s.vertex, START_POINTS).on_hover_text(VERTEX_HELP);
+        combo(ui, "Cost model", &mut s.cost_model, COST_MODELS).on_hover_text(COST_MODEL_HELP);
         combo(ui, "Motion", &mut s.motion, MOTION_MODES).on_hover_text(MOTION_HELP);
         ui.add_enabled_ui(s.motion == MotionMode::OnTheFly, |ui| {
             combo(ui, "Stage route", &mut s.stage_route, STAGE_ROUTES)
@@ -271,21 +245,88 @@ impl Editors {
     }
 }
 
+/// One option of a choice: its value, its words, and what it does (with the command line's
+/// name for it).
+pub type Choice<T> = (T, &'static str, &'static str);
+
+/// The field placements offered, in words.
+pub const FIELD_PLACEMENTS: &[Choice<FieldsMode>] = &[
+    (
+        FieldsMode::Auto,
+        "Fewest fields (automatic)",
+        "As few scan fields as the search finds (a set cover); command line: --fields auto.",
+    ),
+    (
+        FieldsMode::Paper,
+        "Reference paper's method",
+        "The placement of seed 000's paper (§3.1), for comparison; command line: \
+         --fields paper.",
+    ),
+    (
+        FieldsMode::Greedy,
+        "Quick greedy cover",
+        "Fields added one at a time where they cover the most (the baseline); command line: \
+         --fields greedy.",
+    ),
+];
+
+/// What the field placements mean for the operator.
+const FIELDS_HELP: &str = "How scan fields are placed when a file is opened or \
+    \"Re-place automatically\" is pressed (locked fields stay).";
+
+/// The start-point choices offered, in words.
+pub const START_POINTS: &[Choice<VertexMode>] = &[
+    (
+        VertexMode::Exact,
+        "Best start points (exact)",
+        "Where each closed shape starts and which way each open one runs, chosen exactly for \
+         the order found (VEA, then an exact search); command line: --vertex exact.",
+    ),
+    (
+        VertexMode::Vea,
+        "Quick start points (estimate)",
+        "The estimate alone (seed 000's VEA), for comparison; command line: --vertex vea.",
+    ),
+];
+
+/// What the start points mean for the operator.
+const VERTEX_HELP: &str = "Where the laser starts each closed shape and which end of an open \
+    one it starts from. Used by the next solve.";
+
+/// The cost models offered, in words.
+pub const COST_MODELS: &[Choice<CostModel>] = &[
+    (
+        CostModel::Time,
+        "Job time (machine dynamics)",
+        "The machine's time for the job; command line: --cost time.",
+    ),
+    (
+        CostModel::Distance,
+        "Idle travel distance",
+        "The laser-off travel in mm, ignoring the machine's dynamics (seed 000's objective); \
+         command line: --cost distance.",
+    ),
+];
+
 /// What the cost model means for the operator.
 const COST_MODEL_HELP: &str = "What the ordering minimises.\n\
     Job time: the machine's time from the profile's dynamics (stage moves with acceleration \
     and settling, scanner jumps, laser delays); the plan is never slower than the \
     idle-distance plan.\n\
-    Idle distance: the laser-off travel in mm (seed 000's objective), ignoring the machine's \
-    dynamics.\n\
+    Idle travel distance: the laser-off travel in mm, ignoring the machine's dynamics.\n\
     Used by the next solve (HHA, HGA and baseline; as-is keeps the document order).";
 
 /// The motion modes offered, in words.
-pub const MOTION_MODES: &[(MotionMode, &str)] = &[
-    (MotionMode::Step, "Step-and-scan"),
+pub const MOTION_MODES: &[Choice<MotionMode>] = &[
+    (
+        MotionMode::Step,
+        "Step-and-scan",
+        "The stage stops at each scan field; command line: --motion step.",
+    ),
     (
         MotionMode::OnTheFly,
         "On the fly (stage moves while marking)",
+        "The stage never stops; command line: --motion on-the-fly.",
     ),
 ];
 
@@ -296,49 +337,63 @@ const MOTION_HELP: &str = "How the machine moves while it marks.\n\
     On the fly: the stage never stops; it follows a smooth route while the scanner marks, \
     keeping the laser point inside the field (less the profile's on-the-fly margin). Shapes \
     larger than the field need no splitting.\n\
-    Used by the next solve; the plans' toolpaths on the canvas, the playback and the motion \
-    plots are re-computed at once with this setting.";
+    Used by the next solve; a plan made already keeps the motion it was planned for (its \
+    path, playback and motion plots), marked stale.";
 
 /// The stage routes offered, in words.
-pub const STAGE_ROUTES: &[(StageRouteKind, &str)] = &[
-    (StageRouteKind::Taut, "Taut string (shortest)"),
-    (StageRouteKind::Lsa, "Simplified pattern (seed 001 LSA)"),
+pub const STAGE_ROUTES: &[Choice<StageRouteKind>] = &[
+    (
+        StageRouteKind::Taut,
+        "Shortest route (taut, default)",
+        "Per axis the shortest route that keeps the laser point within the scanner's reach; \
+         command line: --stage-route taut.",
+    ),
+    (
+        StageRouteKind::Lsa,
+        "Follow a simplified path of the marks",
+        "The stage follows the marks' points, thinned out (seed 001's line-simplified \
+         route, LSA); command line: --stage-route lsa.",
+    ),
     (
         StageRouteKind::CetspGa,
-        "Genetic algorithm (seed 001 CETSP)",
+        "Genetic algorithm route (slow)",
+        "A route searched by a genetic algorithm (seed 001's close-enough TSP); command \
+         line: --stage-route cetsp-ga.",
     ),
 ];
 
 /// What the stage routes mean for the operator.
-const STAGE_ROUTE_HELP: &str = "How the stage's route is computed on the fly.\n\
-    Taut string: per axis, the shortest route that keeps the laser point within the \
+const STAGE_ROUTE_HELP: &str = "How the stage's route is planned on the fly.\n\
+    Shortest route: per axis, the shortest route that keeps the laser point within the \
     scanner's reach, smoothed to the axes' speed and acceleration limits; the marking slows \
-    where the stage cannot follow.\n\
-    Simplified pattern: seed 001's benchmark, the stage follows the pattern simplified by \
-    RDP and VW.\n\
-    Genetic algorithm: seed 001's close-enough TSP route (slow to plan: 500 generations; \
-    progress and Cancel as for the solves).\n\
+    where the stage cannot follow (command line: --stage-route taut).\n\
+    Follow a simplified path of the marks: the stage follows the pattern's points, thinned \
+    out by line simplification (seed 001's benchmark; --stage-route lsa).\n\
+    Genetic algorithm route: a route through circles around the marks searched by a \
+    genetic algorithm (seed 001's close-enough TSP; --stage-route cetsp-ga); slow to plan: \
+    500 generations, with progress and Cancel as for the solves.\n\
     Used by the next solve.";
 
-/// A labelled combo box; returns the combo's response.
+/// A labelled combo box, each option with its hover text; returns the combo's response.
 fn combo<T: PartialEq + Copy>(
     ui: &mut egui::Ui,
     label: &str,
     value: &mut T,
-    options: &[(T, &str)],
+    options: &[Choice<T>],
 ) -> egui::Response {
     ui.horizontal(|ui| {
         let l = ui.label(label);
         let current = options
             .iter()
-            .find(|(v, _)| v == value)
-            .map(|o| o.1)
-            .unwrap_or("?");
+            .find(|(v, ..)| v == value)
+            .map_or("?", |o| o.1);
         egui::ComboBox::from_id_salt(label)
             .selected_text(current)
+            // a narrow panel wraps the choice's words rather than cutting them
+            .wrap()
             .show_ui(ui, |ui| {
-                for (v, name) in options {
-                    ui.selectable_value(value, *v, *name);
+                for (v, name, hover) in options {
+                    ui.selectable_value(value, *v, *name).on_hover_text(*hover);
                 }
             })
             .response
