@@ -1315,3 +1315,49 @@ fn stage_routes_and_settings_are_offered_in_an_operators_words() {
     h.get_by_label("Quick start points (estimate)");
     assert!(h.query_by_label_contains("(seed 000)").is_none());
 }
+
+#[test]
+fn a_rejected_profile_or_settings_value_clears_after_a_valid_edit_of_another() {
+    let mut h = opened(&demo());
+    section(&mut h, "Machine profile");
+    set_text(&mut h, "Field width (mm)", "-5");
+    h.get_by_label("Field width (mm) must be a positive number, not -5");
+    assert!(h
+        .query_by_label("Values apply on Enter or when leaving a field.")
+        .is_none());
+    // a valid edit of another value: applied, the rejected one is no longer shown (nor red:
+    // its field holds the value in force again) and the hint is back
+    set_text(&mut h, "Stroke X (mm)", "290");
+    assert_eq!(h.state().session.doc.profile.stroke_mm[0], 290.0);
+    assert!(h
+        .query_by_label_contains("must be a positive number")
+        .is_none());
+    assert_eq!(
+        h.get_by_label("Field width (mm)").value().as_deref(),
+        Some("70")
+    );
+    h.get_by_label("Values apply on Enter or when leaving a field.");
+    // likewise when the other value is valid but unchanged
+    set_text(&mut h, "Field width (mm)", "abc");
+    h.get_by_label_contains("must be a number, not 'abc'");
+    set_text(&mut h, "Stroke Y (mm)", "300");
+    assert!(h.query_by_label_contains("must be a number").is_none());
+    assert_eq!(
+        h.get_by_label("Field width (mm)").value().as_deref(),
+        Some("70")
+    );
+    // the name takes its whole width and commits on Enter like the numbers
+    set_text(&mut h, "Name", "bench machine");
+    assert_eq!(h.state().session.doc.profile.name, "bench machine");
+    // the settings form behaves the same
+    section(&mut h, "Solver settings");
+    set_text(&mut h, "GA mutation rate", "1.5");
+    h.get_by_label("GA mutation rate must be between 0 and 1, not 1.5");
+    set_text(&mut h, "Seed", "3");
+    assert_eq!(h.state().session.doc.settings.seed, 3);
+    assert!(h.query_by_label_contains("must be between").is_none());
+    assert_eq!(
+        h.get_by_label("GA mutation rate").value().as_deref(),
+        Some("0.3")
+    );
+}

@@ -179,8 +179,6 @@ impl LayerEditor {
     /// The reserved message lines: the rejected value, the running job, or a hint.
     fn message(&self, ui: &mut egui::Ui, busy: Option<&str>) {
         let h = MESSAGE_LINES * ui.text_style_height(&egui::TextStyle::Body);
-        let w = ui.available_width();
-        let (rect, _) = ui.allocate_exact_size(egui::vec2(w, h), egui::Sense::hover());
         let text = match (&self.error, busy) {
             (Some(e), _) => RichText::new(&e.2).color(ERROR),
             (None, Some(job)) => RichText::new(format!("{job}…")).italics(),
@@ -190,7 +188,7 @@ impl LayerEditor {
             )
             .weak(),
         };
-        ui.put(rect, egui::Label::new(text).wrap());
+        super::panels::reserved_message(ui, text, h);
     }
 
     fn layer_ui(

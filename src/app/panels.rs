@@ -39,6 +39,11 @@ pub fn validate_profile(p: &MachineProfile) -> Result<(), String> {
     p.validate().map_err(|e| e.to_string())
 }
 
+/// Red of rejected values and their messages.
+const ERROR: Color32 = Color32::from_rgb(200, 30, 30);
+/// Width of a number's edit field, px.
+const NARROW_EDIT_PX: f32 = 90.0;
+
 /// Lines reserved above a form for its message, so that a message never moves the fields.
 const MESSAGE_LINES: f32 = 3.0;
 
@@ -60,10 +65,12 @@ impl<T: Clone + PartialEq> Form<T> {
         }
     }
 
-    /// Draws the rows into a grid; returns the new value when one was committed and valid.
+    /// Draws the form: its message, the free-text rows (a name) across the panel, then the
+    /// other rows in a grid; returns the new value when one was committed and valid.
     fn ui(
         &mut self,
         ui: &mut egui::Ui,
+        grid_id: &str,
         value: &T,
         validate: fn(&T) -> Result<(), String>,
     ) -> Option<T> {
@@ -72,55 +79,124 @@ impl<T: Clone + PartialEq> Form<T> {
             self.error = vec![None; self.specs.len()];
             self.synced = Some(value.clone());
         }
-        let mut out = None;
         self.message(ui);
-        ui.end_row();
-        for (k, spec) in self.specs.iter().enumerate() {
-            let label = ui.label(spec.words());
-            let bad = self.error[k].is_some();
-            let mut edit = egui::TextEdit::singleline(&mut self.text[k]).desired_width(90.0);
-            if bad {
-                edit = edit.text_color(Color32::from_rgb(200, 30, 30));
+        let mut out = None;
+        let mut valid_commit = None;
+        let wide: Vec<bool> = self.specs.iter().map(is_wide).collect();
+        for k in (0..self.specs.len()).filter(|&k| wide[k]) {
+            // free text wraps across the panel's width, so that none of it is hidden
+            let label = ui.label(self.specs[k].words());
+            let (bad, help) = (self.error[k].is_some(), self.specs[k].help);
+            let edit = egui::TextEdit::multiline(&mut self.text[k])
+                .desired_rows(1)
+                .desired_width(f32::INFINITY)
+                .return_key(None);
+            let r = add_edit(ui, edit, bad, help, label.id);
+            if r.has_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter)) {
+                // Enter commits, as in the one-line fields
+                r.surrender_focus();
             }
-            let mut r = ui.add(edit).labelled_by(label.id);
-            if !spec.help.is_empty() {
-                r = r.on_hover_text(spec.help);
-            }
-            ui.end_row();
-            // commit on Enter / leaving the field, or when set without focus (accessibility)
-            if r.lost_focus() || (r.changed() && !r.has_focus()) {
-                let mut candidate = value.clone();
-                let result = spec
-                    .set_text(&mut candidate, &self.text[k])
-                    .and_then(|()| validate(&candidate));
-                match result {
-                    Ok(()) if candidate != *value => out = Some(candidate),
-                    Ok(()) => self.error[k] = None,
-                    Err(e) => self.error[k] = Some(e),
+            self.commit(k, &r, value, validate, &mut out, &mut valid_commit);
+        }
+        egui::Grid::new(grid_id)
+            .num_columns(2)
+            .striped(true)
+            .show(ui, |ui| {
+                for k in (0..self.specs.len()).filter(|&k| !wide[k]) {
+                    let label = ui.label(self.specs[k].words());
+                    let (bad, help) = (self.error[k].is_some(), self.specs[k].help);
+                    let edit =
+                        egui::TextEdit::singleline(&mut self.text[k]).desired_width(NARROW_EDIT_PX);
+                    let r = add_edit(ui, edit, bad, help, label.id);
+                    ui.end_row();
+                    self.commit(k, &r, value, validate, &mut out, &mut valid_commit);
+                }
+            });
+        if let Some(k) = valid_commit {
+            // a valid value: a value rejected earlier is no longer current; its text goes back
+            // to the value applied (the whole form is read again when the value changes)
+            for (j, e) in self.error.iter_mut().enumerate() {
+                if j != k && e.take().is_some() {
+                    self.text[j] = (self.specs[j].show)(value);
                 }
             }
+            self.error[k] = None;
         }
         out
     }
 
-    /// The form's message in reserved lines spanning the grid: the rejected value's reason,
+    /// Checks row `k`'s text when it is committed (Enter, leaving the field, or set without
+    /// focus by accessibility): a valid new value goes to `out`, a rejected one is kept with
+    /// its reason.
+    fn commit(
+        &mut self,
+        k: usize,
+        r: &egui::Response,
+        value: &T,
+        validate: fn(&T) -> Result<(), String>,
+        out: &mut Option<T>,
+        valid_commit: &mut Option<usize>,
+    ) {
+        if !(r.lost_focus() || (r.changed() && !r.has_focus())) {
+            return;
+        }
+        let mut candidate = value.clone();
+        let result = self.specs[k]
+            .set_text(&mut candidate, &self.text[k])
+            .and_then(|()| validate(&candidate));
+        match result {
+            Ok(()) => {
+                *valid_commit = Some(k);
+                if candidate != *value {
+                    *out = Some(candidate);
+                }
+            }
+            Err(e) => self.error[k] = Some(e),
+        }
+    }
+
+    /// The form's message in reserved lines across the panel: the rejected value's reason,
     /// or a hint.
     fn message(&self, ui: &mut egui::Ui) {
         let h = MESSAGE_LINES * ui.text_style_height(&egui::TextStyle::Body);
         let text = match self.error.iter().flatten().next() {
-            Some(e) => RichText::new(e).color(Color32::from_rgb(200, 30, 30)),
+            Some(e) => RichText::new(e).color(ERROR),
             None => RichText::new("Values apply on Enter or when leaving a field.").weak(),
         };
-        ui.label("");
-        let (rect, _) =
-            ui.allocate_exact_size(egui::vec2(MESSAGE_WIDTH_PX, h), egui::Sense::hover());
-        ui.put(rect, egui::Label::new(text).wrap());
+        reserved_message(ui, text, h);
     }
 }
 
-/// Width of a form's message (the value column's edits are narrower; the label column's
-/// width comes first).
-const MESSAGE_WIDTH_PX: f32 = 150.0;
+/// A message in a band `height_px` tall across the panel, wrapped and left-aligned from its
+/// top: the band stays when the message changes, so that nothing below it moves.
+pub(super) fn reserved_message(ui: &mut egui::Ui, text: RichText, height_px: f32) {
+    let size = egui::vec2(ui.available_width(), height_px);
+    ui.allocate_ui_with_layout(size, egui::Layout::top_down(egui::Align::LEFT), |ui| {
+        ui.set_min_size(size);
+        ui.add(egui::Label::new(text).wrap());
+    });
+}
+
+/// Adds a row's edit (red while its value is rejected), labelled, with its help.
+fn add_edit(
+    ui: &mut egui::Ui,
+    edit: egui::TextEdit<'_>,
+    bad: bool,
+    help: &str,
+    label: egui::Id,
+) -> egui::Response {
+    let edit = if bad { edit.text_color(ERROR) } else { edit };
+    let r = ui.add(edit).labelled_by(label);
+    match help {
+        "" => r,
+        help => r.on_hover_text(help),
+    }
+}
+
+/// True for a free-text row (a name): it gets the panel's width, wrapped.
+fn is_wide<T>(spec: &FieldSpec<T>) -> bool {
+    spec.rule == Rule::AnyText && spec.key == "name"
+}
 
 /// The profile and settings editors.
 pub struct Editors {
@@ -192,16 +268,14 @@ impl Editors {
             }
         });
         if let Some(e) = &self.file_error {
-            ui.add(egui::Label::new(RichText::new(e).color(Color32::from_rgb(200, 30, 30))).wrap());
+            ui.add(egui::Label::new(RichText::new(e).color(ERROR)).wrap());
         }
-        egui::Grid::new("profile-grid")
-            .num_columns(2)
-            .striped(true)
-            .show(ui, |ui| {
-                if let Some(p) = self.profile.ui(ui, profile, validate_profile) {
-                    out = Some(p);
-                }
-            });
+        if let Some(p) = self
+            .profile
+            .ui(ui, "profile-grid", profile, validate_profile)
+        {
+            out = Some(p);
+        }
         let mut flip = profile.gcode.flip_y;
         if ui
             .checkbox(&mut flip, "Flip Y in G-code (y-up machine)")
@@ -233,14 +307,12 @@ impl Editors {
         );
         ui.checkbox(&mut s.ga.seed_with_hha, "Seed the GA with the HHA plan");
         let mut out = (s != *settings).then_some(s);
-        egui::Grid::new("settings-grid")
-            .num_columns(2)
-            .striped(true)
-            .show(ui, |ui| {
-                if let Some(s) = self.settings.ui(ui, settings, validate_settings) {
-                    out = Some(s);
-                }
-            });
+        if let Some(s) = self
+            .settings
+            .ui(ui, "settings-grid", settings, validate_settings)
+        {
+            out = Some(s);
+        }
         out.map(|s| Command::SetSettings(Box::new(s)))
     }
 }
