@@ -1361,3 +1361,21 @@ fn a_rejected_profile_or_settings_value_clears_after_a_valid_edit_of_another() {
         Some("0.3")
     );
 }
+
+#[test]
+fn the_built_in_picker_names_the_profile_shown() {
+    let mut h = opened(&demo());
+    section(&mut h, "Machine profile");
+    let picked = |h: &Harness<'_, App>| h.get_by_label("Built-in").value();
+    assert_eq!(picked(&h).as_deref(), Some("seed000"));
+    set_text(&mut h, "Stroke X (mm)", "290");
+    // seed000's name, other values: an edited seed000
+    assert_eq!(picked(&h).as_deref(), Some("seed000, edited"));
+    set_text(&mut h, "Name", "bench machine");
+    assert_eq!(picked(&h).as_deref(), Some("custom (edited or loaded)"));
+    h.get_by_label("Built-in").click();
+    h.run();
+    h.get_by_label("small-field").click();
+    h.run();
+    assert_eq!(picked(&h).as_deref(), Some("small-field"));
+}

@@ -239,13 +239,10 @@ impl Editors {
         let mut out = None;
         ui.horizontal(|ui| {
             let label = ui.label("Built-in");
-            let current = BUILTIN
-                .iter()
-                .map(|(name, _)| *name)
-                .find(|name| MachineProfile::builtin(name).is_ok_and(|b| b == *profile))
-                .map_or_else(|| "custom (edited or loaded)".to_string(), str::to_string);
+            let current = builtin_words(profile);
             egui::ComboBox::from_id_salt("builtin-profile")
                 .selected_text(current)
+                .wrap()
                 .show_ui(ui, |ui| {
                     for (name, _) in BUILTIN {
                         if ui.button(*name).clicked() {
@@ -472,4 +469,20 @@ fn combo<T: PartialEq + Copy>(
             .labelled_by(l.id)
     })
     .inner
+}
+
+/// What the built-in profile picker shows for `profile`: the built-in it equals; a built-in's
+/// name with "edited" when it carries that built-in's name but other values; else "custom".
+pub fn builtin_words(profile: &MachineProfile) -> String {
+    let builtins: Vec<(&str, MachineProfile)> = BUILTIN
+        .iter()
+        .filter_map(|(name, _)| Some((*name, MachineProfile::builtin(name).ok()?)))
+        .collect();
+    if let Some((name, _)) = builtins.iter().find(|(_, b)| b == profile) {
+        return (*name).to_string();
+    }
+    match builtins.iter().find(|(_, b)| b.name == profile.name) {
+        Some((name, _)) => format!("{name}, edited"),
+        None => "custom (edited or loaded)".to_string(),
+    }
 }
