@@ -1317,6 +1317,36 @@ fn stage_routes_and_settings_are_offered_in_an_operators_words() {
 }
 
 #[test]
+fn layers_named_after_their_colour_show_a_colour_word() {
+    let mut h = opened(&demo());
+    // the demo's layers are its stroke colours
+    let names: Vec<String> = h
+        .state()
+        .session
+        .doc
+        .layers
+        .iter()
+        .map(|l| l.name.clone())
+        .collect();
+    assert!(names.iter().any(|n| n == "#1f2937"), "{names:?}");
+    h.get_by_label("dark grey (#1f2937)");
+    h.get_by_label("red (#b91c1c)");
+    h.get_by_label("blue (#1d4ed8)");
+    // a rejected value names the layer by its label ...
+    let k = names.iter().position(|n| n == "#1f2937").unwrap();
+    enter_nth(&mut h, "Mark speed (mm/s)", k, "fast");
+    h.run();
+    h.get_by_label("Layer 'dark grey (#1f2937)': Mark speed (mm/s) must be a number, not 'fast'");
+    // ... and a valid edit leaves the document's name (what pens files match) as it was
+    enter_nth(&mut h, "Mark speed (mm/s)", k, "400");
+    h.run();
+    let layer = &h.state().session.doc.layers[k];
+    assert_eq!(layer.name, "#1f2937");
+    assert_eq!(layer.pen.mark_speed_mm_s, Some(400.0));
+    assert!(h.query_by_label_contains("must be a number").is_none());
+}
+
+#[test]
 fn a_rejected_profile_or_settings_value_clears_after_a_valid_edit_of_another() {
     let mut h = opened(&demo());
     section(&mut h, "Machine profile");

@@ -363,7 +363,7 @@ impl Canvas<'_> {
                 "geometry {}: {}, layer {}, {}, {} vertices, {:.2} mm long",
                 k + 1,
                 g.describe(),
-                g.layer,
+                super::layers::layer_label(&g.layer),
                 if g.closed { "closed" } else { "open" },
                 g.points.len(),
                 g.length_mm()

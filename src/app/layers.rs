@@ -207,8 +207,14 @@ impl LayerEditor {
             ui.painter().rect_filled(rect, 2.0, colour);
             let mut enabled = layer.pen.enabled;
             let r = ui
-                .checkbox(&mut enabled, RichText::new(&layer.name).strong())
-                .on_hover_text("Marked: untick to leave this layer out of the job");
+                .checkbox(
+                    &mut enabled,
+                    RichText::new(layer_label(&layer.name)).strong(),
+                )
+                .on_hover_text(format!(
+                    "Layer '{}'. Marked: untick to leave this layer out of the job",
+                    layer_label(&layer.name)
+                ));
             if r.changed() {
                 let mut l = layer.clone();
                 l.pen.enabled = enabled;
@@ -217,7 +223,7 @@ impl LayerEditor {
             let words = if layer.pen.hatch.is_some() {
                 format!("{imported} shapes, {marked} strokes with the hatch")
             } else {
-                format!("{imported} geometries")
+                super::count(imported, "geometry", "geometries")
             };
             ui.label(RichText::new(words).weak());
         });
@@ -279,16 +285,25 @@ impl LayerEditor {
         let r = ui.add(edit).labelled_by(label.id).on_hover_text(format!(
             "{} of layer '{}'",
             c.label(),
-            layer.name
+            layer_label(&layer.name)
         ));
         if !(r.lost_focus() || (r.changed() && !r.has_focus())) {
             return None;
         }
         let mut candidate = layer.clone();
+        let shown = layer_label(&layer.name);
         let result = c
             .set(&mut candidate.pen, &self.text[k][n])
-            .map_err(|e| format!("Layer '{}': {e}", layer.name))
-            .and_then(|()| candidate.validate().map_err(|e| e.to_string()));
+            .map_err(|e| format!("Layer '{shown}': {e}"))
+            .and_then(|()| {
+                candidate.validate().map_err(|e| {
+                    // the library names the layer by its name: the panel by its label
+                    e.to_string().replace(
+                        &format!("Layer '{}'", layer.name),
+                        &format!("Layer '{shown}'"),
+                    )
+                })
+            });
         match result {
             Ok(()) => {
                 // a valid value: an earlier rejected one is no longer current
@@ -322,7 +337,7 @@ fn hatch_style_ui(ui: &mut egui::Ui, k: usize, layer: &Layer) -> Option<Layer> {
         .labelled_by(label.id)
         .on_hover_text(format!(
             "Fill the closed shapes of layer '{}' with hatch lines",
-            layer.name
+            layer_label(&layer.name)
         ));
     ui.end_row();
     if chosen == current {
@@ -369,4 +384,119 @@ fn outline_ui(ui: &mut egui::Ui, k: usize, layer: &Layer) -> Option<Layer> {
         }
         l
     })
+}
+
+/// How the window names a layer: its own name, or for a layer named after its stroke colour
+/// (`#rrggbb`, what an SVG without layer groups gives) a colour word and the hex, e.g.
+/// `dark grey (#1f2937)`. Display only: the document (and pens files) keep the name.
+pub fn layer_label(name: &str) -> String {
+    match crate::document::parse_colour(name) {
+        Some(rgb) => format!("{} ({name})", colour_word(rgb)),
+        None => name.to_string(),
+    }
+}
+
+/// A plain word for a colour: black, white, (dark/light) grey, or a hue (red, orange, brown,
+/// yellow, olive, green, teal, cyan, blue, purple, magenta, pink) with "dark" or "light" when
+/// it is far from mid lightness.
+pub fn colour_word([r, g, b]: [u8; 3]) -> String {
+    let (r, g, b) = (
+        f32::from(r) / 255.0,
+        f32::from(g) / 255.0,
+        f32::from(b) / 255.0,
+    );
+    let max = r.max(g).max(b);
+    let min = r.min(g).min(b);
+    let chroma = max - min;
+    let light = (max + min) / 2.0;
+    if chroma < 0.12 {
+        return match light {
+            l if l < 0.1 => "black",
+            l if l < 0.33 => "dark grey",
+            l if l < 0.7 => "grey",
+            l if l < 0.93 => "light grey",
+            _ => "white",
+        }
+        .to_string();
+    }
+    let hue = if max == r {
+        60.0 * ((g - b) / chroma).rem_euclid(6.0)
+    } else if max == g {
+        60.0 * ((b - r) / chroma + 2.0)
+    } else {
+        60.0 * ((r - g) / chroma + 4.0)
+    };
+    let saturation = chroma / (1.0 - (2.0 * light - 1.0).abs()).max(1e-6);
+    let base = match hue {
+        h if !(12.0..345.0).contains(&h) => {
+            if light < 0.45 && saturation < 0.5 {
+                "brown"
+            } else {
+                "red"
+            }
+        }
+        h if h < 45.0 => {
+            if light < 0.45 {
+                "brown"
+            } else {
+                "orange"
+            }
+        }
+        h if h < 70.0 => {
+            if light < 0.35 {
+                "olive"
+            } else {
+                "yellow"
+            }
+        }
+        h if h < 165.0 => "green",
+        h if h < 175.0 => "teal",
+        h if h < 192.0 => "cyan",
+        h if h < 255.0 => "blue",
+        h if h < 290.0 => "purple",
+        _ if light > 0.6 => "pink",
+        _ => "magenta",
+    };
+    let shade = match light {
+        l if l < 0.28 && base != "brown" && base != "olive" => "dark ",
+        l if l > 0.78 && base != "pink" => "light ",
+        _ => "",
+    };
+    format!("{shade}{base}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn colour_layers_are_shown_with_a_word() {
+        assert_eq!(layer_label("#1f2937"), "dark grey (#1f2937)");
+        assert_eq!(layer_label("#000000"), "black (#000000)");
+        assert_eq!(layer_label("outline"), "outline");
+        assert_eq!(layer_label("#12345"), "#12345");
+        for (hex, word) in [
+            ("#ffffff", "white"),
+            ("#808080", "grey"),
+            ("#d62728", "red"),
+            ("#ff0000", "red"),
+            ("#8b0000", "dark red"),
+            ("#1f77b4", "blue"),
+            ("#0000ff", "blue"),
+            ("#2ca02c", "green"),
+            ("#15803d", "green"),
+            ("#047857", "dark green"),
+            ("#9467bd", "purple"),
+            ("#ff7f0e", "orange"),
+            ("#8c564b", "brown"),
+            ("#e377c2", "pink"),
+            ("#ff00ff", "magenta"),
+            ("#17becf", "cyan"),
+            ("#ffff00", "yellow"),
+            ("#add8e6", "light blue"),
+        ] {
+            let rgb = crate::document::parse_colour(hex).unwrap_or_default();
+            assert_eq!(colour_word(rgb), word, "{hex}");
+        }
+    }
 }
