@@ -1409,3 +1409,57 @@ fn the_built_in_picker_names_the_profile_shown() {
     h.run();
     assert_eq!(picked(&h).as_deref(), Some("small-field"));
 }
+
+#[test]
+fn an_on_the_fly_region_larger_than_the_scan_field_is_called_a_region() {
+    let (mut h, _) = opened_oversize();
+    section(&mut h, "Solver settings");
+    h.get_by_label("Motion").click();
+    h.run();
+    h.get_by_label("On the fly (stage moves while marking)")
+        .click();
+    h.step();
+    wait_idle(&mut h, Duration::from_secs(60));
+    let field_mm = h.state().session.doc.profile.field_mm;
+    let region = h
+        .state()
+        .session
+        .doc
+        .fields
+        .iter()
+        .find(|f| f.size[0] > field_mm[0])
+        .expect("one region holds the shapes larger than the scan field")
+        .clone();
+    let n = h.state().field_label(region.id);
+    assert_eq!(h.state().field_name(region.id), format!("region {n}"));
+    // counted and named as a region in the window's words
+    assert_eq!(h.state().session.doc.fields.len(), 1);
+    h.get_by_label_contains("1 region ·");
+    assert!(h.query_by_label_contains("1 field").is_none());
+    // selected: its heading and what a region is
+    let at = h.state().field_screen_pos(region.id).unwrap();
+    h.hover_at(at);
+    h.step();
+    for pressed in [true, false] {
+        h.event(Event::PointerButton {
+            pos: at,
+            button: PointerButton::Primary,
+            pressed,
+            modifiers: Modifiers::NONE,
+        });
+    }
+    h.run();
+    assert_eq!(h.state().selected_field(), Some(region.id));
+    h.get_by_label(&format!("Region {n}"));
+    h.get_by_label_contains("Larger than the 70 × 70 mm scan field");
+    // the undo menu and status say "region" too
+    h.key_press(Key::Delete);
+    h.run();
+    assert!(
+        h.state()
+            .status()
+            .starts_with(&format!("delete region {n}")),
+        "{}",
+        h.state().status()
+    );
+}

@@ -370,7 +370,8 @@ impl Canvas<'_> {
             ));
             match self.fields.iter().find(|f| f.geometries.contains(&k)) {
                 Some(f) => lines.push(format!(
-                    "  allocated to field {}",
+                    "  allocated to {} {}",
+                    super::field_word(f, self.profile),
                     super::field_number(self.fields, self.visiting, f.id)
                 )),
                 None if self.out_of_reach.contains(&k) => lines.push(
@@ -391,14 +392,28 @@ impl Canvas<'_> {
             }
         }
         if let Some(f) = field {
+            let word = super::field_word(f, self.profile);
+            let size = if word == "field" {
+                String::new()
+            } else {
+                // larger than the scan field: the stage carries the scan field across it
+                format!(", {:.0} × {:.0} mm", f.size[0], f.size[1])
+            };
             lines.push(format!(
-                "field {}: centre ({:.2}, {:.2}) mm, {} geometries{}",
+                "{word} {}: centre ({:.2}, {:.2}) mm{size}, {} geometries{}",
                 super::field_number(self.fields, self.visiting, f.id),
                 f.center.x,
                 f.center.y,
                 f.geometries.len(),
                 if f.locked { ", locked" } else { "" }
             ));
+            if word == "region" {
+                let [w, h] = self.profile.field_mm;
+                lines.push(format!(
+                    "  a region: larger than the {w:.0} × {h:.0} mm scan field, marked on the fly \
+                     while the stage moves"
+                ));
+            }
         }
         if geometry.is_none() && field.is_none() {
             return response;

@@ -67,15 +67,15 @@ pub enum Command {
 }
 
 impl Command {
-    /// A short description for the status line and the undo menu; `number` gives the number
-    /// the canvas shows for a field id.
-    pub fn describe(&self, number: &dyn Fn(usize) -> usize) -> String {
+    /// A short description for the status line and the undo menu; `name` gives what the
+    /// canvas calls a field id ("field 3", "region 1").
+    pub fn describe(&self, name: &dyn Fn(usize) -> String) -> String {
         match self {
-            Command::MoveField { id, .. } => format!("move field {}", number(*id)),
+            Command::MoveField { id, .. } => format!("move {}", name(*id)),
             Command::AddField { .. } => "add field".into(),
-            Command::DeleteField { id } => format!("delete field {}", number(*id)),
-            Command::SetLocked { id, locked: true } => format!("lock field {}", number(*id)),
-            Command::SetLocked { id, locked: false } => format!("unlock field {}", number(*id)),
+            Command::DeleteField { id } => format!("delete {}", name(*id)),
+            Command::SetLocked { id, locked: true } => format!("lock {}", name(*id)),
+            Command::SetLocked { id, locked: false } => format!("unlock {}", name(*id)),
             Command::ReplaceAutomatically => "re-place fields automatically".into(),
             Command::SetProfile(_) => "change machine profile".into(),
             Command::SetSettings(_) => "change solver settings".into(),

@@ -167,8 +167,9 @@ const ROWS: &[Row] = &[
         kind: RowKind::Info,
     },
     Row {
-        label: "Scan fields",
-        help: "number of scan fields the job visits",
+        label: "Fields or regions",
+        help: "number of scan fields the job visits (on the fly: regions, which may be larger \
+               than the scan field)",
         value: |m| Some(m.fields as f64),
         decimals: 0,
         kind: RowKind::Ranked,

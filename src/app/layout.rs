@@ -295,7 +295,7 @@ impl App {
                     let u = self.session.uncovered.len();
                     let t = RichText::new(format!(
                         "{} · {} uncovered",
-                        super::count(self.session.doc.fields.len(), "field", "fields"),
+                        super::fields_count(&self.session.doc.fields, &self.session.doc.profile),
                         u
                     ));
                     ui.label(if u > 0 { t.color(ERROR) } else { t });
@@ -416,7 +416,7 @@ impl App {
                 "{} ({closed} closed, {} open), {}",
                 super::count(self.session.doc.geometries.len(), "geometry", "geometries"),
                 self.session.doc.geometries.len() - closed,
-                super::count(self.session.doc.fields.len(), "field", "fields")
+                super::fields_count(&self.session.doc.fields, &self.session.doc.profile)
             ));
             let far = self.session.out_of_reach.len();
             let near = self.session.uncovered.len() - far;
@@ -516,17 +516,40 @@ impl App {
         };
         ui.separator();
         let visiting = self.active_plan().map(|p| p.fields.as_slice());
-        ui.heading(format!(
-            "Field {}",
+        let word = super::field_word(f, &self.session.doc.profile);
+        let mut heading = format!(
+            "{word} {}",
             super::field_number(&self.session.doc.fields, visiting, f.id)
-        ));
-        ui.label(format!(
-            "centre ({:.2}, {:.2}) mm, {} geometries{}",
-            f.center.x,
-            f.center.y,
-            f.geometries.len(),
-            if f.locked { ", locked" } else { "" }
-        ));
+        );
+        if let Some(first) = heading.get_mut(..1) {
+            first.make_ascii_uppercase();
+        }
+        ui.heading(heading);
+        ui.add(
+            egui::Label::new(format!(
+                "centre ({:.2}, {:.2}) mm, {:.0} × {:.0} mm, {} geometries{}",
+                f.center.x,
+                f.center.y,
+                f.size[0],
+                f.size[1],
+                f.geometries.len(),
+                if f.locked { ", locked" } else { "" }
+            ))
+            .wrap(),
+        );
+        if word == "region" {
+            let [w, h] = self.session.doc.profile.field_mm;
+            ui.add(
+                egui::Label::new(
+                    RichText::new(format!(
+                        "Larger than the {w:.0} × {h:.0} mm scan field: marked on the fly, the \
+                         stage carrying the scan field across it."
+                    ))
+                    .weak(),
+                )
+                .wrap(),
+            );
+        }
     }
 
     fn plans_ui(&mut self, ui: &mut egui::Ui) {

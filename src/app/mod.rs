@@ -671,6 +671,12 @@ impl App {
         self.session.field_label(id)
     }
 
+    /// What the canvas calls field `id`: "field 3", or "region 1" for one larger than the scan
+    /// field.
+    pub fn field_name(&self, id: usize) -> String {
+        self.session.field_name(id)
+    }
+
     /// Uncovered geometries that no scan field can hold.
     pub fn out_of_reach(&self) -> &[usize] {
         &self.session.out_of_reach
@@ -890,8 +896,8 @@ impl App {
                         .find(|f| Some(f.id) == self.view.selected)
                     {
                         let msg = format!(
-                            "moved field {} to ({:.1}, {:.1}) mm: {} geometries, {} uncovered",
-                            self.field_label(f.id),
+                            "moved {} to ({:.1}, {:.1}) mm: {} geometries, {} uncovered",
+                            self.field_name(f.id),
                             f.center.x,
                             f.center.y,
                             f.geometries.len(),
@@ -1045,6 +1051,37 @@ pub fn gui_error(e: &crate::pipeline::PipelineError) -> String {
              automatically\" to cut them at field borders, or choose \"On the fly\" as the motion"
         ),
         None => e.to_string(),
+    }
+}
+
+/// What the window calls a placed field: a "region" when it is larger than the profile's scan
+/// field (on the fly one region may hold what no scan field could: the stage carries the
+/// field across it), else a "field".
+pub fn field_word(field: &ScanField, profile: &MachineProfile) -> &'static str {
+    const TOLERANCE_MM: f64 = 1e-6;
+    let [w, h] = profile.field_mm;
+    if field.size[0] > w + TOLERANCE_MM || field.size[1] > h + TOLERANCE_MM {
+        "region"
+    } else {
+        "field"
+    }
+}
+
+/// How many fields and regions there are, in words: "6 fields", "1 region", "2 fields and
+/// 1 region".
+pub fn fields_count(fields: &[ScanField], profile: &MachineProfile) -> String {
+    let regions = fields
+        .iter()
+        .filter(|f| field_word(f, profile) == "region")
+        .count();
+    match (fields.len() - regions, regions) {
+        (n, 0) => count(n, "field", "fields"),
+        (0, r) => count(r, "region", "regions"),
+        (n, r) => format!(
+            "{} and {}",
+            count(n, "field", "fields"),
+            count(r, "region", "regions")
+        ),
     }
 }
 

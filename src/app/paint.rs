@@ -136,10 +136,15 @@ fn paint_fields(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
         painter.rect_stroke(r, 0.0, stroke, StrokeKind::Middle);
         painter.circle_filled(s(f.center), 2.0, stroke.color);
         let number = super::field_number(c.fields, c.visiting, f.id);
+        // a scan field shows its number; a region larger than the scan field says so
+        let name = match super::field_word(f, c.profile) {
+            "field" => format!("{number}"),
+            word => format!("{word} {number}"),
+        };
         let text = if f.locked {
-            format!("{number} locked")
+            format!("{name} locked")
         } else {
-            format!("{number}")
+            name
         };
         let galley = painter.layout_no_wrap(text, FontId::proportional(13.0), Color32::WHITE);
         let at = r.min + Vec2::new(3.0, 3.0);

@@ -4,8 +4,8 @@
 //! without a window.
 
 use super::commands::{Command, History, Outcome};
-use super::field_number;
 use super::toolpaths::{Lowered, Prelowered, ToolpathCache};
+use super::{field_number, field_word};
 use crate::document::{staleness, Document, MachineProfile, Plan};
 use std::path::PathBuf;
 
@@ -72,6 +72,18 @@ impl Session {
         field_number(&self.doc.fields, visiting, id)
     }
 
+    /// What the canvas calls field `id`: "field 3", or "region 1" for one larger than the
+    /// profile's scan field.
+    pub fn field_name(&self, id: usize) -> String {
+        let word = self
+            .doc
+            .fields
+            .iter()
+            .find(|f| f.id == id)
+            .map_or("field", |f| field_word(f, &self.doc.profile));
+        format!("{word} {}", self.field_label(id))
+    }
+
     /// Plan `k`'s lowered toolpath, or why it could not be lowered (`None`: no such plan).
     pub fn toolpath(&self, k: usize) -> Option<Result<&Lowered, &str>> {
         self.toolpaths.get(k)
@@ -91,7 +103,7 @@ impl Session {
         cmd: Command,
         group: Option<u64>,
     ) -> (String, Result<Outcome, String>) {
-        let what = cmd.describe(&|id| self.field_label(id));
+        let what = cmd.describe(&|id| self.field_name(id));
         let r = self
             .history
             .execute(&mut self.doc, cmd, group, what.clone());
