@@ -1463,3 +1463,31 @@ fn an_on_the_fly_region_larger_than_the_scan_field_is_called_a_region() {
         h.state().status()
     );
 }
+
+#[test]
+fn uncovered_geometries_are_told_apart_from_every_layer_colour() {
+    use galvoplan::document::parse_colour;
+    let mut h = opened(&two_layers());
+    // uncover some geometries: delete a field
+    let id = h.state().session.doc.fields[0].id;
+    h.state_mut().execute(Command::DeleteField { id }).unwrap();
+    h.run();
+    assert!(!h.state().uncovered().is_empty());
+    // the side panel names the highlight (as the canvas's caption does), not a layer's colour
+    h.get_by_label_contains("(magenta halo on the canvas)");
+    assert!(h.query_by_label_contains("(red)").is_none());
+    // its colour is none of the layers' (the palette's red here, the demo's stroke colours)
+    let uncovered = galvoplan::app::uncovered_rgb();
+    let demo = opened(&demo());
+    for l in h
+        .state()
+        .session
+        .doc
+        .layers
+        .iter()
+        .chain(&demo.state().session.doc.layers)
+    {
+        let rgb = l.pen.colour.as_deref().and_then(parse_colour).unwrap();
+        assert_ne!(rgb, uncovered, "layer {}", l.name);
+    }
+}

@@ -378,9 +378,8 @@ impl Canvas<'_> {
                     "  no scan field can hold it: larger than a field or beyond the stage's reach"
                         .into(),
                 ),
-                None if self.uncovered.contains(&k) => {
-                    lines.push("  not covered by any field (add one, or re-place)".into())
-                }
+                None if self.uncovered.contains(&k) => lines
+                    .push("  not covered by any field (magenta halo): add one, or re-place".into()),
                 None => {}
             }
             for path in &self.paths {

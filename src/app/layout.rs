@@ -441,12 +441,12 @@ impl App {
                 ui.add(
                     egui::Label::new(
                         RichText::new(format!(
-                            "{} (red) {} not covered by a scan field yet: add a field \
-                     (Add field) or press \"Re-place automatically\".",
+                            "{} (magenta halo on the canvas) {} not covered by a scan field \
+                     yet: add a field (Add field) or press \"Re-place automatically\".",
                             super::count(near, "geometry", "geometries"),
                             if near == 1 { "is" } else { "are" }
                         ))
-                        .color(ERROR),
+                        .color(colour::UNCOVERED),
                     )
                     .wrap(),
                 );

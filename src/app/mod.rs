@@ -1036,6 +1036,13 @@ fn install_fallback_font(ctx: &egui::Context) {
     ctx.set_fonts(fonts);
 }
 
+/// The colour of the canvas's highlight of geometries no field holds (a halo around them,
+/// in a colour no layer is drawn in), and of the words about them.
+pub fn uncovered_rgb() -> [u8; 3] {
+    let c = paint::colour::UNCOVERED;
+    [c.r(), c.g(), c.b()]
+}
+
 /// `n` and the noun for it: "1 geometry", "3 geometries".
 pub fn count(n: usize, one: &str, many: &str) -> String {
     format!("{n} {}", if n == 1 { one } else { many })

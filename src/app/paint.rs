@@ -15,8 +15,13 @@ pub mod colour {
     pub const CLOSED: Color32 = Color32::from_rgb(30, 41, 59);
     /// Open geometries (also marked with dots at their ends).
     pub const OPEN: Color32 = Color32::from_rgb(21, 128, 61);
-    /// Geometries no field holds.
-    pub const UNCOVERED: Color32 = Color32::from_rgb(220, 38, 38);
+    /// Geometries no field holds: a magenta halo around the geometry (drawn in its own
+    /// colour), a style no layer colour has, and the words that tell of them.
+    pub const UNCOVERED: Color32 = Color32::from_rgb(192, 38, 211);
+    /// Width of the uncovered halo, px.
+    pub const UNCOVERED_HALO_PX: f32 = 9.0;
+    /// A lowering or other error in a canvas caption.
+    pub const ERROR: Color32 = Color32::from_rgb(200, 30, 30);
     /// Geometries no field can hold (larger than a field, or beyond the stage's reach).
     pub const OUT_OF_REACH: Color32 = Color32::from_rgb(147, 51, 234);
     /// Scan fields.
@@ -185,7 +190,33 @@ fn paint_artwork(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
         });
     // during a playback the artwork is faded: the marks done are drawn over it
     let fade = if c.playback_t_s.is_some() { 0.3 } else { 1.0 };
-    let mut shapes = Vec::with_capacity(c.geometries.len());
+    let mut shapes = Vec::with_capacity(c.geometries.len() + c.uncovered.len());
+    // not covered yet: a translucent magenta halo under the geometry, which keeps its colour
+    // (no layer colour can be mistaken for it: no geometry is drawn with a halo otherwise)
+    let halo = Stroke::new(
+        colour::UNCOVERED_HALO_PX,
+        colour::UNCOVERED.gamma_multiply(0.45),
+    );
+    for &k in c.uncovered.iter().filter(|k| !c.out_of_reach.contains(k)) {
+        let Some(g) = c.geometries.get(k) else {
+            continue;
+        };
+        let mut pts: Vec<Pos2> = g.points.iter().map(|&q| s(q)).collect();
+        match pts.len() {
+            0 => continue,
+            1 => shapes.push(Shape::circle_filled(
+                pts[0],
+                colour::UNCOVERED_HALO_PX / 2.0,
+                halo.color,
+            )),
+            _ => {
+                if g.closed {
+                    pts.push(pts[0]);
+                }
+                shapes.push(Shape::line(pts, halo));
+            }
+        }
+    }
     for (k, g) in c.geometries.iter().enumerate() {
         if g.points.is_empty() {
             continue;
@@ -216,19 +247,15 @@ fn paint_artwork(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
             shapes.push(Shape::line(pts, Stroke::new(1.2, col)));
         }
     }
-    for &k in c.uncovered {
+    for &k in c.out_of_reach {
         if let Some(g) = c.geometries.get(k) {
             let mut pts: Vec<Pos2> = g.points.iter().map(|&q| s(q)).collect();
             if g.closed && !pts.is_empty() {
                 pts.push(pts[0]);
             }
-            if c.out_of_reach.contains(&k) {
-                // no field can hold it: dashed purple, apart from the red of "not covered yet"
-                let stroke = Stroke::new(3.0, colour::OUT_OF_REACH);
-                shapes.extend(Shape::dashed_line(&pts, stroke, 6.0, 4.0));
-            } else {
-                shapes.push(Shape::line(pts, Stroke::new(2.5, colour::UNCOVERED)));
-            }
+            // no field can hold it: dashed purple, apart from the halo of "not covered yet"
+            let stroke = Stroke::new(3.0, colour::OUT_OF_REACH);
+            shapes.extend(Shape::dashed_line(&pts, stroke, 6.0, 4.0));
         }
     }
     painter.extend(shapes);
@@ -383,7 +410,7 @@ fn paint_caption(painter: &Painter, c: &Canvas<'_>, rect: Rect) {
             }
         }
         match (p.lowered, c.playback_t_s) {
-            (Err(why), _) => line(why.to_string(), colour::UNCOVERED),
+            (Err(why), _) => line(why.to_string(), colour::ERROR),
             (Ok(l), Some(t_s)) => line(
                 format!(
                     "{}: {}",
@@ -408,7 +435,7 @@ fn paint_caption(painter: &Painter, c: &Canvas<'_>, rect: Rect) {
     if !c.uncovered.is_empty() {
         line(
             format!(
-                "{} not covered by a field",
+                "{} not covered by a field (magenta halo)",
                 super::count(c.uncovered.len(), "geometry", "geometries")
             ),
             colour::UNCOVERED,
