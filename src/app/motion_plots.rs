@@ -156,7 +156,8 @@ fn offset_plot(
     Plot::new("otf-offset")
         .height(height_px)
         .legend(Legend::default())
-        .x_axis_label("t, s")
+        .custom_x_axes(vec![time_axis()])
+        .x_grid_spacer(time_grid_spacer)
         .y_axis_label("offset, mm")
         .allow_scroll(false)
         .show(ui, |pui| {
@@ -203,7 +204,8 @@ fn speed_plot(
     Plot::new("otf-speed")
         .height(height_px)
         .legend(Legend::default())
-        .x_axis_label("t, s")
+        .custom_x_axes(vec![time_axis()])
+        .x_grid_spacer(time_grid_spacer)
         .y_axis_label("speed, mm/s")
         .allow_scroll(false)
         .include_y(0.0)
@@ -225,6 +227,78 @@ fn speed_plot(
         });
 }
 
+/// Labelled time ticks at least this far apart, px (short labels such as "7.5": the time axis
+/// shows its labels from 40 px apart, fully from 50 px, instead of egui_plot's 60 to 80).
+const TIME_LABEL_PX: f64 = 50.0;
+/// Grid lines at least this far apart, px (the plot's default smallest grid spacing).
+const GRID_MIN_PX: f64 = 8.0;
+
+/// The time axis of the motion plots: "t, s", tick labels from [`TIME_LABEL_PX`] apart.
+fn time_axis() -> egui_plot::AxisHints<'static> {
+    egui_plot::AxisHints::new_x()
+        .label("t, s")
+        .label_spacing(40.0..=TIME_LABEL_PX as f32)
+        .formatter(|mark, _| time_tick(mark.value, mark.step_size))
+}
+
+/// A time tick's label with the decimals its step needs: 0.5 s steps read "0.5", not "0".
+fn time_tick(value_s: f64, step_s: f64) -> String {
+    let decimals = (-step_s.log10() - 1e-9).ceil().clamp(0.0, 6.0) as usize;
+    format!("{value_s:.decimals$}")
+}
+
+/// The smallest 1-2-5 step (…, 0.1, 0.2, 0.5, 1, 2, 5, 10, …) of at least `v`.
+fn nice_step(v: f64) -> f64 {
+    let v = v.max(1e-9);
+    let decade = 10f64.powf(v.log10().floor());
+    [1.0, 2.0, 5.0, 10.0]
+        .into_iter()
+        .map(|m| m * decade)
+        .find(|&s| s >= v * (1.0 - 1e-9))
+        .unwrap_or(10.0 * decade)
+}
+
+/// Grid of the time axes: labelled 1-2-5 steps at least [`TIME_LABEL_PX`] apart, so that a
+/// job of any length on a plot of any width has several labelled times (a power-of-ten grid
+/// leaves only "0" on a narrow plot of a few seconds), with finer unlabelled lines between.
+pub fn time_grid_spacer(input: egui_plot::GridInput) -> Vec<egui_plot::GridMark> {
+    let per_px = input.base_step_size / GRID_MIN_PX;
+    let labelled = nice_step(per_px * TIME_LABEL_PX);
+    // 1 → 0.2, 2 → 0.5, 5 → 1: a fifth or a quarter, a divisor of the labelled step
+    let mantissa = labelled / 10f64.powf(labelled.log10().floor());
+    let fine = labelled
+        / if (mantissa - 2.0).abs() < 1e-6 {
+            4.0
+        } else {
+            5.0
+        };
+    let coarse = labelled * 10.0;
+    let (lo, hi) = input.bounds;
+    let mut marks = Vec::new();
+    if !(lo.is_finite() && hi.is_finite()) || hi <= lo || fine <= 0.0 {
+        return marks;
+    }
+    // a bound on a tick (1.4 s of 0.05 s ticks) is one, rounding aside
+    let first = (lo / fine - 1e-9).ceil() as i64;
+    let last = (hi / fine + 1e-9).floor() as i64;
+    if last - first > 10_000 {
+        return marks;
+    }
+    for k in first..=last {
+        let value = k as f64 * fine;
+        let on = |step: f64| ((value / step).round() * step - value).abs() < fine * 1e-3;
+        let step_size = if on(coarse) {
+            coarse
+        } else if on(labelled) {
+            labelled
+        } else {
+            fine
+        };
+        marks.push(egui_plot::GridMark { value, step_size });
+    }
+    marks
+}
+
 #[cfg(test)]
 mod tests {
     #![allow(clippy::unwrap_used, clippy::expect_used)]
@@ -239,6 +313,43 @@ mod tests {
         assert!(t.len() <= MAX_SAMPLES + 1, "{}", t.len());
         assert_eq!(*t.last().unwrap(), 1000.0);
         assert_eq!(sample_times_s(0.0, 2e-3, MAX_SAMPLES), vec![0.0]);
+    }
+
+    #[test]
+    fn time_ticks_are_labelled_on_narrow_plots() {
+        assert_eq!(nice_step(0.3), 0.5);
+        assert_eq!(nice_step(1.0), 1.0);
+        assert_eq!(nice_step(1.01), 2.0);
+        assert_eq!(nice_step(7.0), 10.0);
+        assert_eq!(time_tick(0.5, 0.5), "0.5");
+        assert_eq!(time_tick(1.0, 0.5), "1.0");
+        assert_eq!(time_tick(4.0, 2.0), "4");
+        assert_eq!(time_tick(0.25, 0.05), "0.25");
+        assert_eq!(time_tick(10.0, 10.0), "10");
+        // a 7.8 s job on a 250 px plot: 1 s is 32 px, so the labelled step is 2 s
+        // (egui_plot's own grid labelled only 0 there)
+        let px_per_s = 250.0 / 7.8;
+        let marks = time_grid_spacer(egui_plot::GridInput {
+            bounds: (-0.2, 8.0),
+            base_step_size: GRID_MIN_PX / px_per_s,
+        });
+        let labelled: Vec<f64> = marks
+            .iter()
+            .filter(|m| m.step_size * px_per_s >= TIME_LABEL_PX)
+            .map(|m| m.value)
+            .collect();
+        assert_eq!(labelled, vec![0.0, 2.0, 4.0, 6.0, 8.0]);
+        // a 1.4 s job on a 600 px plot: every 0.2 s
+        let px_per_s = 600.0 / 1.4;
+        let marks = time_grid_spacer(egui_plot::GridInput {
+            bounds: (0.0, 1.4),
+            base_step_size: GRID_MIN_PX / px_per_s,
+        });
+        let labelled = marks
+            .iter()
+            .filter(|m| m.step_size * px_per_s >= TIME_LABEL_PX)
+            .count();
+        assert_eq!(labelled, 8);
     }
 
     #[test]
