@@ -204,29 +204,35 @@ impl Job {
         self.progress.latest.lock().ok().and_then(|l| l.clone())
     }
 
-    /// Draws the progress bar, elapsed time and a Cancel button.
+    /// What the job is doing, in words: its name and the latest progress message (the status
+    /// bar shows it in full, wrapped, beside the bar).
+    pub fn progress_text(&self) -> String {
+        match self.progress() {
+            Some(p) => format!("{}: {}", self.name, p.message),
+            None => format!("{}: starting", self.name),
+        }
+    }
+
+    /// Draws a compact progress bar (the share done, when known), the elapsed time and a
+    /// Cancel button; the words are [`Job::progress_text`].
     pub fn show(&self, ui: &mut egui::Ui) {
         let p = self.progress();
-        let (fraction, text) = match &p {
-            Some(p) if p.total > 0 => (
-                (p.done as f32 / p.total as f32).clamp(0.0, 1.0),
-                format!("{}: {}", self.name, p.message),
-            ),
+        let (fraction, known) = match &p {
+            Some(p) if p.total > 0 => ((p.done as f32 / p.total as f32).clamp(0.0, 1.0), true),
             // unknown total (GA generations): the share of the time limit, when there is one
-            Some(p) => (
+            Some(_) => (
                 self.time_limit_s.map_or(0.0, |t| {
                     (self.elapsed().as_secs_f64() / t.max(1e-9)).clamp(0.0, 1.0) as f32
                 }),
-                format!("{}: {}", self.name, p.message),
+                self.time_limit_s.is_some(),
             ),
-            None => (0.0, format!("{}: starting", self.name)),
+            None => (0.0, false),
         };
-        ui.add(
-            egui::ProgressBar::new(fraction)
-                .desired_width(260.0)
-                .text(text)
-                .animate(true),
-        );
+        let bar = egui::ProgressBar::new(fraction)
+            .desired_width(PROGRESS_BAR_PX)
+            .animate(true);
+        let bar = if known { bar.show_percentage() } else { bar };
+        ui.add(bar).on_hover_text(self.progress_text());
         ui.label(format!("{:.1} s", self.elapsed().as_secs_f64()));
         let label = if self.is_cancelled() {
             "Cancelling…"
@@ -241,6 +247,9 @@ impl Job {
         }
     }
 }
+
+/// Width of the status bar's progress bar, px (its words are beside it).
+const PROGRESS_BAR_PX: f32 = 110.0;
 
 impl Drop for Job {
     fn drop(&mut self) {

@@ -322,13 +322,28 @@ impl App {
                     ui.separator();
                 }
                 ui.with_layout(egui::Layout::left_to_right(egui::Align::Center), |ui| {
-                    let t = RichText::new(&self.view.status.text);
-                    let t = if self.view.status.error {
-                        t.color(ERROR)
+                    // the running job's words replace the status line that started it, in
+                    // full (wrapped); an error said meanwhile stays beside them
+                    let status = RichText::new(&self.view.status.text);
+                    let status = if self.view.status.error {
+                        status.color(ERROR)
                     } else {
-                        t
+                        status
                     };
-                    ui.add(egui::Label::new(t).wrap());
+                    match &self.runtime.job {
+                        Some(job) if self.view.status.error => {
+                            ui.vertical(|ui| {
+                                ui.add(egui::Label::new(job.progress_text()).wrap());
+                                ui.add(egui::Label::new(status).wrap());
+                            });
+                        }
+                        Some(job) => {
+                            ui.add(egui::Label::new(job.progress_text()).wrap());
+                        }
+                        None => {
+                            ui.add(egui::Label::new(status).wrap());
+                        }
+                    }
                 });
             });
         });
