@@ -1491,3 +1491,48 @@ fn uncovered_geometries_are_told_apart_from_every_layer_colour() {
         assert_ne!(rgb, uncovered, "layer {}", l.name);
     }
 }
+
+/// A harness at the window's smallest size.
+fn small(path: &Path) -> Harness<'static, App> {
+    let mut app = App::default();
+    assert!(app.open(path), "{}", app.status());
+    let mut h = Harness::builder()
+        .with_size(Vec2::new(900.0, 600.0))
+        .build_ui_state(|ui, app: &mut App| app.ui(ui), app);
+    h.run();
+    h
+}
+
+#[test]
+fn nothing_is_cut_off_on_the_smallest_window() {
+    let mut h = small(&two_layers());
+    let side = |h: &Harness<'_, App>| h.get_by_label("Document").rect().left();
+    let canvas_left = |h: &Harness<'_, App>| h.get_by_label("Work area").rect().left();
+    // layers panel: every value's edit beside the canvas, not under it
+    for label in ["Power", "Pulse frequency (kHz)", "Mark speed (mm/s)"] {
+        for node in h.get_all_by_label(label) {
+            assert!(node.rect().right() <= canvas_left(&h), "{label}");
+        }
+    }
+    // the profile's name wraps within the panel
+    section(&mut h, "Machine profile");
+    let name = h.get_all_by_label("Name").last().unwrap().rect();
+    assert!(name.right() <= canvas_left(&h), "{name:?}");
+    assert!(name.height() > 30.0, "the long name wraps: {name:?}");
+    // on the fly: the plots' titles and the time beside the playback controls stay in view
+    set_motion(&mut h, "On the fly (stage moves while marking)");
+    solve(&mut h, "Run HHA");
+    for title in ["Scanner offset", "Stage speed, mm/s", "t = 0.00 s of"] {
+        let r = h.get_by_label_contains(title).rect();
+        assert!(r.right() <= side(&h) + 0.5, "{title}: {r:?}");
+    }
+    solve(&mut h, "Run as-is");
+    h.get_by_label("Compare").click();
+    h.run();
+    for label in ["Fit view", "Overlay", "Plan B", "B vs A"] {
+        for node in h.get_all_by_label(label) {
+            let r = node.rect();
+            assert!(r.right() <= side(&h) + 0.5, "{label}: {r:?}");
+        }
+    }
+}

@@ -200,13 +200,6 @@ impl Canvas<'_> {
         )
     }
 
-    /// Height kept free for the caption when fitting: its title line and per plan the plan's
-    /// figures, the machine's state during a playback, and on the fly the route legend and a
-    /// re-lowered note (room for one plan before the first solve), px.
-    fn caption_px(&self) -> f32 {
-        8.0 + 20.0 * paint::caption_lines(self) as f32
-    }
-
     /// Shows the canvas in `size` (the available space when `None`); returns the response and
     /// the operator's actions. Drag pans (or moves the field under the pointer when editable),
     /// the middle button always pans, the wheel zooms about the cursor.
@@ -228,8 +221,11 @@ impl Canvas<'_> {
         }
         if state.view.scale == 0.0 || state.fit_requested {
             // the caption (top left) keeps its own band above the content
-            let below_caption =
-                Rect::from_min_max(rect.min + Vec2::Y * self.caption_px(), rect.max);
+            let caption_px = paint::caption_px(ui.painter(), self, rect.width());
+            let below_caption = Rect::from_min_max(
+                rect.min + Vec2::Y * caption_px.min(rect.height() * 0.5),
+                rect.max,
+            );
             state.view.fit(below_caption, lo, hi);
             state.view.offset += below_caption.min - rect.min;
             state.fit_requested = false;

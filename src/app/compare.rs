@@ -425,7 +425,8 @@ fn played(
 }
 
 fn toolbar(ui: &mut egui::Ui, st: &mut CompareState, plans: &[Plan]) {
-    ui.horizontal(|ui| {
+    // wraps on a narrow view: a wider row would widen the whole view under the side panel
+    ui.horizontal_wrapped(|ui| {
         plan_combo(ui, "Plan A", &mut st.a, plans);
         plan_combo(ui, "Plan B", &mut st.b, plans);
         if ui.button("Swap A/B").clicked() {
@@ -516,20 +517,40 @@ pub fn show(
         }
     }
     ui.add_space(4.0);
+    let mut plans = vec![(a, colour::PATH_A)];
+    if let Some(b) = b {
+        plans.push((b, colour::PATH_B));
+    }
+    let history = plans.iter().any(|(p, _)| !p.history.is_empty());
+    let metrics = |ui: &mut egui::Ui| {
+        // both ways: on a narrow view the table scrolls sideways rather than losing columns
+        egui::ScrollArea::both()
+            .id_salt("compare-metrics-scroll")
+            .max_height(bottom)
+            .show(ui, |ui| {
+                metrics_table(ui, "compare-metrics", a, b);
+                let mut notes = vec![(a, stale_of(ka))];
+                if let (Some(b), Some(kb)) = (b, kb) {
+                    notes.push((b, stale_of(kb)));
+                }
+                stale_notes(ui, &notes);
+            });
+    };
+    if !history {
+        // no GA history among the plans: the table has the whole width, the plot a line
+        ui.label(
+            RichText::new(
+                "GA convergence: no generation history among the compared plans (run HGA).",
+            )
+            .weak(),
+        );
+        metrics(ui);
+        return;
+    }
     ui.horizontal_top(|ui| {
         ui.vertical(|ui| {
-            ui.set_width((width * 0.42).min(480.0));
-            egui::ScrollArea::vertical()
-                .id_salt("compare-metrics-scroll")
-                .max_height(bottom)
-                .show(ui, |ui| {
-                    metrics_table(ui, "compare-metrics", a, b);
-                    let mut notes = vec![(a, stale_of(ka))];
-                    if let (Some(b), Some(kb)) = (b, kb) {
-                        notes.push((b, stale_of(kb)));
-                    }
-                    stale_notes(ui, &notes);
-                });
+            ui.set_width((width * 0.5).clamp(METRICS_MIN_PX.min(width * 0.6), 480.0));
+            metrics(ui);
         });
         ui.separator();
         ui.vertical(|ui| {
@@ -538,12 +559,11 @@ pub fn show(
                 .flatten()
                 .find(|p| p.algo == Algo::Hha)
                 .or_else(|| doc.plans.iter().rev().find(|p| p.algo == Algo::Hha));
-            let mut plans = vec![(a, colour::PATH_A)];
-            if let Some(b) = b {
-                plans.push((b, colour::PATH_B));
-            }
             ui.set_height(bottom);
             convergence_plot(ui, &plans, hha);
         });
     });
 }
+
+/// Width the compare view's metrics table would like beside the convergence plot, px.
+const METRICS_MIN_PX: f32 = 400.0;

@@ -15,6 +15,11 @@ const ERROR: Color32 = Color32::from_rgb(200, 30, 30);
 /// widgets under the pointer.
 const MESSAGE_LINES: f32 = 3.0;
 
+/// Width of a value's edit field, px.
+const EDIT_PX: f32 = 64.0;
+/// Gap between the grid's columns, px.
+const GRID_GAP_PX: f32 = 6.0;
+
 /// A text-edited number of a pen.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Col {
@@ -227,9 +232,26 @@ impl LayerEditor {
             };
             ui.label(RichText::new(words).weak());
         });
+        // two values a row when both fit beside their labels, else one: never a squeezed edit
+        let font = egui::TextStyle::Body.resolve(ui.style());
+        let label_px = COLS
+            .iter()
+            .map(|c| {
+                ui.painter()
+                    .layout_no_wrap(c.label(), font.clone(), Color32::WHITE)
+                    .size()
+                    .x
+            })
+            .fold(0.0, f32::max);
+        let pair_px = label_px + EDIT_PX + 3.0 * GRID_GAP_PX;
+        let pairs = if ui.available_width() >= 2.0 * pair_px {
+            2
+        } else {
+            1
+        };
         egui::Grid::new(("layer-grid", k))
-            .num_columns(4)
-            .spacing([6.0, 3.0])
+            .num_columns(2 * pairs)
+            .spacing([GRID_GAP_PX, 3.0])
             .show(ui, |ui| {
                 let hint = |c: Col| match c {
                     Col::Speed => format!("{}", profile.scanner.mark_speed_mm_s),
@@ -250,7 +272,7 @@ impl LayerEditor {
                     if let Some(l) = self.cell(ui, k, n, c, layer, &hint(c)) {
                         out = Some(l);
                     }
-                    if n % 2 == 1 {
+                    if (n + 1) % pairs == 0 {
                         ui.end_row();
                     }
                 }
@@ -277,7 +299,7 @@ impl LayerEditor {
         let label = ui.label(c.label());
         let bad = self.error.as_ref().is_some_and(|e| e.0 == k && e.1 == c);
         let mut edit = egui::TextEdit::singleline(&mut self.text[k][n])
-            .desired_width(60.0)
+            .desired_width(EDIT_PX)
             .hint_text(hint);
         if bad {
             edit = edit.text_color(ERROR);

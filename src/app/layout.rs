@@ -9,10 +9,18 @@ use super::{compare, motion_plots, playback, App, Section, Tab, SOLVERS};
 use egui::{Color32, RichText};
 
 const ERROR: Color32 = Color32::from_rgb(200, 30, 30);
+/// The most of the window's width the left panel takes (370 px of 1500 by default).
+const LEFT_SHARE: f32 = 0.3;
+/// The most of the window's width the right panel takes (330 px of 1500 by default).
+const RIGHT_SHARE: f32 = 0.28;
+/// The side panels' width on the smallest window, at least, px.
+const SIDE_MIN_PX: f32 = 200.0;
 
 impl App {
     /// Lays out the whole window.
     pub(super) fn layout(&mut self, ui: &mut egui::Ui) {
+        // the side panels give way on a small window, so that the central view keeps room
+        let window_px = ui.available_width();
         egui::Panel::top("menu").show(ui, |ui| self.menu_bar(ui));
         egui::Panel::top("toolbar").show(ui, |ui| self.toolbar(ui));
         egui::Panel::bottom("status").show(ui, |ui| self.status_bar(ui));
@@ -20,6 +28,7 @@ impl App {
             egui::Panel::left("left")
                 .resizable(true)
                 .default_size(370.0)
+                .max_size((window_px * LEFT_SHARE).max(SIDE_MIN_PX))
                 .show(ui, |ui| {
                     egui::ScrollArea::vertical().show(ui, |ui| self.left_panel(ui));
                 });
@@ -27,6 +36,7 @@ impl App {
         egui::Panel::right("right")
             .resizable(true)
             .default_size(330.0)
+            .max_size((window_px * RIGHT_SHARE).max(SIDE_MIN_PX))
             .show(ui, |ui| {
                 egui::ScrollArea::vertical().show(ui, |ui| self.right_panel(ui));
             });
@@ -576,7 +586,7 @@ impl App {
         for k in 0..self.session.doc.plans.len() {
             let p = &self.session.doc.plans[k];
             let stale = self.plan_staleness(k).to_vec();
-            ui.horizontal(|ui| {
+            ui.horizontal_wrapped(|ui| {
                 let text = match p.metrics.job_time_s {
                     Some(t) => format!("{}  job time {t:.2} s", p.name),
                     None => format!("{}  idle travel {:.1} mm", p.name, p.metrics.idle_mm),

@@ -142,11 +142,15 @@ fn offset_plot(
     height_px: f32,
 ) {
     let [rx, ry] = reach_mm(profile);
-    ui.label(format!(
-        "Scanner offset (tool - stage), mm: peak {:.1} of ±{:.1}",
-        s.peak_offset_mm(),
-        rx.min(ry)
-    ))
+    // one line (the plot's height counts on it): cut with "…" when narrow, in full on hover
+    ui.add(
+        egui::Label::new(format!(
+            "Scanner offset (tool - stage), mm: peak {:.1} of ±{:.1}",
+            s.peak_offset_mm(),
+            rx.min(ry)
+        ))
+        .truncate(),
+    )
     .on_hover_text(format!(
         "Where the laser point is inside the scan field while the stage moves. The scanner \
          can reach up to the red dashed lines: half the field less the profile's on-the-fly \
@@ -190,12 +194,15 @@ fn speed_plot(
         profile.axis_x.max_velocity_mm_s,
         profile.axis_y.max_velocity_mm_s,
     );
-    ui.label(format!(
-        "Stage speed, mm/s: peak {:.0}, limit {:.0} an axis, {:.0} both",
-        s.peak_speed_mm_s(),
-        vx.max(vy),
-        vx.hypot(vy)
-    ))
+    ui.add(
+        egui::Label::new(format!(
+            "Stage speed, mm/s: peak {:.0}, limit {:.0} an axis, {:.0} both",
+            s.peak_speed_mm_s(),
+            vx.max(vy),
+            vx.hypot(vy)
+        ))
+        .truncate(),
+    )
     .on_hover_text(
         "How fast the stage travels along its route (both axes together). Each axis stays \
          within its own limit (dashed), so on a diagonal the combined speed may reach the dotted \

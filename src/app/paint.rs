@@ -381,21 +381,14 @@ fn start_end_markers(painter: &Painter, ps: Pos2, pe: Pos2) {
     );
 }
 
-fn paint_caption(painter: &Painter, c: &Canvas<'_>, rect: Rect) {
-    let mut y = rect.min.y + 6.0;
-    let mut line = |text: String, col: Color32| {
-        let galley = painter.layout_no_wrap(text, FontId::proportional(13.0), col);
-        let r = Rect::from_min_size(
-            Pos2::new(rect.min.x + 6.0, y),
-            galley.size() + Vec2::new(8.0, 4.0),
-        );
-        painter.rect_filled(r, 3.0, Color32::from_white_alpha(225));
-        painter.galley(r.min + Vec2::new(4.0, 2.0), galley, col);
-        y = r.max.y + 2.0;
-    };
-    line(c.label.to_string(), Color32::from_gray(40));
+/// The caption's lines (text and colour), top to bottom: the canvas's name, per plan its
+/// figures, the stage route's legend (on the fly) and the machine's state (during a playback,
+/// or `playback_room`: a line as long as one, for making room), a stale note, the uncovered
+/// and out-of-reach geometries.
+fn caption(c: &Canvas<'_>, playback_room: bool) -> Vec<(String, Color32)> {
+    let mut lines = vec![(c.label.to_string(), Color32::from_gray(40))];
     for (k, p) in c.paths.iter().enumerate() {
-        line(plan_caption(p), p.colour);
+        lines.push((plan_caption(p), p.colour));
         if let Ok(l) = p.lowered {
             if l.on_the_fly() && c.layers.base_path {
                 let col = if k == 0 {
@@ -403,22 +396,30 @@ fn paint_caption(painter: &Painter, c: &Canvas<'_>, rect: Rect) {
                 } else {
                     p.colour
                 };
-                line(
-                    "stage route (solid line in this colour): where the stage travels while the scanner marks".into(),
+                lines.push((
+                    "solid line in this colour: the stage's route while the scanner marks".into(),
                     col,
-                );
+                ));
             }
         }
         match (p.lowered, c.playback_t_s) {
-            (Err(why), _) => line(why.to_string(), colour::ERROR),
-            (Ok(l), Some(t_s)) => line(
+            (Err(why), _) => lines.push((why.to_string(), colour::ERROR)),
+            (Ok(l), Some(t_s)) => lines.push((
                 format!(
                     "{}: {}",
                     playback::time_text(t_s.min(l.duration_s()), l.duration_s()),
                     playback::state_text(l, t_s)
                 ),
                 Color32::from_gray(40),
-            ),
+            )),
+            (Ok(l), None) if playback_room => lines.push((
+                format!(
+                    "{}: {}",
+                    playback::time_text(l.duration_s(), l.duration_s()),
+                    playback::state_text(l, 0.0)
+                ),
+                Color32::from_gray(40),
+            )),
             (Ok(_), None) => {}
         }
     }
@@ -427,30 +428,84 @@ fn paint_caption(painter: &Painter, c: &Canvas<'_>, rect: Rect) {
             1 => String::new(),
             n => format!(" (and {} more)", n - 1),
         };
-        line(
+        lines.push((
             format!("stale plan: {first} since it was made{more}"),
             super::layout::STALE,
-        );
+        ));
     }
-    if !c.uncovered.is_empty() {
-        line(
+    let near = c
+        .uncovered
+        .iter()
+        .filter(|k| !c.out_of_reach.contains(k))
+        .count();
+    if near > 0 {
+        lines.push((
             format!(
                 "{} not covered by a field (magenta halo)",
-                super::count(c.uncovered.len(), "geometry", "geometries")
+                super::count(near, "geometry", "geometries")
             ),
             colour::UNCOVERED,
+        ));
+    }
+    if !c.out_of_reach.is_empty() {
+        lines.push((
+            format!(
+                "{} no scan field can hold (dashed purple)",
+                super::count(c.out_of_reach.len(), "geometry", "geometries")
+            ),
+            colour::OUT_OF_REACH,
+        ));
+    }
+    lines
+}
+
+/// Font of the caption.
+fn caption_font() -> FontId {
+    FontId::proportional(13.0)
+}
+
+/// The caption's lines laid out for a canvas `width_px` wide: wrapped, never cut.
+fn caption_galleys(
+    painter: &Painter,
+    c: &Canvas<'_>,
+    width_px: f32,
+    playback_room: bool,
+) -> Vec<std::sync::Arc<egui::Galley>> {
+    let wrap_px = (width_px - 2.0 * CAPTION_MARGIN_PX - 8.0).max(40.0);
+    caption(c, playback_room)
+        .into_iter()
+        .map(|(text, col)| painter.layout(text, caption_font(), col, wrap_px))
+        .collect()
+}
+
+/// Margin of the caption from the canvas's corner, px.
+const CAPTION_MARGIN_PX: f32 = 6.0;
+
+fn paint_caption(painter: &Painter, c: &Canvas<'_>, rect: Rect) {
+    let mut y = rect.min.y + CAPTION_MARGIN_PX;
+    for galley in caption_galleys(painter, c, rect.width(), false) {
+        let r = Rect::from_min_size(
+            Pos2::new(rect.min.x + CAPTION_MARGIN_PX, y),
+            galley.size() + Vec2::new(8.0, 4.0),
         );
+        painter.rect_filled(r, 3.0, Color32::from_white_alpha(225));
+        painter.galley(r.min + Vec2::new(4.0, 2.0), galley, Color32::from_gray(40));
+        y = r.max.y + 2.0;
     }
 }
 
-/// How many caption lines a canvas shows at most (title, and per plan: figures, playback
-/// state, stage route legend; a stale note).
-pub fn caption_lines(c: &Canvas<'_>) -> usize {
-    let per_plan = |p: &PathLayer<'_>| match p.lowered {
-        Ok(l) => 2 + usize::from(l.on_the_fly()),
-        Err(_) => 2,
+/// Height of the caption on a canvas `width_px` wide, with room for the machine's state of a
+/// playback, px.
+pub fn caption_px(painter: &Painter, c: &Canvas<'_>, width_px: f32) -> f32 {
+    let lines = caption_galleys(painter, c, width_px, true);
+    let line_px = |g: &std::sync::Arc<egui::Galley>| g.size().y + 6.0;
+    // before the first solve: room for a plan's figures and its playback state, so that the
+    // first plan's caption does not cover the content fitted now
+    let plan_room = match (c.paths.is_empty(), lines.first()) {
+        (true, Some(title)) => 2.0 * line_px(title),
+        _ => 0.0,
     };
-    1 + usize::from(!c.stale.is_empty()) + c.paths.iter().map(per_plan).sum::<usize>().max(2)
+    CAPTION_MARGIN_PX + lines.iter().map(line_px).sum::<f32>() + plan_room
 }
 
 /// A plan's caption, led by the figure that decides: its job time.

@@ -23,6 +23,10 @@ const SLIDER_PX: (f32, f32) = (120.0, 520.0);
 /// Room kept for the time text at the end of the row, px.
 const TIME_TEXT_PX: f32 = 200.0;
 
+/// Room the time label, the narrowest slider and the time text need beside the buttons, px
+/// (else they take a row of their own).
+const SLIDER_ROW_PX: f32 = 48.0 + SLIDER_PX.0 + TIME_TEXT_PX;
+
 /// Playback state of one view (run time only, never saved).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Playback {
@@ -124,12 +128,26 @@ pub fn controls(
             ui.ctx().request_repaint();
         }
     }
-    ui.horizontal(|ui| {
-        ui.add_enabled_ui(lowered.is_some(), |ui| buttons(ui, id, pb, duration_s));
+    // on a narrow view the slider and the time go to a second row rather than out of sight
+    let slider_row = |ui: &mut egui::Ui, pb: &mut Playback| {
+        ui.add_enabled_ui(lowered.is_some(), |ui| time_slider(ui, pb, duration_s));
         if lowered.is_some() {
             ui.label(RichText::new(time_text(pb.t_s, duration_s)).monospace());
         }
-    });
+    };
+    let one_row = ui
+        .horizontal(|ui| {
+            ui.add_enabled_ui(lowered.is_some(), |ui| buttons(ui, id, pb, duration_s));
+            let fits = ui.available_width() >= SLIDER_ROW_PX;
+            if fits {
+                slider_row(ui, pb);
+            }
+            fits
+        })
+        .inner;
+    if !one_row {
+        ui.horizontal(|ui| slider_row(ui, pb));
+    }
     if !state_words && lowered.is_some() {
         return;
     }
@@ -185,6 +203,10 @@ fn buttons(ui: &mut egui::Ui, id: &str, pb: &mut Playback, duration_s: f64) {
         .response
         .labelled_by(l.id)
         .on_hover_text("× real time; auto: real time, faster when the job is long");
+}
+
+/// The time slider, as wide as the row leaves beside the time text.
+fn time_slider(ui: &mut egui::Ui, pb: &mut Playback, duration_s: f64) {
     let l = ui.label("Time");
     let room_px = ui.available_width() - TIME_TEXT_PX;
     ui.spacing_mut().slider_width = room_px.clamp(SLIDER_PX.0, SLIDER_PX.1);
