@@ -306,13 +306,16 @@ pub fn stale_notes(ui: &mut egui::Ui, plans: &[(&Plan, &[String])]) {
             1 => String::new(),
             n => format!(" (and {} more)", n - 1),
         };
-        ui.label(
-            RichText::new(format!(
-                "{} is stale: {first} since it was made{more}",
-                plan.name
-            ))
-            .small()
-            .color(super::layout::STALE),
+        ui.add(
+            egui::Label::new(
+                RichText::new(format!(
+                    "{} is stale: {first} since it was made{more}; its figures are those of \
+                     the plan as made",
+                    plan.name
+                ))
+                .color(super::layout::STALE),
+            )
+            .wrap(),
         )
         .on_hover_text(super::layout::stale_text(why));
     }
@@ -528,12 +531,13 @@ pub fn show(
             .id_salt("compare-metrics-scroll")
             .max_height(bottom)
             .show(ui, |ui| {
-                metrics_table(ui, "compare-metrics", a, b);
+                // stale figures are said to be so before they are shown
                 let mut notes = vec![(a, stale_of(ka))];
                 if let (Some(b), Some(kb)) = (b, kb) {
                     notes.push((b, stale_of(kb)));
                 }
                 stale_notes(ui, &notes);
+                metrics_table(ui, "compare-metrics", a, b);
             });
     };
     if !history {

@@ -486,12 +486,13 @@ impl App {
         if let Some(plan) = self.active_plan() {
             ui.separator();
             ui.heading("Metrics");
-            compare::metrics_table(ui, "active-metrics", plan, None);
+            // stale figures are said to be so before they are shown
             let stale = self
                 .session
                 .active
                 .map_or(&[][..], |k| self.plan_staleness(k));
             compare::stale_notes(ui, &[(plan, stale)]);
+            compare::metrics_table(ui, "active-metrics", plan, None);
         }
         ui.separator();
         let n = self.session.doc.warnings.len();
@@ -732,7 +733,7 @@ fn motion_plots_header(ui: &mut egui::Ui, open: &mut bool) {
         .selectable_label(shown, text)
         .on_hover_text(
             "The scanner offset against the field limits and the stage speed over the job \
-             (of the toolpath shown, lowered with the current settings)",
+             (of the plan shown, as it was planned)",
         )
         .clicked()
     {

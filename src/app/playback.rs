@@ -92,6 +92,8 @@ pub fn state_text(l: &Lowered, t_s: f64) -> String {
     let doing = match seg.kind {
         _ if t_s >= l.duration_s() => format!("job done: {n} strokes marked"),
         SegmentKind::Mark => format!("marking stroke {next} of {n}"),
+        // on the fly the stage never stops at a field: this is the start of its route
+        SegmentKind::StageMove if l.on_the_fly() => "stage getting under way on its route".into(),
         SegmentKind::StageMove => "stage moving to the next field".into(),
         SegmentKind::Settle => "stage settling".into(),
         SegmentKind::Jump => format!("scanner jumping to stroke {next} of {n}"),

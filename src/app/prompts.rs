@@ -383,12 +383,15 @@ impl App {
                         .session
                         .active
                         .map_or(&[][..], |k| self.plan_staleness(k));
+                    let name = self
+                        .active_plan()
+                        .map_or_else(|| "this plan".to_string(), |p| p.name.clone());
                     ui.add(
-                        egui::Label::new(
-                            "The document changed since this plan was made. Exported as \
-                             planned, the file is the plan with the settings it was made with, \
-                             not the ones shown now:",
-                        )
+                        egui::Label::new(format!(
+                            "The document changed since {name} was made. Exported as planned, \
+                             the file is {name} with the settings it was made with, not the \
+                             ones shown now:"
+                        ))
                         .wrap(),
                     );
                     for w in why.iter().take(6) {
