@@ -16,10 +16,13 @@ pub struct RecordError {
     pub msg: String,
 }
 
-/// A [`RunRecorder`] writing to an `.rrd` file.
+/// A [`RunRecorder`] writing to an `.rrd` file. The recorder's calls cannot fail (a stage
+/// must not stop for its recording); the first logging error is kept and reported by
+/// [`RerunRecorder::finish`].
 pub struct RerunRecorder {
     rec: rerun::RecordingStream,
     file: String,
+    first_error: std::sync::Mutex<Option<String>>,
 }
 
 fn xy(p: crate::geom::Pt) -> [f32; 2] {
@@ -36,15 +39,42 @@ impl RerunRecorder {
                 file: file.clone(),
                 msg: e.to_string(),
             })?;
-        Ok(Self { rec, file })
+        Ok(Self {
+            rec,
+            file,
+            first_error: std::sync::Mutex::new(None),
+        })
     }
 
-    /// Flushes everything to disk.
+    /// Flushes everything to disk; reports the first error of the recording, if any.
     pub fn finish(&self) -> Result<(), RecordError> {
-        self.rec.flush_blocking().map_err(|e| RecordError {
+        let error = |msg: String| RecordError {
             file: self.file.clone(),
-            msg: e.to_string(),
-        })
+            msg,
+        };
+        self.rec
+            .flush_blocking()
+            .map_err(|e| error(e.to_string()))?;
+        let first = self
+            .first_error
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .take();
+        match first {
+            Some(msg) => Err(error(msg)),
+            None => Ok(()),
+        }
+    }
+
+    /// Keeps the first error of a logging call.
+    fn keep<E: std::fmt::Display>(&self, what: &str, r: Result<(), E>) {
+        if let Err(e) = r {
+            let mut first = self
+                .first_error
+                .lock()
+                .unwrap_or_else(std::sync::PoisonError::into_inner);
+            first.get_or_insert_with(|| format!("{what}: {e}"));
+        }
     }
 }
 
@@ -62,9 +92,12 @@ impl RunRecorder for RerunRecorder {
                 rerun::LineStrip2D::from_iter(pts)
             })
             .collect();
-        let _ = self.rec.log_static(
-            "artwork",
-            &rerun::LineStrips2D::new(strips).with_colors([rerun::Color::from_rgb(40, 40, 40)]),
+        self.keep(
+            "log",
+            self.rec.log_static(
+                "artwork",
+                &rerun::LineStrips2D::new(strips).with_colors([rerun::Color::from_rgb(40, 40, 40)]),
+            ),
         );
     }
 
@@ -74,12 +107,16 @@ impl RunRecorder for RerunRecorder {
             .iter()
             .map(|f| [f.size[0] as f32, f.size[1] as f32])
             .collect();
-        let labels: Vec<String> = fields.iter().map(|f| format!("field {}", f.id)).collect();
-        let _ = self.rec.log_static(
-            "fields",
-            &rerun::Boxes2D::from_centers_and_sizes(centers, sizes)
-                .with_labels(labels)
-                .with_colors([rerun::Color::from_rgb(59, 130, 246)]),
+        // numbered 1…n in placement order, as the canvas numbers them before a plan
+        let labels: Vec<String> = (1..=fields.len()).map(|k| format!("field {k}")).collect();
+        self.keep(
+            "log",
+            self.rec.log_static(
+                "fields",
+                &rerun::Boxes2D::from_centers_and_sizes(centers, sizes)
+                    .with_labels(labels)
+                    .with_colors([rerun::Color::from_rgb(59, 130, 246)]),
+            ),
         );
     }
 
@@ -98,29 +135,42 @@ impl RunRecorder for RerunRecorder {
             .collect();
         let base: Vec<[f32; 2]> = plan.fields.iter().map(|f| xy(f.center)).collect();
         let root = format!("plans/{}", plan.name);
-        let _ = self.rec.log_static(
-            format!("{root}/marks"),
-            &rerun::LineStrips2D::new(marks).with_colors([rerun::Color::from_rgb(0, 0, 0)]),
+        self.keep(
+            "log",
+            self.rec.log_static(
+                format!("{root}/marks"),
+                &rerun::LineStrips2D::new(marks).with_colors([rerun::Color::from_rgb(0, 0, 0)]),
+            ),
         );
-        let _ = self.rec.log_static(
-            format!("{root}/idle"),
-            &rerun::LineStrips2D::new(idle).with_colors([rerun::Color::from_rgb(220, 38, 38)]),
+        self.keep(
+            "log",
+            self.rec.log_static(
+                format!("{root}/idle"),
+                &rerun::LineStrips2D::new(idle).with_colors([rerun::Color::from_rgb(220, 38, 38)]),
+            ),
         );
-        let _ = self.rec.log_static(
-            format!("{root}/base_path"),
-            &rerun::LineStrips2D::new([rerun::LineStrip2D::from_iter(base)])
-                .with_colors([rerun::Color::from_rgb(22, 163, 74)]),
+        self.keep(
+            "log",
+            self.rec.log_static(
+                format!("{root}/base_path"),
+                &rerun::LineStrips2D::new([rerun::LineStrip2D::from_iter(base)])
+                    .with_colors([rerun::Color::from_rgb(22, 163, 74)]),
+            ),
         );
-        let _ = self.rec.flush_blocking();
+        self.keep("flush", self.rec.flush_blocking());
     }
 
     fn generation(&self, generation: usize, best_idle_mm: f64, mean_idle_mm: f64) {
         self.rec.set_time_sequence("generation", generation as i64);
-        let _ = self
-            .rec
-            .log("hga/best_idle_mm", &rerun::Scalars::single(best_idle_mm));
-        let _ = self
-            .rec
-            .log("hga/mean_idle_mm", &rerun::Scalars::single(mean_idle_mm));
+        self.keep(
+            "log",
+            self.rec
+                .log("hga/best_idle_mm", &rerun::Scalars::single(best_idle_mm)),
+        );
+        self.keep(
+            "log",
+            self.rec
+                .log("hga/mean_idle_mm", &rerun::Scalars::single(mean_idle_mm)),
+        );
     }
 }

@@ -160,3 +160,73 @@ fn the_ordering_toolpath_is_the_plans_lowering() {
         assert!(toolpath == lower_plan(&doc, &plan).unwrap(), "{case}");
     }
 }
+
+/// A project saved with a plan and reopened where the profile, pens and hatch are different
+/// exports the plan byte for byte as it was planned (its own inputs), and says it is stale.
+#[test]
+fn a_saved_plan_exports_the_same_gcode_after_reopening_and_edits() {
+    use galvoplan::document::{load_project, save_project, staleness, HatchSettings, PenLibrary};
+    use galvoplan::pipeline::{apply_pen_library, derive_geometries, plan_document_lowered};
+    let root = common::root().join("assets/examples");
+    let (mut doc, _) = load_svg(
+        &root.join("two-layers.svg"),
+        MachineProfile::default(),
+        SolverSettings::default(),
+        &ImportOptions::default(),
+    )
+    .unwrap();
+    let pens = PenLibrary::load(&root.join("two-layers.pens.toml")).unwrap();
+    apply_pen_library(&mut doc, &pens);
+    let (plan, toolpath) = plan_document_lowered(&mut doc, &JobCtx::default()).unwrap();
+    let gcode = write_gcode(&toolpath, &plan, doc.page_mm[1], "two-layers.svg").unwrap();
+    doc.plans.push(plan);
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("job.galvoplan");
+    save_project(&doc, &file).unwrap();
+    let mut back = load_project(&file).unwrap();
+    // another machine, other pens, another hatch: the plan keeps its own
+    back.profile.axis_x.max_velocity_mm_s /= 3.0;
+    back.profile.gcode.feed_mm_min = 1234.0;
+    back.layers[0].pen.power = Some(5.0);
+    back.layers[1].pen.hatch = Some(HatchSettings::parse_spec("lines:1:0").unwrap());
+    derive_geometries(&mut back, &JobCtx::default()).unwrap();
+    let plan = &back.plans[0];
+    let again = write_gcode(
+        &lower_plan(&back, plan).unwrap(),
+        plan,
+        back.page_mm[1],
+        "two-layers.svg",
+    )
+    .unwrap();
+    assert_eq!(again, gcode);
+    let why = staleness(plan, &back);
+    assert!(why.len() >= 4, "{why:?}");
+    assert!(
+        why.iter().any(|w| w.starts_with("outline: power 40 → 5")),
+        "{why:?}"
+    );
+}
+
+/// Version-2 projects (plans without their inputs) load with the document's profile and
+/// settings as the plans' own.
+#[test]
+fn a_version_2_project_gives_its_plans_the_documents_inputs() {
+    let (mut doc, plan) = run("demo.svg", SolverSettings::default());
+    doc.plans.push(plan);
+    let mut v: serde_json::Value = serde_json::json!({
+        "format": "galvoplan-project",
+        "version": 2,
+        "document": serde_json::to_value(&doc).unwrap(),
+    });
+    for p in v["document"]["plans"].as_array_mut().unwrap() {
+        let p = p.as_object_mut().unwrap();
+        p.remove("profile");
+        p.remove("settings");
+        p.remove("geometry_rev");
+    }
+    v["document"]["profile"]["axis_x"]["max_velocity_mm_s"] = serde_json::json!(123.0);
+    let back = galvoplan::document::parse_project(&v.to_string(), "v2.json").unwrap();
+    assert_eq!(back.plans[0].profile.axis_x.max_velocity_mm_s, 123.0);
+    assert_eq!(back.plans[0].profile, back.profile);
+    assert!(galvoplan::document::staleness(&back.plans[0], &back).is_empty());
+}

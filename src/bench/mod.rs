@@ -97,8 +97,11 @@ pub fn collect_svgs(paths: &[PathBuf]) -> std::io::Result<Vec<PathBuf>> {
     let mut out = Vec::new();
     for p in paths {
         if p.is_dir() {
-            let mut v: Vec<PathBuf> = std::fs::read_dir(p)?
-                .filter_map(|e| e.ok().map(|e| e.path()))
+            // an unreadable entry is an error, not a file left out in silence
+            let entries = std::fs::read_dir(p)?.collect::<std::io::Result<Vec<_>>>()?;
+            let mut v: Vec<PathBuf> = entries
+                .into_iter()
+                .map(|e| e.path())
                 .filter(|q| {
                     q.extension().is_some_and(|x| {
                         x.eq_ignore_ascii_case("svg") || x.eq_ignore_ascii_case("svgz")

@@ -31,9 +31,12 @@ fn collect(paths: &[PathBuf]) -> Result<Vec<PathBuf>> {
     let mut out = Vec::new();
     for p in paths {
         if p.is_dir() {
-            let mut v: Vec<PathBuf> = std::fs::read_dir(p)
-                .with_context(|| format!("{}: cannot list", p.display()))?
-                .filter_map(|e| e.ok().map(|e| e.path()))
+            let entries = std::fs::read_dir(p)
+                .and_then(|d| d.collect::<std::io::Result<Vec<_>>>())
+                .with_context(|| format!("{}: cannot list", p.display()))?;
+            let mut v: Vec<PathBuf> = entries
+                .into_iter()
+                .map(|e| e.path())
                 .filter(|q| q.extension().is_some_and(|x| x.eq_ignore_ascii_case("csv")))
                 .collect();
             v.sort();
