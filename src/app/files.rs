@@ -123,13 +123,6 @@ impl ExportKind {
             ExportKind::Trajectory => "trajectory.csv",
         }
     }
-    /// Every kind, in menu order.
-    pub const ALL: [ExportKind; 4] = [
-        ExportKind::Gcode,
-        ExportKind::Report,
-        ExportKind::Preview,
-        ExportKind::Trajectory,
-    ];
 }
 
 /// The folder last exported to, per kind of export (kept between runs).
@@ -165,6 +158,7 @@ pub fn export_text(
 ) -> Result<String, String> {
     let source = doc.source.clone().unwrap_or_else(|| "document".into());
     if kind == ExportKind::Report {
+        // the report needs no toolpath: never lowered for it
         return Ok(report_json(&source, plan, &doc.warnings));
     }
     let lowered;

@@ -630,7 +630,7 @@ pub fn settings_specs() -> Vec<FieldSpec<SolverSettings>> {
 /// A pen's values (the layers panel's rows).
 pub fn pen_specs() -> Vec<FieldSpec<Pen>> {
     use Rule::Positive;
-    let mut colour = FieldSpec {
+    let colour = FieldSpec {
         label: "Colour",
         unit: "",
         key: "colour",
@@ -646,7 +646,6 @@ pub fn pen_specs() -> Vec<FieldSpec<Pen>> {
             Ok(())
         },
     };
-    colour.shapes_plan = false;
     vec![
         choice!("Marked", "enabled", |p| yes_no(p.enabled)),
         optional!(
