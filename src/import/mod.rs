@@ -72,6 +72,18 @@ pub struct Imported {
     pub page_mm: [f64; 2],
 }
 
+/// Most items an error or warning lists before "… and N more".
+pub const LIST_MAX: usize = 5;
+
+/// Up to [`LIST_MAX`] items joined by `sep`, then "… and N more" for the rest.
+pub fn short_list<T: std::fmt::Display>(items: &[T], sep: &str) -> String {
+    let mut out: Vec<String> = items.iter().take(LIST_MAX).map(|i| i.to_string()).collect();
+    if items.len() > LIST_MAX {
+        out.push(format!("… and {} more", items.len() - LIST_MAX));
+    }
+    out.join(sep)
+}
+
 /// A file format [`import_file`] reads.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Format {
@@ -230,20 +242,13 @@ fn normalise(pts: Vec<Pt>, closed: bool) -> Result<(Vec<Pt>, bool), &'static str
     Ok((out, closed))
 }
 
-/// The error for a file with nothing to mark: what was skipped (the first three warnings), or
-/// `empty` when nothing was.
+/// The error for a file with nothing to mark: what was skipped (the first [`LIST_MAX`]
+/// warnings), or `empty` when nothing was.
 fn nothing_to_mark(file: &str, warnings: &[Warning], empty: &str) -> ImportError {
     let detail = if warnings.is_empty() {
         empty.to_string()
     } else {
-        let listed: Vec<String> = warnings.iter().take(3).map(|w| w.to_string()).collect();
-        let more = warnings.len().saturating_sub(3);
-        let tail = if more > 0 {
-            format!("; and {more} more")
-        } else {
-            String::new()
-        };
-        format!("only skipped content: {}{tail}", listed.join("; "))
+        format!("only skipped content: {}", short_list(warnings, "; "))
     };
     ImportError::NothingToMark {
         file: file.into(),
