@@ -3,15 +3,20 @@
 //! [`import_file`] is the one entry point for files: it chooses the format by extension (and by
 //! content when the extension says nothing) and every error names the file and the format.
 
+mod clip;
 mod curves;
 mod dxf;
+mod dxf_scan;
 mod dxf_text;
 mod fonts;
 mod guard;
+mod place;
 mod svg;
+mod svg_scan;
 
 pub use self::dxf::import_dxf;
 pub use fonts::{BUNDLED_CAP_HEIGHT_EM, BUNDLED_FAMILY};
+pub use place::{place_artwork, Place, PlaceError};
 pub use svg::{import_svg, import_svg_file};
 
 use crate::document::Geometry;
@@ -38,7 +43,7 @@ pub enum FontSource {
     BundledOnly,
 }
 
-/// Import options.
+/// Import options. Build them with `..ImportOptions::default()`: fields are added over time.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ImportOptions {
     /// Maximum distance between a curve and its flattened polyline, mm (the same guarantee for
@@ -46,9 +51,21 @@ pub struct ImportOptions {
     pub chord_tol_mm: f64,
     /// Fonts for text.
     pub fonts: FontSource,
-    /// Width and height of the area the artwork should lie in (the base stroke), mm. A DXF
-    /// drawing that lies outside it but would fit is moved to its corner (with a warning).
+    /// Width and height of the area the artwork should lie in (the base stroke), mm: what
+    /// [`Place`] places the artwork on. `None`: no machine is known, the artwork stays as in
+    /// the file (except [`Place::Corner`]).
     pub work_area_mm: Option<[f64; 2]>,
+    /// Scan field size, mm: the laser reaches half a field beyond the work area on every side
+    /// ([`Place::Auto`] keeps artwork inside that reach where it is). `None`: no margin.
+    pub field_mm: Option<[f64; 2]>,
+    /// Where the artwork goes on the machine (see [`Place`]; applied right after import).
+    pub place: Place,
+    /// Offsets (mm) smaller than this are not applied nor reported: below the export's
+    /// resolution (a G-code with 4 decimals: 10⁻⁴ mm).
+    pub resolution_mm: f64,
+    /// Layers the drawing hides (DXF layers off or frozen, SVG layers with `display:none`)
+    /// to import anyway.
+    pub hidden_layers: HiddenLayers,
 }
 
 impl Default for ImportOptions {
@@ -57,8 +74,71 @@ impl Default for ImportOptions {
             chord_tol_mm: 0.01,
             fonts: FontSource::System,
             work_area_mm: None,
+            field_mm: None,
+            place: Place::Auto,
+            resolution_mm: 1e-4,
+            hidden_layers: HiddenLayers::Skip,
         }
     }
+}
+
+/// What happens to layers the drawing hides.
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub enum HiddenLayers {
+    /// Skipped, each with one summary warning and listed in [`Imported::skipped_layers`].
+    #[default]
+    Skip,
+    /// All imported (`--include-hidden-layers`).
+    IncludeAll,
+    /// These layers (by name; DXF layer names compare without case) imported, others skipped.
+    Include(Vec<String>),
+}
+
+impl HiddenLayers {
+    /// True when the hidden layer `name` is to be imported.
+    pub fn includes(&self, name: &str) -> bool {
+        match self {
+            HiddenLayers::Skip => false,
+            HiddenLayers::IncludeAll => true,
+            HiddenLayers::Include(names) => names.iter().any(|n| n.eq_ignore_ascii_case(name)),
+        }
+    }
+}
+
+/// Why a layer was not imported.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum LayerHidden {
+    /// A DXF layer that is off (negative colour number).
+    Off,
+    /// A DXF layer that is frozen (flag 1).
+    Frozen,
+    /// A DXF layer that is off and frozen.
+    OffAndFrozen,
+    /// An SVG layer (top-level group) with `display:none`.
+    Hidden,
+}
+
+impl std::fmt::Display for LayerHidden {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            LayerHidden::Off => "off",
+            LayerHidden::Frozen => "frozen",
+            LayerHidden::OffAndFrozen => "off and frozen",
+            LayerHidden::Hidden => "hidden",
+        })
+    }
+}
+
+/// A layer the import skipped because the drawing hides it; imported when
+/// [`ImportOptions::hidden_layers`] names it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SkippedLayer {
+    /// The layer's name, as geometries on it would carry it (`Geometry::layer`).
+    pub name: String,
+    /// How the drawing hides it.
+    pub why: LayerHidden,
+    /// Entities (DXF, each block instance counted) or elements (SVG) skipped with it.
+    pub skipped: usize,
 }
 
 /// The result of an import.
@@ -70,6 +150,10 @@ pub struct Imported {
     pub warnings: Vec<Warning>,
     /// Page size in mm (width, height).
     pub page_mm: [f64; 2],
+    /// Layers left out because the drawing hides them (each also has a warning).
+    pub skipped_layers: Vec<SkippedLayer>,
+    /// How far the placement moved the artwork (mm; zero when it stays as in the file).
+    pub moved_mm: [f64; 2],
 }
 
 /// Most items an error or warning lists before "… and N more".
@@ -137,6 +221,16 @@ pub fn import_file(path: &Path, opts: &ImportOptions) -> Result<Imported, Import
         Some(Format::Dxf) => import_dxf(&bytes, &file, opts),
         None => Err(ImportError::UnknownFormat { file }),
     }
+}
+
+/// The geometries of an import placed as `opts.place` says ([`place_artwork`]); a placement
+/// that cannot be made is an error naming the file.
+fn placed(mut im: Imported, file: &str, opts: &ImportOptions) -> Result<Imported, ImportError> {
+    place_artwork(&mut im, opts).map_err(|source| ImportError::Place {
+        file: file.into(),
+        source,
+    })?;
+    Ok(im)
 }
 
 /// Something the import skipped or changed, naming the element.
@@ -213,6 +307,14 @@ pub enum ImportError {
         file: String,
         /// What was found instead.
         detail: String,
+    },
+    /// The artwork cannot be placed as asked.
+    #[error("{file}: {source}")]
+    Place {
+        /// The file.
+        file: String,
+        /// Why.
+        source: PlaceError,
     },
 }
 
