@@ -6,7 +6,7 @@ use crate::document::{
 };
 use crate::fields::{place_fields, split_oversize, FieldError, Placement};
 use crate::hatch::{is_hatch_output, layer_geometries, HatchError};
-use crate::import::{import_file, ImportError, ImportOptions};
+use crate::import::{import_file, ImportError, ImportOptions, SkippedLayer};
 use crate::job::JobCtx;
 use crate::motion::{
     label_layers, lower_motion, plan_stage_route, MotionError, OtfError, Toolpath,
@@ -71,19 +71,46 @@ pub enum PipelineError {
 }
 
 /// Imports an SVG or DXF file ([`import_file`]) into a new document with the given profile and
-/// settings; returns it with the import time in s. A DXF drawing is placed in the profile's
-/// base stroke where its extents allow (`opts.work_area_mm` unset is taken from the profile).
+/// settings; returns it with the import time in s. The artwork is placed on the profile's
+/// machine as `opts.place` says (unset `opts.work_area_mm` and `opts.field_mm` are the
+/// profile's base stroke and field; `opts.resolution_mm` is the G-code's: offsets below a unit
+/// of its last decimal are not made).
 pub fn load_svg(
     path: &Path,
     profile: MachineProfile,
     settings: SolverSettings,
     opts: &ImportOptions,
 ) -> Result<(Document, f64), PipelineError> {
+    load_artwork(path, profile, settings, opts).map(|l| (l.doc, l.import_s))
+}
+
+/// A document made by [`load_artwork`], with what the import left out or changed.
+#[derive(Debug, Clone)]
+pub struct Loaded {
+    /// The new document.
+    pub doc: Document,
+    /// Import time, s.
+    pub import_s: f64,
+    /// Layers the drawing hides, not imported (import them with
+    /// [`ImportOptions::hidden_layers`]).
+    pub skipped_layers: Vec<SkippedLayer>,
+    /// How far the placement moved the artwork, mm (zero: as in the file).
+    pub moved_mm: [f64; 2],
+}
+
+/// [`load_svg`] with the import's skipped layers and placement offset.
+pub fn load_artwork(
+    path: &Path,
+    profile: MachineProfile,
+    settings: SolverSettings,
+    opts: &ImportOptions,
+) -> Result<Loaded, PipelineError> {
     let t0 = Instant::now();
     let mut opts = opts.clone();
-    if opts.work_area_mm.is_none() {
-        opts.work_area_mm = Some(profile.stroke_mm);
-    }
+    opts.work_area_mm.get_or_insert(profile.stroke_mm);
+    opts.field_mm.get_or_insert(profile.field_mm);
+    // the G-code's resolution: a unit in its last decimal
+    opts.resolution_mm = 0.1_f64.powi(i32::try_from(profile.gcode.decimals).unwrap_or(i32::MAX));
     let imported = import_file(path, &opts)?;
     let mut layers = Vec::new();
     sync_layers(&mut layers, &imported.geometries, &default_pen(&settings));
@@ -100,7 +127,12 @@ pub fn load_svg(
         fields: Vec::new(),
         plans: Vec::new(),
     };
-    Ok((doc, t0.elapsed().as_secs_f64()))
+    Ok(Loaded {
+        doc,
+        import_s: t0.elapsed().as_secs_f64(),
+        skipped_layers: imported.skipped_layers,
+        moved_mm: imported.moved_mm,
+    })
 }
 
 /// Places fields (replacing the document's unlocked ones; locked fields stay) and orders the
