@@ -101,10 +101,9 @@ pub fn import_dxf(bytes: &[u8], file: &str, opts: &ImportOptions) -> Result<Impo
         return Err(ImportError::Empty { file: file.into() });
     }
     let drawing = load(bytes, file)?;
-    let pairs = dxf_scan::pairs(bytes);
-    let hidden = hidden_layers(&pairs, opts);
-    let unparsed = dxf_scan::entities(&pairs, |kind| !PARSED_TYPES.contains(&kind));
-    drop(pairs);
+    let scanned = dxf_scan::scan(bytes, |kind| !PARSED_TYPES.contains(&kind));
+    let hidden = hidden_layers(scanned.layers, opts);
+    let unparsed = scanned.entities;
     let mut warnings = Vec::new();
     let unit_mm = units_mm(drawing.header.default_drawing_units, &mut warnings);
     let mut walk = Walk {
@@ -158,8 +157,11 @@ pub fn import_dxf(bytes: &[u8], file: &str, opts: &ImportOptions) -> Result<Impo
 
 /// The layers the drawing hides and the import skips (by upper-case name): off or frozen in
 /// the layer table and not named by `opts.hidden_layers`.
-fn hidden_layers(pairs: &[dxf_scan::Pair], opts: &ImportOptions) -> FxHashMap<String, LayerHidden> {
-    dxf_scan::layer_states(pairs)
+fn hidden_layers(
+    layers: Vec<(String, dxf_scan::LayerState)>,
+    opts: &ImportOptions,
+) -> FxHashMap<String, LayerHidden> {
+    layers
         .into_iter()
         .filter_map(|(name, state)| {
             let why = match (state.off, state.frozen) {

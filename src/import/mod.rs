@@ -90,7 +90,7 @@ pub enum HiddenLayers {
     Skip,
     /// All imported (`--include-hidden-layers`).
     IncludeAll,
-    /// These layers (by name; DXF layer names compare without case) imported, others skipped.
+    /// These layers (by name, compared without case) imported, others skipped.
     Include(Vec<String>),
 }
 

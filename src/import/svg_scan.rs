@@ -115,6 +115,26 @@ fn line_of(xml: &Document, node: &Node) -> u32 {
     xml.text_pos_at(node.range().start).row
 }
 
+/// Line numbers by byte offset, for many lookups (`Document::text_pos_at` scans the text from
+/// its start on every call).
+struct LineIndex(Vec<usize>);
+
+impl LineIndex {
+    fn new(text: &str) -> Self {
+        LineIndex(
+            text.bytes()
+                .enumerate()
+                .filter(|&(_, b)| b == b'\n')
+                .map(|(i, _)| i)
+                .collect(),
+        )
+    }
+    /// The 1-based line holding byte `pos`.
+    fn line(&self, pos: usize) -> u32 {
+        u32::try_from(self.0.partition_point(|&nl| nl < pos) + 1).unwrap_or(u32::MAX)
+    }
+}
+
 fn is_svg(node: &Node) -> bool {
     node.tag_name().namespace().is_none_or(|ns| ns == SVG_NS)
 }
@@ -205,9 +225,10 @@ pub(super) fn apply_edits(text: &str, edits: &[(Range<usize>, String)]) -> Strin
 
 /// The line of each element with an `id`.
 pub(super) fn id_lines(xml: &Document) -> FxHashMap<String, u32> {
+    let index = LineIndex::new(xml.input_text());
     xml.descendants()
         .filter(|n| n.is_element())
-        .filter_map(|n| Some((n.attribute("id")?.to_string(), line_of(xml, &n))))
+        .filter_map(|n| Some((n.attribute("id")?.to_string(), index.line(n.range().start))))
         .collect()
 }
 
@@ -390,6 +411,19 @@ mod tests {
 {body}
 </svg>"#
         )
+    }
+
+    #[test]
+    fn line_index_agrees_with_roxmltree() {
+        let text = doc("<rect id=\"a\"/>\n\n<g>\n<circle id=\"b\" r=\"1\"/></g>");
+        let xml = Document::parse(&text).unwrap();
+        let lines = id_lines(&xml);
+        for n in xml.descendants().filter(|n| n.is_element()) {
+            if let Some(id) = n.attribute("id") {
+                assert_eq!(lines[id], line_of(&xml, &n), "{id}");
+            }
+        }
+        assert_eq!((lines["a"], lines["b"]), (3, 6));
     }
 
     #[test]
