@@ -695,3 +695,18 @@ fn cli_prints_progress_lines_when_stderr_is_not_a_terminal() {
         "{err}"
     );
 }
+
+#[test]
+fn glyphs_with_an_empty_contour_are_not_warned_about() {
+    // DejaVu Sans' "u" has an empty contour besides its outline: it was one "zero length;
+    // skipped" warning per letter
+    let svg = r#"<svg xmlns="http://www.w3.org/2000/svg" width="100mm" height="40mm" viewBox="0 0 100 40"><text id="t" x="5" y="20" font-size="10" font-family="DejaVu Sans">uuu umu</text></svg>"#;
+    let o = ImportOptions {
+        fonts: FontSource::BundledOnly,
+        ..ImportOptions::default()
+    };
+    let im = galvoplan::import::import_svg(svg.as_bytes(), "u.svg", &o).unwrap();
+    assert!(im.warnings.is_empty(), "{:?}", im.warnings);
+    assert_eq!(im.geometries.len(), 6);
+    assert!(im.geometries.iter().all(|g| g.closed));
+}
