@@ -4,7 +4,7 @@ use crate::document::{
     pen_of, sync_layers, DerivedKey, Document, Geometry, Layer, MachineProfile, MotionMode, Pen,
     PenLibrary, Plan, ScanField, SolverSettings, StageRouteKind, Step,
 };
-use crate::fields::{place_fields, split_oversize, FieldError, Placement};
+use crate::fields::{check_artwork, place_fields, split_oversize, FieldError, Placement};
 use crate::hatch::{is_hatch_output, layer_geometries, HatchError};
 use crate::import::{import_file, ImportError, ImportOptions, SkippedLayer};
 use crate::job::JobCtx;
@@ -335,6 +335,11 @@ pub fn place_document_fields(doc: &mut Document, ctx: &JobCtx) -> Result<usize, 
     }
     let file = doc.source.clone().unwrap_or_else(|| "document".into());
     if doc.settings.split_oversize {
+        // artwork beyond the reach is not helped by cutting: said before a warning per cut
+        check_artwork(&doc.geometries, &doc.profile).map_err(|source| PipelineError::Fields {
+            file: file.clone(),
+            source,
+        })?;
         let warnings = split_oversize(&mut doc.geometries, doc.profile.field_mm);
         if !warnings.is_empty() {
             // indices changed: fields and plans of the old geometry list are void

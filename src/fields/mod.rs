@@ -20,7 +20,7 @@ pub use edit::{
     add_field, delete_field, move_field, reallocate, replace_automatically, set_locked, EditError,
 };
 pub use greedy::greedy_fields;
-pub use reach::{center_range, check_reach, Span};
+pub use reach::{center_range, check_artwork, check_reach, Span};
 pub use split::{is_oversize, split_geometry, split_oversize};
 
 use crate::document::{FieldsMode, Geometry, MachineProfile, ScanField, SolverSettings};

@@ -86,10 +86,9 @@ pub(super) fn artwork_message(extent: &[f64; 4], stroke: &[f64; 2], field: &[f64
     }
 }
 
-/// Fails when the artwork as a whole is not within the laser's reach (too large, or in the
-/// wrong place: [`FieldError::Artwork`]), then with every geometry larger than a field, then
-/// with every geometry out of reach.
-pub fn check_reach(geometries: &[Geometry], profile: &MachineProfile) -> Result<(), FieldError> {
+/// Fails when the artwork as a whole is not within the laser's reach: larger than it, or in the
+/// wrong place ([`FieldError::Artwork`], with its size against the reach).
+pub fn check_artwork(geometries: &[Geometry], profile: &MachineProfile) -> Result<(), FieldError> {
     let extent = geometries
         .iter()
         .fold(BBox::EMPTY, |b, g| b.union(g.bbox()));
@@ -107,6 +106,14 @@ pub fn check_reach(geometries: &[Geometry], profile: &MachineProfile) -> Result<
             field_mm: profile.field_mm,
         });
     }
+    Ok(())
+}
+
+/// Fails when the artwork as a whole is not within the laser's reach ([`check_artwork`]), then
+/// with every geometry larger than a field, then with every geometry out of reach.
+pub fn check_reach(geometries: &[Geometry], profile: &MachineProfile) -> Result<(), FieldError> {
+    check_artwork(geometries, profile)?;
+    let [fw, fh] = profile.field_mm;
     let oversize: Vec<String> = geometries
         .iter()
         .enumerate()
