@@ -531,7 +531,7 @@ fn svg_hidden_shapes_layers_and_display_none_are_skipped_and_said() {
 }
 
 #[test]
-fn svg_broken_use_and_flowroot_are_named_with_their_lines() {
+fn svg_broken_use_flowroot_and_clip_reference_are_named_with_their_lines() {
     let im = import("broken-refs.svg", &opts());
     assert_eq!(im.geometries.len(), 1);
     assert_eq!(im.geometries[0].source.element, "#shown");
@@ -539,11 +539,13 @@ fn svg_broken_use_and_flowroot_are_named_with_their_lines() {
     assert_eq!(
         w,
         [
-            "<use id=\"missing\"> (line 7): refers to #gear, which is not in the file; skipped",
-            "<use id=\"external\"> (line 8): refers to 'parts.svg#gear' in another file, which \
+            "<use id=\"missing\"> (line 8): refers to #gear, which is not in the file; skipped",
+            "<use id=\"external\"> (line 9): refers to 'parts.svg#gear' in another file, which \
              is not read; skipped (put the element in this file)",
-            "<flowRoot id=\"flowRoot1\"> (line 9): Inkscape flowed text \"Serial 0042\" is not \
+            "<flowRoot id=\"flowRoot1\"> (line 10): Inkscape flowed text \"Serial 0042\" is not \
              supported; skipped (in Inkscape: Text ▸ Convert to Text)",
+            "<circle id=\"unclipped\"> (line 14): clip-path refers to #lost, which is not in the \
+             file; the element was skipped",
         ]
     );
 }

@@ -199,6 +199,30 @@ fn unhide(node: &Node, edits: &mut Vec<(Range<usize>, String)>) {
     }
 }
 
+/// The edit that hides an element: `display:none` as the last declaration of its `style`
+/// (which wins over attributes and earlier declarations), or a new `style` attribute.
+fn hide(text: &str, node: &Node, edits: &mut Vec<(Range<usize>, String)>) {
+    let style = node
+        .attributes()
+        .find(|a| a.name() == "style" && a.namespace().is_none());
+    match style {
+        Some(a) => edits.push((
+            a.range_value(),
+            format!("{};display:none", xml_escape(a.value())),
+        )),
+        None => {
+            // right after the tag name as written (with its prefix, if any)
+            let start = node.range().start + 1;
+            let name_len = text
+                .get(start..)
+                .and_then(|t| t.find(|c: char| c.is_whitespace() || c == '/' || c == '>'))
+                .unwrap_or(0);
+            let at = start + name_len;
+            edits.push((at..at, " style=\"display:none\"".into()));
+        }
+    }
+}
+
 fn xml_escape(s: &str) -> String {
     s.replace('&', "&amp;")
         .replace('<', "&lt;")
@@ -266,6 +290,56 @@ fn broken_use(node: &Node, ids: &FxHashMap<&str, Node>) -> Option<String> {
             "refers to #{id}, a <{}> that is not drawn; skipped",
             target.tag_name().name()
         ));
+    }
+    None
+}
+
+/// The value of a presentation property: its `style` declaration, else its attribute.
+fn property<'a>(node: &Node<'a, '_>, name: &str) -> Option<&'a str> {
+    let from_style = node.attribute("style").and_then(|s| {
+        s.split(';')
+            .filter_map(|d| d.split_once(':'))
+            .filter(|(k, _)| k.trim() == name)
+            .map(|(_, v)| v.trim())
+            .next_back()
+    });
+    from_style.or_else(|| node.attribute(name).map(str::trim))
+}
+
+/// Why an element with a `clip-path` or `mask` usvg cannot use draws nothing (usvg drops such
+/// an element without a word; browsers differ), if it does not.
+fn broken_link(node: &Node, ids: &FxHashMap<&str, Node>) -> Option<String> {
+    for (property_name, tag) in [("clip-path", "clipPath"), ("mask", "mask")] {
+        let Some(value) = property(node, property_name) else {
+            continue;
+        };
+        if value == "none" || value.is_empty() {
+            continue;
+        }
+        let id = value
+            .strip_prefix("url(")
+            .and_then(|v| v.strip_suffix(')'))
+            .map(|v| v.trim().trim_matches(['"', '\'']))
+            .and_then(|v| v.strip_prefix('#'));
+        let Some(id) = id else {
+            return Some(format!(
+                "{property_name} '{value}' is not a reference to a <{tag}> in this file; the element was skipped"
+            ));
+        };
+        match ids.get(id) {
+            None => {
+                return Some(format!(
+                    "{property_name} refers to #{id}, which is not in the file; the element was skipped"
+                ))
+            }
+            Some(t) if t.tag_name().name() != tag => {
+                return Some(format!(
+                    "{property_name} refers to #{id}, a <{}> and not a <{tag}>; the element was skipped",
+                    t.tag_name().name()
+                ))
+            }
+            Some(_) => {}
+        }
     }
     None
 }
@@ -377,6 +451,12 @@ pub(super) fn scan(xml: &Document, hidden: &HiddenLayers) -> Scan {
         if NOT_RENDERED.contains(&name) {
             continue;
         }
+        if let Some(why) = broken_link(&node, &ids) {
+            // usvg would draw it unclipped (or unmasked): hidden instead
+            hide(xml.input_text(), &node, &mut out.edits);
+            warn(&mut out, why);
+            continue;
+        }
         if name == "use" {
             if let Some(why) = broken_use(&node, &ids) {
                 warn(&mut out, why);
@@ -461,6 +541,40 @@ mod tests {
         let shown = apply_edits(&text, &all.edits);
         assert!(shown.contains(r#"display="inline""#), "{shown}");
         assert!(all.skipped_layers.is_empty());
+    }
+
+    #[test]
+    fn elements_with_broken_clip_or_mask_references_are_hidden_and_named() {
+        let text = doc(r##"<clipPath id="c"><rect width="1" height="1"/></clipPath>
+<rect id="ok" width="1" height="1" clip-path="url(#c)"/>
+<svg:rect xmlns:svg="http://www.w3.org/2000/svg" id="lost" width="1" height="1" clip-path="url(#nothere)"/>
+<circle id="m" r="1" style="fill:red" mask="url('#c')"/>"##);
+        let xml = Document::parse(&text).unwrap();
+        let s = scan(&xml, &HiddenLayers::Skip);
+        let w: Vec<String> = s.warnings.iter().map(|w| w.to_string()).collect();
+        assert_eq!(
+            w,
+            [
+                "<rect id=\"lost\"> (line 5): clip-path refers to #nothere, which is not in the file; the element was skipped",
+                "<circle id=\"m\"> (line 6): mask refers to #c, a <clipPath> and not a <mask>; the element was skipped",
+            ]
+        );
+        let edited = apply_edits(&text, &s.edits);
+        assert!(
+            edited.contains(r#"<svg:rect style="display:none" xmlns:svg"#),
+            "{edited}"
+        );
+        assert!(
+            edited.contains(r#"style="fill:red;display:none""#),
+            "{edited}"
+        );
+        let again = Document::parse(&edited).unwrap();
+        let hidden: Vec<&str> = again
+            .descendants()
+            .filter(|n| n.is_element() && display_none(n))
+            .filter_map(|n| n.attribute("id"))
+            .collect();
+        assert_eq!(hidden, ["lost", "m"]);
     }
 
     #[test]
