@@ -1,12 +1,12 @@
 //! The whole pipeline on a [`Document`]: import → fields → order → metrics, with stage times.
 
 use crate::document::{
-    is_hatch_output, sync_layers, DerivedKey, Document, MachineProfile, MotionMode, Pen,
-    PenLibrary, Plan, PlanInputs, ScanField, SolverSettings, StageRouteKind,
+    is_hatch_output, sync_layers, ArtworkImport, DerivedKey, Document, MachineProfile, MotionMode,
+    Pen, PenLibrary, Plan, PlanInputs, ScanField, SolverSettings, StageRouteKind,
 };
-use crate::fields::{place_fields, split_oversize, FieldError, Placement};
+use crate::fields::{check_artwork, place_fields, split_oversize, FieldError, Placement};
 use crate::hatch::{layer_geometries, HatchError};
-use crate::import::{import_file, ImportError, ImportOptions};
+use crate::import::{import_file, ImportError, ImportOptions, SkippedLayer};
 use crate::job::JobCtx;
 use crate::motion::{lower_motion, plan_stage_route, MotionError, OtfError, Toolpath};
 pub use crate::order::expand_passes;
@@ -81,6 +81,9 @@ pub enum PipelineError {
 pub enum Remedy {
     /// Geometries are larger than a scan field: cut them at field borders, or mark on the fly.
     SplitOversize,
+    /// The artwork fits within the laser's reach but lies outside it: place it elsewhere
+    /// (centred on the base stroke, or at a corner).
+    Place,
 }
 
 impl PipelineError {
@@ -91,25 +94,53 @@ impl PipelineError {
                 source: FieldError::Oversize { .. },
                 ..
             } => Some(Remedy::SplitOversize),
+            PipelineError::Fields { source, .. } if source.fits_once_moved() => Some(Remedy::Place),
             _ => None,
         }
     }
 }
 
 /// Imports an SVG or DXF file ([`import_file`]) into a new document with the given profile and
-/// settings; returns it with the import time in s. A DXF drawing is placed in the profile's
-/// base stroke where its extents allow (`opts.work_area_mm` unset is taken from the profile).
+/// settings; returns it with the import time in s. The artwork is placed on the profile's
+/// machine as `opts.place` says (unset `opts.work_area_mm` and `opts.field_mm` are the
+/// profile's base stroke and field; `opts.resolution_mm` is the G-code's: offsets below a unit
+/// of its last decimal are not made).
 pub fn load_svg(
     path: &Path,
     profile: MachineProfile,
     settings: SolverSettings,
     opts: &ImportOptions,
 ) -> Result<(Document, f64), PipelineError> {
+    load_artwork(path, profile, settings, opts).map(|l| (l.doc, l.import_s))
+}
+
+/// A document made by [`load_artwork`], with what the import left out or changed.
+#[derive(Debug, Clone)]
+pub struct Loaded {
+    /// The new document.
+    pub doc: Document,
+    /// Import time, s.
+    pub import_s: f64,
+    /// Layers the drawing hides, not imported (import them with
+    /// [`ImportOptions::hidden_layers`]).
+    pub skipped_layers: Vec<SkippedLayer>,
+    /// How far the placement moved the artwork, mm (zero: as in the file).
+    pub moved_mm: [f64; 2],
+}
+
+/// [`load_svg`] with the import's skipped layers and placement offset.
+pub fn load_artwork(
+    path: &Path,
+    profile: MachineProfile,
+    settings: SolverSettings,
+    opts: &ImportOptions,
+) -> Result<Loaded, PipelineError> {
     let t0 = Instant::now();
     let mut opts = opts.clone();
-    if opts.work_area_mm.is_none() {
-        opts.work_area_mm = Some(profile.stroke_mm);
-    }
+    opts.work_area_mm.get_or_insert(profile.stroke_mm);
+    opts.field_mm.get_or_insert(profile.field_mm);
+    // the G-code's resolution: a unit in its last decimal
+    opts.resolution_mm = 0.1_f64.powi(i32::try_from(profile.gcode.decimals).unwrap_or(i32::MAX));
     let imported = import_file(path, &opts)?;
     let mut layers = Vec::new();
     sync_layers(&mut layers, &imported.geometries, &default_pen(&settings));
@@ -122,9 +153,19 @@ pub fn load_svg(
         warnings: imported.warnings,
         profile,
         settings,
+        import: ArtworkImport {
+            place: opts.place,
+            hidden_layers: imported.skipped_layers.clone(),
+            included: Vec::new(),
+        },
         ..Document::default()
     };
-    Ok((doc, t0.elapsed().as_secs_f64()))
+    Ok(Loaded {
+        doc,
+        import_s: t0.elapsed().as_secs_f64(),
+        skipped_layers: imported.skipped_layers,
+        moved_mm: imported.moved_mm,
+    })
 }
 
 /// Places fields (replacing the document's unlocked ones; locked fields stay) and orders the
@@ -287,6 +328,11 @@ pub fn place_document_fields(doc: &mut Document, ctx: &JobCtx) -> Result<usize, 
     }
     let file = doc.source.clone().unwrap_or_else(|| "document".into());
     if doc.settings.split_oversize {
+        // artwork beyond the reach is not helped by cutting: said before a warning per cut
+        check_artwork(&doc.geometries, &doc.profile).map_err(|source| PipelineError::Fields {
+            file: file.clone(),
+            source,
+        })?;
         let mut geometries = doc.geometries.clone();
         let warnings = split_oversize(&mut geometries, doc.profile.field_mm);
         if !warnings.is_empty() {

@@ -4,7 +4,7 @@
 
 use galvoplan::geom::{point_segment_dist, Pt};
 use galvoplan::import::{
-    import_dxf, import_file, FontSource, ImportError, ImportOptions, Imported,
+    import_dxf, import_file, FontSource, ImportError, ImportOptions, Imported, Place,
 };
 use std::path::Path;
 
@@ -15,6 +15,7 @@ fn opts(tol: f64) -> ImportOptions {
         chord_tol_mm: tol,
         fonts: FontSource::BundledOnly,
         work_area_mm: Some([300.0, 300.0]),
+        ..ImportOptions::default()
     }
 }
 
@@ -164,15 +165,49 @@ fn y_up_is_flipped_never_mirrored_and_the_origin_stays() {
 }
 
 #[test]
-fn negative_or_far_drawings_move_into_the_work_area_with_a_warning() {
+fn drawings_out_of_reach_are_centred_on_the_work_area_with_a_warning() {
+    // x −50…10, y −20…0 in the DXF: y_mm = 0 − y, then centred on the 300 × 300 mm work area
+    // (no field given: the reach is the work area itself)
     let im = import_text(&minimal(&line("0", (-50.0, -20.0), (10.0, 0.0)), Some(4))).unwrap();
     assert_eq!(
         im.geometries[0].points,
-        [Pt::new(0.0, 20.0), Pt::new(60.0, 0.0)]
+        [Pt::new(120.0, 160.0), Pt::new(180.0, 140.0)]
     );
-    assert!(im.warnings.iter().any(|w| w.message.contains("moved by")));
+    assert_eq!(im.moved_mm, [170.0, 140.0]);
+    assert_eq!(im.page_mm, [300.0, 300.0]);
+    let w: Vec<String> = im.warnings.iter().map(|w| w.to_string()).collect();
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(
+        w[0].starts_with(
+            "artwork: lies out of reach where the file puts it (x -50.0…10.0, y 0.0…20.0 mm"
+        ) && w[0].contains("moved by (170.0000, 140.0000) mm"),
+        "{w:?}"
+    );
     let far = import_text(&minimal(&line("0", (1000.0, 0.0), (1010.0, 10.0)), Some(4))).unwrap();
-    assert_eq!(far.geometries[0].points[0], Pt::new(0.0, 10.0));
+    assert_eq!(far.geometries[0].points[0], Pt::new(145.0, 155.0));
+    // as in the file when asked, even out of reach (the field stage then says so)
+    let o = ImportOptions {
+        place: Place::AsIs,
+        ..opts(0.01)
+    };
+    let bytes = minimal(&line("0", (1000.0, 0.0), (1010.0, 10.0)), Some(4));
+    let kept = import_dxf(bytes.as_bytes(), "far.dxf", &o).unwrap();
+    assert_eq!(kept.geometries[0].points[0], Pt::new(1000.0, 10.0));
+    assert!(kept.warnings.is_empty());
+}
+
+#[test]
+fn a_drawing_a_few_micrometres_below_the_origin_is_not_moved_when_the_laser_reaches_it() {
+    // LibreCAD's paisley.dxf: 2 µm below y = 0, once reported as "moved by (0.000, 0.000) mm"
+    let o = ImportOptions {
+        field_mm: Some([70.0, 70.0]),
+        ..opts(0.01)
+    };
+    let bytes = minimal(&line("0", (0.0, -0.002), (100.0, 50.0)), Some(4));
+    let im = import_dxf(bytes.as_bytes(), "paisley.dxf", &o).unwrap();
+    assert!(im.warnings.is_empty(), "{:?}", im.warnings);
+    assert_eq!(im.moved_mm, [0.0, 0.0]);
+    assert_eq!(im.geometries[0].points[0], Pt::new(0.0, 50.002));
 }
 
 #[test]

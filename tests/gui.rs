@@ -1536,3 +1536,78 @@ fn nothing_is_cut_off_on_the_smallest_window() {
         }
     }
 }
+
+#[test]
+fn hidden_layers_are_listed_greyed_and_included_with_one_click_then_undone() {
+    let dxf = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/hidden/hidden-layers.dxf");
+    let mut h = opened(&dxf);
+    let before = h.state().session.doc.geometries.len();
+    assert_eq!(before, 1);
+    assert!(
+        h.state()
+            .status()
+            .contains("2 layers the drawing hides not marked"),
+        "{}",
+        h.state().status()
+    );
+    let layers = format!("Layers ({})", h.state().session.doc.layers.len());
+    section(&mut h, &layers);
+    h.get_by_label_contains("OFF: off, 1 item, not marked");
+    h.get_by_label_contains("FROZEN: frozen, 1 item, not marked");
+    // the first "Include" is the OFF layer's
+    h.get_all_by_label("Include").next().unwrap().click();
+    h.step();
+    wait_idle(&mut h, Duration::from_secs(60));
+    assert_eq!(h.state().session.doc.geometries.len(), 2);
+    assert_eq!(h.state().session.doc.import.included, ["OFF"]);
+    h.get_by_label_contains("OFF: off, 1 item, marked");
+    assert!(h.state().uncovered().is_empty());
+    h.get_by_label("Undo").click();
+    h.run();
+    assert_eq!(h.state().session.doc.geometries.len(), 1);
+    h.get_by_label_contains("OFF: off, 1 item, not marked");
+}
+
+#[test]
+fn placement_centres_the_artwork_on_the_base_stroke() {
+    let sheet = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/hidden/boxes-331x351.svg");
+    let mut h = opened(&sheet);
+    let bbox = |h: &Harness<'_, App>| {
+        h.state()
+            .session
+            .doc
+            .geometries
+            .iter()
+            .fold(galvoplan::geom::BBox::EMPTY, |b, g| b.union(g.bbox()))
+    };
+    let layers = format!("Layers ({})", h.state().session.doc.layers.len());
+    section(&mut h, &layers);
+    // as in the file: out of reach, and the error names the control that helps
+    h.get_by_label("Placement").click();
+    h.run();
+    h.get_by_label("as in the file").click();
+    h.step();
+    wait_idle(&mut h, Duration::from_secs(60));
+    assert!((bbox(&h).min_x - 10.0).abs() < 1e-3, "{:?}", bbox(&h));
+    let status = h.state().status().to_string();
+    assert!(
+        status.contains("out of reach") && status.contains("Placement: centred on the base stroke"),
+        "{status}"
+    );
+    h.get_by_label("Placement").click();
+    h.run();
+    h.get_by_label("centred on the base stroke").click();
+    h.step();
+    wait_idle(&mut h, Duration::from_secs(60));
+    let b = bbox(&h);
+    let stroke = h.state().session.doc.profile.stroke_mm;
+    assert!(
+        ((b.min_x + b.max_x) / 2.0 - stroke[0] / 2.0).abs() < 1e-3,
+        "{b:?}"
+    );
+    assert!(
+        ((b.min_y + b.max_y) / 2.0 - stroke[1] / 2.0).abs() < 1e-3,
+        "{b:?}"
+    );
+    assert!(h.state().uncovered().is_empty());
+}

@@ -7,8 +7,8 @@
 //! together.
 
 use crate::document::{
-    validate_layers, DerivedKey, Document, Geometry, GeometryRevision, Layer, MachineProfile, Plan,
-    ScanField, SolverSettings, Warning,
+    validate_layers, ArtworkImport, DerivedKey, Document, Geometry, GeometryRevision, Layer,
+    MachineProfile, Plan, ScanField, SolverSettings, Warning,
 };
 use crate::fields::{add_field, delete_field, move_field, reallocate, set_locked};
 use crate::geom::Pt;
@@ -150,6 +150,9 @@ pub fn apply(doc: &mut Document, cmd: &Command) -> Result<Outcome, String> {
         }
         Command::SetContent { doc: new, .. } => {
             new.validate().map_err(|e| e.to_string())?;
+            doc.artwork = new.artwork.clone();
+            doc.page_mm = new.page_mm;
+            doc.import = new.import.clone();
             doc.geometries = new.geometries.clone();
             doc.geometry_rev = new.geometry_rev;
             doc.kept_geometries = new.kept_geometries.clone();
@@ -163,9 +166,13 @@ pub fn apply(doc: &mut Document, cmd: &Command) -> Result<Outcome, String> {
     }
 }
 
-/// The geometries (with their revision and the kept revisions), plans and warnings.
+/// The artwork (with its page and import choices), the geometries (with their revision and
+/// the kept revisions), plans and warnings.
 #[derive(Debug, Clone)]
 struct Content {
+    artwork: Vec<Geometry>,
+    page_mm: [f64; 2],
+    import: ArtworkImport,
     geometries: Vec<Geometry>,
     geometry_rev: u64,
     kept_geometries: Vec<GeometryRevision>,
@@ -176,6 +183,9 @@ struct Content {
 impl Content {
     fn of(doc: &Document) -> Self {
         Self {
+            artwork: doc.artwork.clone(),
+            page_mm: doc.page_mm,
+            import: doc.import.clone(),
             geometries: doc.geometries.clone(),
             geometry_rev: doc.geometry_rev,
             kept_geometries: doc.kept_geometries.clone(),
@@ -186,6 +196,9 @@ impl Content {
     /// Puts this content into the document and returns what it replaced.
     fn swap(self, doc: &mut Document) -> Self {
         Self {
+            artwork: std::mem::replace(&mut doc.artwork, self.artwork),
+            page_mm: std::mem::replace(&mut doc.page_mm, self.page_mm),
+            import: std::mem::replace(&mut doc.import, self.import),
             geometries: std::mem::replace(&mut doc.geometries, self.geometries),
             geometry_rev: std::mem::replace(&mut doc.geometry_rev, self.geometry_rev),
             kept_geometries: std::mem::replace(&mut doc.kept_geometries, self.kept_geometries),

@@ -2,13 +2,15 @@
 //! Dialogs (rfd) are optional: without a desktop portal they return `None` at once, and every
 //! operation is also reachable through the [`App`](super::App) methods that take a path.
 
-use crate::document::{load_project, write_atomic, Document, MachineProfile, Plan, SolverSettings};
+use crate::document::{
+    load_project, write_atomic, ArtworkImport, Document, MachineProfile, Plan, SolverSettings,
+};
 use crate::export::{preview_svg, report_json, trajectory_csv, trajectory_period_s, write_gcode};
-use crate::import::ImportOptions;
+use crate::import::{HiddenLayers, ImportOptions};
 use crate::job::JobCtx;
 use crate::motion::Toolpath;
-use crate::pipeline::{load_svg, place_document_fields};
-use crate::pipeline::{lower_plan, lower_plan_on};
+use crate::pipeline::{derive_geometries, lower_plan, lower_plan_on};
+use crate::pipeline::{load_artwork, place_document_fields};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -61,13 +63,14 @@ pub fn open(
     ctx: &JobCtx,
 ) -> Result<Opened, String> {
     if is_artwork(path) {
-        let (mut doc, _) = load_svg(
+        let mut doc = load_artwork(
             path,
             profile.clone(),
             settings.clone(),
             &ImportOptions::default(),
         )
-        .map_err(|e| e.to_string())?;
+        .map_err(|e| e.to_string())?
+        .doc;
         let problem = match place_document_fields(&mut doc, ctx) {
             Ok(_) => None,
             Err(e) if ctx.is_cancelled() => {
@@ -88,6 +91,73 @@ pub fn open(
             is_project: true,
         })
     }
+}
+
+/// Imports `doc`'s artwork file again with the choices of `import` (placement, hidden layers
+/// included) into a copy of `doc`: its layers and pens, profile, settings and plans stay;
+/// geometries are made again and the unlocked fields placed again when they changed. Fields
+/// that cannot be placed (artwork out of reach) leave the document without unlocked fields and
+/// say why, as opening does.
+pub fn reimport(
+    doc: &Document,
+    import: ArtworkImport,
+    ctx: &JobCtx,
+) -> Result<(Document, Option<String>), String> {
+    let source = doc
+        .source
+        .clone()
+        .ok_or("the document has no artwork file to import again")?;
+    let opts = ImportOptions {
+        place: import.place,
+        hidden_layers: HiddenLayers::Include(import.included.clone()),
+        ..ImportOptions::default()
+    };
+    let loaded = load_artwork(
+        Path::new(&source),
+        doc.profile.clone(),
+        doc.settings.clone(),
+        &opts,
+    )
+    .map_err(|e| e.to_string())?;
+    let mut work = doc.clone();
+    work.artwork = loaded.doc.artwork;
+    work.page_mm = loaded.doc.page_mm;
+    work.warnings = loaded.doc.warnings;
+    // every hidden layer stays known, also those imported this time
+    let mut hidden = import.hidden_layers;
+    for l in loaded.skipped_layers {
+        if !hidden.iter().any(|h| h.name == l.name) {
+            hidden.push(l);
+        }
+    }
+    work.import = ArtworkImport {
+        place: import.place,
+        hidden_layers: hidden,
+        included: import.included,
+    };
+    work.derived_with = None;
+    let before = work.geometry_rev;
+    derive_geometries(&mut work, ctx).map_err(|e| e.to_string())?;
+    if work.geometry_rev == before {
+        return Ok((work, None));
+    }
+    match place_document_fields(&mut work, ctx) {
+        Ok(_) => Ok((work, None)),
+        Err(e) if ctx.is_cancelled() => Err(format!("cancelled ({e})")),
+        Err(e) => {
+            work.fields.retain(|f| f.locked);
+            Ok((work, Some(super::gui_error(&e))))
+        }
+    }
+}
+
+/// True when `doc`'s artwork can be imported again: it came from an SVG or DXF that is
+/// still there.
+pub fn can_reimport(doc: &Document) -> bool {
+    doc.source
+        .as_deref()
+        .map(Path::new)
+        .is_some_and(|p| is_artwork(p) && p.is_file())
 }
 
 /// What can be exported from a plan.

@@ -63,6 +63,9 @@ pub enum JobResult {
         doc: Box<Document>,
         /// What the job did, for the status line and the undo menu.
         what: String,
+        /// Why fields could not be placed (the document is taken all the same, its
+        /// geometries uncovered), in the GUI's words.
+        problem: Option<String>,
     },
     /// An export written.
     Exported {

@@ -5,7 +5,7 @@
 
 use super::prompts::PathAction;
 use crate::document::spec::{self, FieldSpec};
-use crate::document::{Layer, MachineProfile, Pen};
+use crate::document::{ArtworkImport, Layer, MachineProfile, Pen, Place};
 use crate::hatch::{HatchSettings, HatchStyle, OutlineMode};
 use egui::{Color32, RichText};
 
@@ -98,6 +98,8 @@ pub enum LayerAction {
     Set(Vec<Layer>),
     /// Load or save a pen library.
     File(PathAction),
+    /// Import the artwork again with these choices (placement, hidden layers included).
+    Reimport(ArtworkImport),
 }
 
 /// Edit buffers of the layers panel.
@@ -107,6 +109,8 @@ pub struct LayerEditor {
     text: Vec<Vec<String>>,
     /// The rejected value: (layer, column) and the message.
     error: Option<(usize, Col, String)>,
+    /// The placement's corner as typed (x, y, mm), and the choice it was typed for.
+    corner_text: Option<(Place, [String; 2])>,
 }
 
 const COLS: [Col; 7] = [
@@ -130,13 +134,15 @@ impl LayerEditor {
         self.error.as_ref().map(|e| e.2.as_str())
     }
 
-    /// Draws the panel; `counts` are (imported, marked) geometries per layer.
+    /// Draws the panel; `counts` are (imported, marked) geometries per layer; `import` is how
+    /// the artwork was imported (`None`: it cannot be imported again, e.g. its file is gone).
     pub fn ui(
         &mut self,
         ui: &mut egui::Ui,
         layers: &[Layer],
         counts: &[(usize, usize)],
         profile: &MachineProfile,
+        import: Option<&ArtworkImport>,
         busy: Option<&str>,
     ) -> Option<LayerAction> {
         if self.synced.as_deref() != Some(layers) {
@@ -166,6 +172,12 @@ impl LayerEditor {
             }
         });
         self.message(ui, busy);
+        if let Some(import) = import {
+            if let Some(a) = self.artwork_ui(ui, import, busy.is_none()) {
+                out = Some(a);
+            }
+            ui.separator();
+        }
         if layers.is_empty() {
             ui.label("No layers: open an SVG or a project.");
         }
@@ -179,6 +191,139 @@ impl LayerEditor {
             ui.separator();
         }
         out
+    }
+
+    /// Where the artwork lies on the machine, and the layers the drawing hides (greyed, each
+    /// with a button that imports it or leaves it out again).
+    fn artwork_ui(
+        &mut self,
+        ui: &mut egui::Ui,
+        import: &ArtworkImport,
+        enabled: bool,
+    ) -> Option<LayerAction> {
+        let mut out = None;
+        let again = |place: Place, included: Vec<String>| {
+            Some(LayerAction::Reimport(ArtworkImport {
+                place,
+                hidden_layers: import.hidden_layers.clone(),
+                included,
+            }))
+        };
+        ui.add_enabled_ui(enabled, |ui| {
+            ui.horizontal(|ui| {
+                let label = ui.label("Placement").on_hover_text(
+                    "Where the artwork goes on the machine; choosing another imports the file \
+                     again",
+                );
+                let mut choice = import.place;
+                let combo = egui::ComboBox::from_id_salt("placement")
+                    .selected_text(place_words(&choice))
+                    .show_ui(ui, |ui| {
+                        let corner = match import.place {
+                            Place::Corner(xy) => Place::Corner(xy),
+                            _ => Place::Corner([0.0, 0.0]),
+                        };
+                        for p in [Place::Auto, Place::AsIs, Place::Centre, corner] {
+                            let words = place_words(&p);
+                            ui.selectable_value(&mut choice, p, words);
+                        }
+                    });
+                combo.response.labelled_by(label.id);
+                if choice != import.place {
+                    out = again(choice, import.included.clone());
+                }
+            });
+            if let Place::Corner(xy) = import.place {
+                if let Some(place) = self.corner_ui(ui, xy) {
+                    out = again(place, import.included.clone());
+                }
+            }
+            if import.hidden_layers.is_empty() {
+                return;
+            }
+            ui.label("Layers the drawing hides:")
+                .on_hover_text("Off, frozen or hidden in the file; not marked unless included");
+            for hidden in &import.hidden_layers {
+                let included = import
+                    .included
+                    .iter()
+                    .any(|n| n.eq_ignore_ascii_case(&hidden.name));
+                ui.horizontal(|ui| {
+                    let what = format!(
+                        "{}: {}, {} {}",
+                        layer_label(&hidden.name),
+                        hidden.why,
+                        hidden.skipped,
+                        if hidden.skipped == 1 { "item" } else { "items" }
+                    );
+                    if included {
+                        ui.label(format!("{what}, marked"));
+                        if ui
+                            .button("Leave out")
+                            .on_hover_text("Import the file again without this layer")
+                            .clicked()
+                        {
+                            let rest = import
+                                .included
+                                .iter()
+                                .filter(|n| !n.eq_ignore_ascii_case(&hidden.name))
+                                .cloned()
+                                .collect();
+                            out = again(import.place, rest);
+                        }
+                    } else {
+                        ui.label(RichText::new(format!("{what}, not marked")).weak());
+                        if ui
+                            .button("Include")
+                            .on_hover_text("Import the file again with this layer, to mark it")
+                            .clicked()
+                        {
+                            let mut with = import.included.clone();
+                            with.push(hidden.name.clone());
+                            out = again(import.place, with);
+                        }
+                    }
+                });
+            }
+        });
+        out
+    }
+
+    /// The corner's x and y edits (mm); a new corner once both are numbers and one was
+    /// committed.
+    fn corner_ui(&mut self, ui: &mut egui::Ui, xy: [f64; 2]) -> Option<Place> {
+        let current = Place::Corner(xy);
+        if self.corner_text.as_ref().map(|c| c.0) != Some(current) {
+            self.corner_text = Some((current, xy.map(|v| format!("{v}"))));
+        }
+        let (_, text) = self.corner_text.as_mut()?;
+        let mut committed = false;
+        ui.horizontal(|ui| {
+            ui.label("top-left corner at");
+            for (k, axis) in ["x", "y"].iter().enumerate() {
+                let label = ui.label(*axis);
+                let r = ui
+                    .add(
+                        egui::TextEdit::singleline(&mut text[k])
+                            .desired_width(EDIT_PX)
+                            .id_salt(("corner", *axis)),
+                    )
+                    .labelled_by(label.id);
+                committed |= r.lost_focus();
+            }
+            ui.label("mm");
+        });
+        let parsed = [text[0].trim().parse::<f64>(), text[1].trim().parse::<f64>()];
+        match parsed {
+            [Ok(x), Ok(y)] if committed && x.is_finite() && y.is_finite() && [x, y] != xy => {
+                Some(Place::Corner([x, y]))
+            }
+            [Ok(_), Ok(_)] => None,
+            _ => {
+                ui.colored_label(ERROR, "x and y must be numbers (mm)");
+                None
+            }
+        }
     }
 
     /// The reserved message lines: the rejected value, the running job, or a hint.
@@ -406,6 +551,16 @@ fn outline_ui(ui: &mut egui::Ui, k: usize, layer: &Layer) -> Option<Layer> {
         }
         l
     })
+}
+
+/// A placement in the panel's words.
+pub fn place_words(place: &Place) -> String {
+    match place {
+        Place::Auto => "as in the file, centred when out of reach".into(),
+        Place::AsIs => "as in the file".into(),
+        Place::Centre => "centred on the base stroke".into(),
+        Place::Corner(_) => "top-left corner at a point".into(),
+    }
 }
 
 /// How the window names a layer: its own name, or for a layer named after its stroke colour

@@ -361,17 +361,21 @@ impl App {
 
     fn layers_ui(&mut self, ui: &mut egui::Ui) {
         let busy = self.runtime.job.as_ref().map(|j| j.name.clone());
+        let import =
+            super::files::can_reimport(&self.session.doc).then_some(&self.session.doc.import);
         let action = self.view.layer_editor.ui(
             ui,
             &self.session.doc.layers,
             &self.session.layer_counts,
             &self.session.doc.profile,
+            import,
             busy.as_deref(),
         );
         let ctx = ui.ctx().clone();
         match action {
             Some(LayerAction::Set(layers)) => self.set_layers(layers, &ctx),
             Some(LayerAction::File(a)) => self.choose_path(a, &ctx),
+            Some(LayerAction::Reimport(import)) => self.reimport(import, &ctx),
             None => {}
         }
     }

@@ -389,8 +389,17 @@ impl App {
         self.refresh();
         self.changed();
         self.session.saved_revision = self.session.revision;
+        let hidden = self.session.doc.import.skipped().count();
+        let hidden = if hidden > 0 {
+            format!(
+                "; {} the drawing hides not marked (Layers panel)",
+                count(hidden, "layer", "layers")
+            )
+        } else {
+            String::new()
+        };
         let msg = format!(
-            "{}: {} on {}, {}, {}",
+            "{}: {} on {}, {}, {}{hidden}",
             path.display(),
             count(self.session.doc.geometries.len(), "geometry", "geometries"),
             count(self.session.doc.layers.len(), "layer", "layers"),
@@ -447,6 +456,27 @@ impl App {
                 Ok(JobResult::Placed {
                     doc: Box::new(work),
                     what: "re-place fields automatically".into(),
+                    problem: None,
+                })
+            },
+        );
+    }
+
+    /// Imports the artwork again with other choices (placement, hidden layers) in a background
+    /// job (undoable when it ends).
+    pub fn reimport(&mut self, import: crate::document::ArtworkImport, repaint: &egui::Context) {
+        let what = import_change(&self.session.doc.import, &import);
+        let doc = self.session.doc.clone();
+        self.start_job(
+            format!("importing again: {what}"),
+            "import",
+            repaint,
+            move |ctx| {
+                let (doc, problem) = files::reimport(&doc, import, ctx)?;
+                Ok(JobResult::Placed {
+                    doc: Box::new(doc),
+                    what,
+                    problem,
                 })
             },
         );
@@ -481,6 +511,7 @@ impl App {
             Ok(JobResult::Placed {
                 doc: Box::new(work),
                 what,
+                problem: None,
             })
         });
     }
@@ -808,9 +839,13 @@ impl App {
         self.runtime.job = None;
         match outcome {
             JobOutcome::Done(JobResult::Opened { path, opened }) => self.opened(&path, *opened),
-            JobOutcome::Done(JobResult::Placed { doc, what }) => {
+            JobOutcome::Done(JobResult::Placed { doc, what, problem }) => {
                 if self.execute(Command::SetContent { doc, what }).is_ok() {
                     self.view.layer_editor.clear_error();
+                    if let Some(p) = problem {
+                        self.set_status(format!("scan fields not placed: {p}"), true);
+                        self.session.problem = Some(p);
+                    }
                 }
             }
             JobOutcome::Done(JobResult::Exported { path, kind }) => {
@@ -1043,6 +1078,28 @@ pub fn uncovered_rgb() -> [u8; 3] {
     [c.r(), c.g(), c.b()]
 }
 
+/// A change of import choices in words, for the status line and the undo menu.
+fn import_change(
+    before: &crate::document::ArtworkImport,
+    after: &crate::document::ArtworkImport,
+) -> String {
+    if before.place != after.place {
+        return match after.place {
+            crate::document::Place::Corner([x, y]) => {
+                format!("place the artwork's top-left corner at ({x}, {y}) mm")
+            }
+            p => format!("place the artwork {}", layers::place_words(&p)),
+        };
+    }
+    let added = after.included.iter().find(|n| !before.included.contains(n));
+    let removed = before.included.iter().find(|n| !after.included.contains(n));
+    match (added, removed) {
+        (Some(n), _) => format!("include hidden layer {}", layers::layer_label(n)),
+        (None, Some(n)) => format!("leave out hidden layer {}", layers::layer_label(n)),
+        (None, None) => "import the artwork again".into(),
+    }
+}
+
 /// `n` and the noun for it: "1 geometry", "3 geometries".
 pub fn count(n: usize, one: &str, many: &str) -> String {
     format!("{n} {}", if n == 1 { one } else { many })
@@ -1056,6 +1113,10 @@ pub fn gui_error(e: &crate::pipeline::PipelineError) -> String {
         Some(Remedy::SplitOversize) => format!(
             "{e}; tick \"Split oversize geometries\" in Solver settings and press \"Re-place \
              automatically\" to cut them at field borders, or choose \"On the fly\" as the motion"
+        ),
+        Some(Remedy::Place) => format!(
+            "{e}; choose \"Placement: centred on the base stroke\" in the Layers panel to move it \
+             within reach"
         ),
         None => e.to_string(),
     }

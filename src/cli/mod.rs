@@ -13,7 +13,7 @@ use galvoplan::document::{
     SolverSettings, StageRouteKind, VertexMode,
 };
 use galvoplan::hatch::{HatchSettings, OutlineMode};
-use galvoplan::import::ImportOptions;
+use galvoplan::import::{HiddenLayers, ImportOptions, Place};
 use std::path::PathBuf;
 
 /// CAM for redundant laser-marking machines (galvo scanner on an XY base stage).
@@ -161,6 +161,16 @@ struct JobOpts {
     /// Chord tolerance for flattening curves, mm.
     #[arg(long, default_value_t = 0.01)]
     chord_tol: f64,
+    /// Where the artwork goes on the machine: auto (as in the file where the laser reaches all
+    /// of it, else centred on the base stroke with a warning), as-is, centre (centred on the
+    /// base stroke), or corner:X,Y (its top-left corner at X,Y mm; y down).
+    #[arg(long, default_value = "auto", value_name = "auto|as-is|centre|corner:X,Y", value_parser = parse_place)]
+    place: Place,
+    /// Import what the drawing hides on layers: DXF layers that are off or frozen, SVG layers
+    /// (top-level groups) with display:none. Invisible DXF entities and hidden SVG shapes stay
+    /// out.
+    #[arg(long)]
+    include_hidden_layers: bool,
     /// Hatch the closed shapes: STYLE:SPACING_MM[:ANGLE_DEG], STYLE = zigzag | lines | cross |
     /// contour (closed paths of one SVG element form one region, even-odd).
     #[arg(long, value_name = "STYLE:SPACING_MM[:ANGLE_DEG]")]
@@ -320,9 +330,20 @@ impl JobOpts {
         );
         Ok(ImportOptions {
             chord_tol_mm: self.chord_tol,
+            place: self.place,
+            hidden_layers: if self.include_hidden_layers {
+                HiddenLayers::IncludeAll
+            } else {
+                HiddenLayers::Skip
+            },
             ..ImportOptions::default()
         })
     }
+}
+
+fn parse_place(s: &str) -> Result<Place, String> {
+    s.parse()
+        .map_err(|e: galvoplan::import::PlaceError| e.to_string())
 }
 
 #[derive(Args, Debug)]
@@ -415,6 +436,7 @@ fn hint(e: &anyhow::Error) -> Option<&'static str> {
         Remedy::SplitOversize => {
             "use --split-oversize to cut them at field borders, or --motion on-the-fly"
         }
+        Remedy::Place => "use --place centre or --place corner:X,Y",
     })
 }
 

@@ -8,8 +8,11 @@ use galvoplan::export::{
     check_outputs, geometry_svg, preview_svg, report_json, trajectory_csv, trajectory_period_s,
     write_gcode,
 };
+use galvoplan::import::Place;
+use galvoplan::job::Progress;
+use galvoplan::job::ProgressSink;
 use galvoplan::job::{CancelToken, JobCtx};
-use galvoplan::pipeline::{apply_pen_library, load_svg, lower_plan_on, plan_document_lowered};
+use galvoplan::pipeline::{apply_pen_library, load_artwork, lower_plan_on, plan_document_lowered};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -24,9 +27,39 @@ pub fn run(a: &PlanArgs) -> Result<()> {
         .map(|_| trajectory_period_s(a.trajectory_period_ms))
         .transpose()?;
     let pens = a.job.pens()?;
-    let (mut doc, import_s) = load_svg(&a.input, profile, settings, &opts)?;
+    let progress = Arc::new(BarProgress::new());
+    let import_progress = |done| {
+        progress.report(&Progress {
+            stage: "import",
+            done,
+            total: 1,
+            message: a.input.display().to_string(),
+        })
+    };
+    import_progress(0);
+    let loaded = load_artwork(&a.input, profile, settings, &opts);
+    import_progress(1);
+    let loaded = loaded?;
+    let (mut doc, import_s) = (loaded.doc, loaded.import_s);
     for w in &doc.warnings {
         eprintln!("galvoplan: warning: {}: {w}", a.input.display());
+    }
+    let hidden = loaded.skipped_layers.len();
+    if hidden > 0 {
+        eprintln!(
+            "galvoplan: {}: --include-hidden-layers imports the {hidden} {} the drawing hides",
+            a.input.display(),
+            if hidden == 1 { "layer" } else { "layers" }
+        );
+    }
+    let [dx, dy] = loaded.moved_mm;
+    if opts.place != Place::Auto && (dx != 0.0 || dy != 0.0) {
+        let n = doc.profile.gcode.decimals;
+        eprintln!(
+            "galvoplan: {}: artwork placed (--place {}): moved by ({dx:.n$}, {dy:.n$}) mm",
+            a.input.display(),
+            opts.place
+        );
     }
     if let Some(lib) = &pens {
         for name in apply_pen_library(&mut doc, lib) {
@@ -34,11 +67,10 @@ pub fn run(a: &PlanArgs) -> Result<()> {
             eprintln!(
                 "galvoplan: warning: {}: the pens file names layer '{name}', which the artwork does not have (its layers: {})",
                 a.input.display(),
-                known.join(", ")
+                galvoplan::document::short_list(&known, ", ")
             );
         }
     }
-    let progress = Arc::new(BarProgress::new());
     let mut ctx = JobCtx::new(CancelToken::new(), progress.clone());
     let recorder = recorder(a.rerun.as_deref())?;
     if let Some(r) = &recorder {

@@ -1,5 +1,6 @@
 //! The document model: geometries, machine profile, solver settings, scan fields and plans.
 
+mod artwork_import;
 mod geometry;
 mod hatch;
 mod inputs;
@@ -13,6 +14,7 @@ pub mod spec;
 pub mod validate;
 mod warning;
 
+pub use artwork_import::{ArtworkImport, LayerHidden, Place, PlaceError, SkippedLayer};
 pub use geometry::{is_hatch_output, Geometry, Source, HATCH_LAYER_PREFIX};
 pub use hatch::{FillRule, HatchSettings, HatchSpecError, HatchStyle, OutlineMode, MIN_SPACING_MM};
 pub use inputs::{staleness, GeometryRevision, PlanInputs};
@@ -37,7 +39,7 @@ pub use settings::{
 };
 
 use serde::{Deserialize, Serialize};
-pub use warning::Warning;
+pub use warning::{short_list, Warning, LIST_MAX};
 
 /// The parts of the layer table and profile that decide the marked geometries: per layer its
 /// name, whether it is enabled and its hatch; the field size (hatch is cut at field cells).
@@ -73,6 +75,9 @@ pub struct Document {
     /// made by the layers' pens (see `solve::derive_geometries`).
     #[serde(default)]
     pub artwork: Vec<Geometry>,
+    /// How the artwork was imported (placement, hidden layers).
+    #[serde(default)]
+    pub import: ArtworkImport,
     /// The layers of the artwork and their pens, in order of first appearance.
     #[serde(default)]
     pub layers: Vec<Layer>,

@@ -21,3 +21,15 @@ impl std::fmt::Display for Warning {
         }
     }
 }
+
+/// Most items an error or warning lists before "… and N more".
+pub const LIST_MAX: usize = 5;
+
+/// Up to [`LIST_MAX`] items joined by `sep`, then "… and N more" for the rest.
+pub fn short_list<T: std::fmt::Display>(items: &[T], sep: &str) -> String {
+    let mut out: Vec<String> = items.iter().take(LIST_MAX).map(|i| i.to_string()).collect();
+    if items.len() > LIST_MAX {
+        out.push(format!("… and {} more", items.len() - LIST_MAX));
+    }
+    out.join(sep)
+}

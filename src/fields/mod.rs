@@ -20,7 +20,7 @@ pub use edit::{
     add_field, delete_field, move_field, reallocate, replace_automatically, set_locked, EditError,
 };
 pub use greedy::greedy_fields;
-pub use reach::{center_range, check_reach, Span};
+pub use reach::{center_range, check_artwork, check_reach, Span};
 pub use split::{is_oversize, split_geometry, split_oversize};
 
 use crate::document::{FieldsMode, Geometry, MachineProfile, ScanField, SolverSettings};
@@ -33,8 +33,18 @@ pub const INSIDE_EPS_MM: f64 = 1e-7;
 /// Why fields could not be placed.
 #[derive(Debug, Error)]
 pub enum FieldError {
+    /// The artwork as a whole lies beyond the laser's reach, or is larger than it.
+    #[error("{}", reach::artwork_message(.extent_mm, .stroke_mm, .field_mm))]
+    Artwork {
+        /// The artwork's bounding box: least x, least y, greatest x, greatest y (mm).
+        extent_mm: [f64; 4],
+        /// Base stroke.
+        stroke_mm: [f64; 2],
+        /// Field size.
+        field_mm: [f64; 2],
+    },
     /// Geometries larger than one scan field.
-    #[error("{} {} larger than the {:.1} × {:.1} mm scan field: {}", .list.len(), if .list.len() == 1 { "geometry is" } else { "geometries are" }, .field_mm[0], .field_mm[1], .list.join("; "))]
+    #[error("{} {} larger than the {:.1} × {:.1} mm scan field: {}", .list.len(), if .list.len() == 1 { "geometry is" } else { "geometries are" }, .field_mm[0], .field_mm[1], crate::document::short_list(.list, "; "))]
     Oversize {
         /// Each offending geometry, described with its size.
         list: Vec<String>,
@@ -42,7 +52,7 @@ pub enum FieldError {
         field_mm: [f64; 2],
     },
     /// Geometries the laser cannot reach from any base position.
-    #[error("{} {} out of reach (base stroke {:.1} × {:.1} mm, laser reaches x and y in [{:.1}, {:.1}] mm): {}", .list.len(), if .list.len() == 1 { "geometry is" } else { "geometries are" }, .stroke_mm[0], .stroke_mm[1], -.field_mm[0] / 2.0, .stroke_mm[0] + .field_mm[0] / 2.0, .list.join("; "))]
+    #[error("{} {} out of reach (base stroke {:.1} × {:.1} mm, laser reaches x and y in [{:.1}, {:.1}] mm): {}", .list.len(), if .list.len() == 1 { "geometry is" } else { "geometries are" }, .stroke_mm[0], .stroke_mm[1], -.field_mm[0] / 2.0, .stroke_mm[0] + .field_mm[0] / 2.0, crate::document::short_list(.list, "; "))]
     OutOfReach {
         /// Each offending geometry, described with its position.
         list: Vec<String>,

@@ -64,8 +64,43 @@ fn oversize_and_out_of_reach_are_listed() {
     );
     let gs = vec![rect(340.0, 10.0, 5.0, 5.0)];
     let msg = place(&gs, &p).unwrap_err().to_string();
+    assert_eq!(
+        msg,
+        "the artwork is 5.0 × 5.0 mm at x 340.0…345.0, y 10.0…15.0 mm, out of reach where it \
+         lies: the laser reaches x -35.0…335.0, y -35.0…335.0 mm (300.0 × 300.0 mm base stroke \
+         + 70.0 × 70.0 mm scan field); it fits once moved: place it centred on the base stroke \
+         or with its corner at a chosen point"
+    );
+}
+
+#[test]
+fn lists_stop_at_five_and_huge_artwork_asks_for_a_unit_check() {
+    let p = MachineProfile::default();
+    // 12 oversize geometries: five named, then the count of the rest
+    let gs: Vec<Geometry> = (0..12)
+        .map(|i| rect(0.0, 20.0 * i as f64, 80.0, 10.0))
+        .collect();
+    let msg = place(&gs, &p).unwrap_err().to_string();
+    assert!(msg.starts_with("12 geometries are larger"), "{msg}");
     assert!(
-        msg.contains("out of reach") && msg.contains("geometry 0"),
+        msg.contains("geometry 4 ") && !msg.contains("geometry 5 "),
+        "{msg}"
+    );
+    assert!(msg.ends_with("; … and 7 more"), "{msg}");
+    // a drawing in metres read as mm: 17,600 × 11,400 mm
+    let gs = vec![rect(0.0, 0.0, 17_600.0, 1.0), rect(0.0, 11_399.0, 1.0, 1.0)];
+    let msg = place(&gs, &p).unwrap_err().to_string();
+    assert_eq!(
+        msg,
+        "the artwork is 17600.0 × 11400.0 mm, 48 times the 370.0 × 370.0 mm the laser reaches \
+         (300.0 × 300.0 mm base stroke + 70.0 × 70.0 mm scan field): check the drawing's units \
+         (DXF $INSUNITS; SVG width, height and viewBox)"
+    );
+    // a little too large: no unit check, no placement
+    let gs = vec![rect(0.0, 0.0, 60.0, 60.0), rect(340.0, 0.0, 60.0, 60.0)];
+    let msg = place(&gs, &p).unwrap_err().to_string();
+    assert!(
+        msg.starts_with("the artwork is 400.0 × 60.0 mm, larger than the 370.0 × 370.0 mm"),
         "{msg}"
     );
 }

@@ -6,14 +6,22 @@
 //! never mirrored, and a profile with the G-code Y flip writes the DXF's own coordinates. A
 //! drawing in the first quadrant keeps its position relative to the DXF origin (the page's
 //! bottom-left corner); one with negative coordinates, or outside the work area although it
-//! would fit, is moved so that its bounding box starts at the corner (with a warning).
+//! would fit, is placed by [`super::place_artwork`] like any artwork (`--place`).
+//!
+//! Hidden content is not marked: entities on layers that are off or frozen, and entities
+//! flagged invisible, are skipped with one summary warning per layer (and one for the invisible
+//! ones); [`super::HiddenLayers`] imports hidden layers anyway. As in CAD, an INSERT on a layer
+//! that is off still shows its block's entities on other layers (those on layer 0 take the
+//! insert's layer, and are off with it); an INSERT on a frozen layer shows nothing.
 
 use super::curves::{bulge_arc, fit_point_spline, Affine, ConicArc, Nurbs};
+use super::dxf_scan::{self, ScannedEntity};
 use super::dxf_text::{self, TextRun};
 use super::svg::too_many_points;
 use super::svg::Outline;
 use super::{
-    guard, normalise, nothing_to_mark, ImportError, ImportOptions, Imported, Warning, MAX_POINTS,
+    guard, normalise, nothing_to_mark, placed, ImportError, ImportOptions, Imported, LayerHidden,
+    SkippedLayer, Warning, LIST_MAX, MAX_POINTS,
 };
 use crate::document::{Geometry, Source};
 use crate::geom::{flatten_cubic, BBox, Pt};
@@ -93,7 +101,10 @@ pub fn import_dxf(bytes: &[u8], file: &str, opts: &ImportOptions) -> Result<Impo
         return Err(ImportError::Empty { file: file.into() });
     }
     let drawing = load(bytes, file)?;
-    let mut warnings = skipped_types(bytes);
+    let scanned = dxf_scan::scan(bytes, |kind| !PARSED_TYPES.contains(&kind));
+    let hidden = hidden_layers(scanned.layers, opts);
+    let unparsed = scanned.entities;
+    let mut warnings = Vec::new();
     let unit_mm = units_mm(drawing.header.default_drawing_units, &mut warnings);
     let mut walk = Walk {
         file,
@@ -107,14 +118,25 @@ pub fn import_dxf(bytes: &[u8], file: &str, opts: &ImportOptions) -> Result<Impo
         stack: Vec::new(),
         visits: 0,
         warned: FxHashSet::default(),
+        hidden,
+        skipped: Vec::new(),
+        invisible: 0,
+        invisible_listed: Vec::new(),
+        inserted: FxHashSet::default(),
     };
     let to_mm = Affine::scale(unit_mm, unit_mm);
     for e in drawing.entities() {
         walk.entity(e, &to_mm, None)?;
     }
+    let mut warnings = walk.unparsed_warnings(unparsed);
+    let (summaries, skipped_layers) = walk.hidden_summaries();
     let Walk {
-        raw, mut warnings, ..
+        raw,
+        warnings: walked,
+        ..
     } = walk;
+    warnings.extend(walked);
+    warnings.extend(summaries);
     if raw.is_empty() {
         return Err(nothing_to_mark(
             file,
@@ -122,12 +144,35 @@ pub fn import_dxf(bytes: &[u8], file: &str, opts: &ImportOptions) -> Result<Impo
             "the drawing has no entities",
         ));
     }
-    let (geometries, page_mm) = place(raw, opts.work_area_mm, &mut warnings);
-    Ok(Imported {
+    let (geometries, page_mm) = flip(raw);
+    let imported = Imported {
         geometries,
         warnings,
         page_mm,
-    })
+        skipped_layers,
+        moved_mm: [0.0, 0.0],
+    };
+    placed(imported, file, opts)
+}
+
+/// The layers the drawing hides and the import skips (by upper-case name): off or frozen in
+/// the layer table and not named by `opts.hidden_layers`.
+fn hidden_layers(
+    layers: Vec<(String, dxf_scan::LayerState)>,
+    opts: &ImportOptions,
+) -> FxHashMap<String, LayerHidden> {
+    layers
+        .into_iter()
+        .filter_map(|(name, state)| {
+            let why = match (state.off, state.frozen) {
+                (false, false) => return None,
+                (true, false) => LayerHidden::Off,
+                (false, true) => LayerHidden::Frozen,
+                (true, true) => LayerHidden::OffAndFrozen,
+            };
+            (!opts.hidden_layers.includes(&name)).then(|| (name.to_uppercase(), why))
+        })
+        .collect()
 }
 
 /// Parses the drawing; the reader's errors and panics (it has some on malformed headers) become
@@ -205,45 +250,6 @@ fn units_mm(units: Units, warnings: &mut Vec<Warning>) -> f64 {
     })
 }
 
-/// Entities the `dxf` crate skips silently (HATCH, MTEXT's cousins, MESH, …): found by scanning
-/// the ASCII code pairs of the ENTITIES and BLOCKS sections. Binary files are not scanned.
-fn skipped_types(bytes: &[u8]) -> Vec<Warning> {
-    let Ok(text) = std::str::from_utf8(bytes) else {
-        return Vec::new();
-    };
-    let lines: Vec<&str> = text.lines().map(str::trim).collect();
-    let mut out = Vec::new();
-    let mut in_geometry = false;
-    let mut i = 0;
-    while i + 1 < lines.len() {
-        let (code, value) = (lines[i], lines[i + 1]);
-        if code == "2" && i >= 2 && lines[i - 1] == "SECTION" {
-            in_geometry = value == "ENTITIES" || value == "BLOCKS";
-        } else if code == "0" && in_geometry && !PARSED_TYPES.contains(&value) {
-            let (handle, layer) = handle_and_layer(&lines[i + 2..]);
-            out.push(Warning {
-                element: format!("{value} (handle {handle}) (layer {layer})"),
-                line: u32::try_from(i + 2).ok(),
-                message: format!("{value} entities are not supported; skipped"),
-            });
-        }
-        i += 2;
-    }
-    out
-}
-
-fn handle_and_layer<'a>(pairs: &[&'a str]) -> (&'a str, &'a str) {
-    let (mut handle, mut layer) = ("?", "?");
-    for p in pairs.chunks(2).take_while(|p| p.first() != Some(&"0")) {
-        match p {
-            ["5", h] => handle = h,
-            ["8", l] => layer = l,
-            _ => {}
-        }
-    }
-    (handle, layer)
-}
-
 /// A flattened path in mm, y up, before placement.
 struct Raw {
     points: Vec<Pt>,
@@ -266,6 +272,16 @@ struct Walk<'d> {
     visits: usize,
     /// Warnings given, by element and message.
     warned: FxHashSet<(String, String)>,
+    /// Hidden layers skipped, by upper-case name.
+    hidden: FxHashMap<String, LayerHidden>,
+    /// Entities skipped per hidden layer (name as the entity writes it), in order of the first.
+    skipped: Vec<(String, LayerHidden, usize)>,
+    /// Entities skipped because they are flagged invisible (each block instance counted).
+    invisible: usize,
+    /// The first few of them, each named once.
+    invisible_listed: Vec<String>,
+    /// Blocks inserted where the drawing shows them (upper-case names).
+    inserted: FxHashSet<String>,
 }
 
 /// The DXF name of an entity type (its variant name in capitals for the rare ones).
@@ -324,6 +340,104 @@ impl<'d> Walk<'d> {
         s
     }
 
+    /// How the drawing hides `layer`, when the import skips it.
+    fn hidden_layer(&self, layer: &str) -> Option<LayerHidden> {
+        if self.hidden.is_empty() {
+            return None;
+        }
+        self.hidden.get(&layer.to_uppercase()).copied()
+    }
+
+    /// Counts one entity skipped because it is flagged invisible.
+    fn skip_invisible(&mut self, element: String) {
+        self.invisible += 1;
+        if self.invisible_listed.len() < LIST_MAX && !self.invisible_listed.contains(&element) {
+            self.invisible_listed.push(element);
+        }
+    }
+
+    /// Counts one entity skipped with its hidden layer.
+    fn skip_hidden(&mut self, layer: &str, why: LayerHidden) {
+        match self
+            .skipped
+            .iter_mut()
+            .find(|(name, _, _)| name.eq_ignore_ascii_case(layer))
+        {
+            Some((_, _, n)) => *n += 1,
+            None => self.skipped.push((layer.to_string(), why, 1)),
+        }
+    }
+
+    /// Warnings for the entity types the `dxf` crate does not read: those in blocks the drawing
+    /// never shows (not inserted, or only under a frozen or invisible insert) are dropped, hidden
+    /// and invisible ones are counted with the other hidden entities, the rest name their block.
+    fn unparsed_warnings(&mut self, unparsed: Vec<ScannedEntity>) -> Vec<Warning> {
+        let mut out = Vec::new();
+        for e in unparsed {
+            if let Some(b) = &e.block {
+                if !self.inserted.contains(&b.to_uppercase()) {
+                    continue;
+                }
+            }
+            let mut element = format!("{} (handle {})", e.kind, e.handle);
+            if let Some(b) = &e.block {
+                element.push_str(&format!(" in block {b}"));
+            }
+            if e.invisible {
+                self.skip_invisible(format!("{element} (layer {})", e.layer));
+                continue;
+            }
+            if let Some(why) = self.hidden_layer(&e.layer) {
+                self.skip_hidden(&e.layer, why);
+                continue;
+            }
+            out.push(Warning {
+                element: format!("{element} (layer {})", e.layer),
+                line: e.line,
+                message: format!("{} entities are not supported; skipped", e.kind),
+            });
+        }
+        out
+    }
+
+    /// One warning per hidden layer and one for the invisible entities; the skipped layers.
+    fn hidden_summaries(&self) -> (Vec<Warning>, Vec<SkippedLayer>) {
+        let mut out = Vec::new();
+        let mut layers = Vec::new();
+        for (name, why, n) in &self.skipped {
+            let what = if *n == 1 { "entity" } else { "entities" };
+            out.push(Warning {
+                element: format!("layer {name} {why}"),
+                line: None,
+                message: format!("{n} {what} skipped (hidden in the drawing)"),
+            });
+            layers.push(SkippedLayer {
+                name: name.clone(),
+                why: *why,
+                skipped: *n,
+            });
+        }
+        let n = self.invisible;
+        if n > 0 {
+            let listed = self.invisible_listed.join("; ");
+            let more = n - self.invisible_listed.len();
+            let tail = if more > 0 {
+                format!("; … and {more} more")
+            } else {
+                String::new()
+            };
+            out.push(Warning {
+                element: "invisible entities".into(),
+                line: None,
+                message: format!(
+                    "{n} {} flagged invisible in the drawing; skipped: {listed}{tail}",
+                    if n == 1 { "entity is" } else { "entities are" },
+                ),
+            });
+        }
+        (out, layers)
+    }
+
     /// Adds a warning once (a block's entity warns once, not once per insert).
     fn warn(&mut self, element: String, layer: &str, message: impl Into<String>) {
         let w = Warning {
@@ -361,6 +475,19 @@ impl<'d> Walk<'d> {
             let why = "paper-space entity; skipped (only model space is marked)";
             self.warn(element, &layer, why);
             return Ok(());
+        }
+        if !e.common.is_visible {
+            self.skip_invisible(format!("{element} (layer {layer})"));
+            return Ok(());
+        }
+        if let Some(why) = self.hidden_layer(&layer) {
+            // an INSERT on a layer that is off still shows its block's entities on other layers
+            let shows_block =
+                why == LayerHidden::Off && matches!(e.specific, EntityType::Insert(_));
+            if !shows_block {
+                self.skip_hidden(&layer, why);
+                return Ok(());
+            }
         }
         let tol = self.opts.chord_tol_mm.max(1e-6);
         match curve_paths(&e.specific, m, tol) {
@@ -490,6 +617,7 @@ impl<'d> Walk<'d> {
         let scale = Affine::scale(ins.x_scale_factor, ins.y_scale_factor)
             .then(Affine::translate(-block.base_point.x, -block.base_point.y));
         let (cols, rows) = (ins.column_count.max(1), ins.row_count.max(1));
+        self.inserted.insert(block.name.to_uppercase());
         self.stack.push(block.name.as_str());
         for row in 0..rows {
             for col in 0..cols {
@@ -768,37 +896,21 @@ fn spline_paths(s: &::dxf::entities::Spline, m: &Affine, tol: f64) -> Result<Vec
     }
 }
 
-/// Flips y (up → down) about the drawing's top and places it (see the module docs).
-fn place(
-    raw: Vec<Raw>,
-    work_area: Option<[f64; 2]>,
-    warnings: &mut Vec<Warning>,
-) -> (Vec<Geometry>, [f64; 2]) {
+/// Flips y (up → down) about the page's top: the page's bottom-left corner is the DXF origin
+/// and its top-right corner `[max x, max y]` (at least 0), so `y_mm = page height − y`.
+/// Placement on the machine follows ([`super::place_artwork`]).
+fn flip(raw: Vec<Raw>) -> (Vec<Geometry>, [f64; 2]) {
     let b = raw
         .iter()
         .fold(BBox::EMPTY, |b, r| b.union(BBox::of(&r.points)));
-    let fits_area = work_area.is_none_or(|[w, h]| b.max_x <= w && b.max_y <= h);
-    let keep = b.min_x >= 0.0 && b.min_y >= 0.0 && fits_area;
-    let dx = if keep { 0.0 } else { -b.min_x };
-    if !keep {
-        warnings.push(Warning {
-            element: "drawing".into(),
-            line: None,
-            message: format!(
-                "moved by ({:.3}, {:.3}) mm so that its bounding box starts at the work area's corner \
-                 (it lies at x {:.3}…{:.3}, y {:.3}…{:.3} mm in the DXF)",
-                -b.min_x, -b.min_y, b.min_x, b.max_x, b.min_y, b.max_y
-            ),
-        });
-    }
-    let page_mm = [b.max_x + dx, b.max_y - if keep { 0.0 } else { b.min_y }];
+    let page_mm = [b.max_x.max(0.0), b.max_y.max(0.0)];
     let geometries = raw
         .into_iter()
         .map(|r| {
             let pts = r
                 .points
                 .iter()
-                .map(|p| Pt::new(p.x + dx, b.max_y - p.y))
+                .map(|p| Pt::new(p.x, page_mm[1] - p.y))
                 .collect();
             Geometry::new(pts, r.closed, r.source)
         })

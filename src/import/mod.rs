@@ -3,15 +3,21 @@
 //! [`import_file`] is the one entry point for files: it chooses the format by extension (and by
 //! content when the extension says nothing) and every error names the file and the format.
 
+mod clip;
 mod curves;
 mod dxf;
+mod dxf_scan;
 mod dxf_text;
 mod fonts;
 mod guard;
+mod place;
 mod svg;
+mod svg_scan;
 
 pub use self::dxf::import_dxf;
+pub use crate::document::{ArtworkImport, LayerHidden, Place, PlaceError, SkippedLayer};
 pub use fonts::{bundled_font, BUNDLED_CAP_HEIGHT_EM, BUNDLED_FAMILY};
+pub use place::place_artwork;
 pub use svg::{import_svg, import_svg_file};
 
 use crate::document::Geometry;
@@ -38,7 +44,7 @@ pub enum FontSource {
     BundledOnly,
 }
 
-/// Import options.
+/// Import options. Build them with `..ImportOptions::default()`: fields are added over time.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ImportOptions {
     /// Maximum distance between a curve and its flattened polyline, mm (the same guarantee for
@@ -46,9 +52,21 @@ pub struct ImportOptions {
     pub chord_tol_mm: f64,
     /// Fonts for text.
     pub fonts: FontSource,
-    /// Width and height of the area the artwork should lie in (the base stroke), mm. A DXF
-    /// drawing that lies outside it but would fit is moved to its corner (with a warning).
+    /// Width and height of the area the artwork should lie in (the base stroke), mm: what
+    /// [`Place`] places the artwork on. `None`: no machine is known, the artwork stays as in
+    /// the file (except [`Place::Corner`]).
     pub work_area_mm: Option<[f64; 2]>,
+    /// Scan field size, mm: the laser reaches half a field beyond the work area on every side
+    /// ([`Place::Auto`] keeps artwork inside that reach where it is). `None`: no margin.
+    pub field_mm: Option<[f64; 2]>,
+    /// Where the artwork goes on the machine (see [`Place`]; applied right after import).
+    pub place: Place,
+    /// Offsets (mm) smaller than this are not applied nor reported: below the export's
+    /// resolution (a G-code with 4 decimals: 10⁻⁴ mm).
+    pub resolution_mm: f64,
+    /// Layers the drawing hides (DXF layers off or frozen, SVG layers with `display:none`)
+    /// to import anyway.
+    pub hidden_layers: HiddenLayers,
 }
 
 impl Default for ImportOptions {
@@ -57,6 +75,33 @@ impl Default for ImportOptions {
             chord_tol_mm: 0.01,
             fonts: FontSource::System,
             work_area_mm: None,
+            field_mm: None,
+            place: Place::Auto,
+            resolution_mm: 1e-4,
+            hidden_layers: HiddenLayers::Skip,
+        }
+    }
+}
+
+/// What happens to layers the drawing hides.
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub enum HiddenLayers {
+    /// Skipped, each with one summary warning and listed in [`Imported::skipped_layers`].
+    #[default]
+    Skip,
+    /// All imported (`--include-hidden-layers`).
+    IncludeAll,
+    /// These layers (by name, compared without case) imported, others skipped.
+    Include(Vec<String>),
+}
+
+impl HiddenLayers {
+    /// True when the hidden layer `name` is to be imported.
+    pub fn includes(&self, name: &str) -> bool {
+        match self {
+            HiddenLayers::Skip => false,
+            HiddenLayers::IncludeAll => true,
+            HiddenLayers::Include(names) => names.iter().any(|n| n.eq_ignore_ascii_case(name)),
         }
     }
 }
@@ -70,6 +115,10 @@ pub struct Imported {
     pub warnings: Vec<Warning>,
     /// Page size in mm (width, height).
     pub page_mm: [f64; 2],
+    /// Layers left out because the drawing hides them (each also has a warning).
+    pub skipped_layers: Vec<SkippedLayer>,
+    /// How far the placement moved the artwork (mm; zero when it stays as in the file).
+    pub moved_mm: [f64; 2],
 }
 
 /// A file format [`import_file`] reads.
@@ -127,7 +176,17 @@ pub fn import_file(path: &Path, opts: &ImportOptions) -> Result<Imported, Import
     }
 }
 
-pub use crate::document::Warning;
+pub use crate::document::{short_list, Warning, LIST_MAX};
+
+/// The geometries of an import placed as `opts.place` says ([`place_artwork`]); a placement
+/// that cannot be made is an error naming the file.
+fn placed(mut im: Imported, file: &str, opts: &ImportOptions) -> Result<Imported, ImportError> {
+    place_artwork(&mut im, opts).map_err(|source| ImportError::Place {
+        file: file.into(),
+        source,
+    })?;
+    Ok(im)
+}
 
 /// Why a file could not be imported. Every variant names the file.
 #[derive(Debug, Error)]
@@ -184,6 +243,14 @@ pub enum ImportError {
         /// What was found instead.
         detail: String,
     },
+    /// The artwork cannot be placed as asked.
+    #[error("{file}: {source}")]
+    Place {
+        /// The file.
+        file: String,
+        /// Why.
+        source: PlaceError,
+    },
 }
 
 /// Drops repeated points, detects implicit closing, rejects degenerate subpaths.
@@ -212,20 +279,13 @@ fn normalise(pts: Vec<Pt>, closed: bool) -> Result<(Vec<Pt>, bool), &'static str
     Ok((out, closed))
 }
 
-/// The error for a file with nothing to mark: what was skipped (the first three warnings), or
-/// `empty` when nothing was.
+/// The error for a file with nothing to mark: what was skipped (the first [`LIST_MAX`]
+/// warnings), or `empty` when nothing was.
 fn nothing_to_mark(file: &str, warnings: &[Warning], empty: &str) -> ImportError {
     let detail = if warnings.is_empty() {
         empty.to_string()
     } else {
-        let listed: Vec<String> = warnings.iter().take(3).map(|w| w.to_string()).collect();
-        let more = warnings.len().saturating_sub(3);
-        let tail = if more > 0 {
-            format!("; and {more} more")
-        } else {
-            String::new()
-        };
-        format!("only skipped content: {}{tail}", listed.join("; "))
+        format!("only skipped content: {}", short_list(warnings, "; "))
     };
     ImportError::NothingToMark {
         file: file.into(),

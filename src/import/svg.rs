@@ -1,9 +1,19 @@
 //! SVG import through `usvg`: shapes, groups, transforms and `use` resolved; curves flattened;
 //! `<text>` laid out with the fonts of [`super::fonts`] and imported as glyph outlines.
+//!
+//! Only what the drawing shows is imported: `display:none` content and hidden layers (found
+//! by [`super::svg_scan`], which also names what usvg drops without a word) and shapes with
+//! `visibility:hidden` are skipped with warnings; `clip-path`, and masks that are plain clips
+//! (opaque white shapes, or any opaque shapes for `mask-type:alpha`), cut the geometry
+//! ([`super::clip`]): strokes at the clip's boundary, fills (closed outlines) to the clipped
+//! region. Content under a mask that is not a plain clip is skipped with a warning.
 
+use super::clip::{Region, Rule};
 use super::fonts::{family_list, miss_warnings, usvg_options, Misses};
+use super::svg_scan::{self, describe};
 use super::{
-    normalise, nothing_to_mark, ImportError, ImportOptions, Imported, Warning, MAX_POINTS,
+    normalise, nothing_to_mark, placed, short_list, ImportError, ImportOptions, Imported, Warning,
+    MAX_POINTS,
 };
 use crate::document::{Geometry, Source};
 use crate::geom::{flatten_cubic, flatten_quad, Pt};
@@ -20,20 +30,6 @@ const SNAP_MM: f64 = 1e-5;
 fn snap(v: f64) -> f64 {
     (v / SNAP_MM).round() * SNAP_MM
 }
-
-/// Elements that carry visible content galvoplan cannot mark.
-const UNSUPPORTED: &[&str] = &[
-    "image",
-    "foreignObject",
-    "video",
-    "audio",
-    "canvas",
-    "iframe",
-];
-/// Containers whose children are not drawn directly.
-const NOT_RENDERED: &[&str] = &[
-    "defs", "symbol", "clipPath", "mask", "marker", "pattern", "metadata",
-];
 
 /// Reads and imports an SVG (or SVGZ) file.
 pub fn import_svg_file(
@@ -66,14 +62,17 @@ pub fn import_svg(bytes: &[u8], file: &str, opts: &ImportOptions) -> Result<Impo
     };
     let text =
         std::str::from_utf8(bytes).map_err(|e| malformed(format!("not UTF-8 text ({e})")))?;
-    let xml = roxmltree::Document::parse_with_options(
-        text,
-        roxmltree::ParsingOptions {
-            allow_dtd: true,
-            ..Default::default()
-        },
-    )
-    .map_err(|e| malformed(format!("malformed XML: {e}")))?;
+    let parse = |text| {
+        roxmltree::Document::parse_with_options(
+            text,
+            roxmltree::ParsingOptions {
+                allow_dtd: true,
+                ..Default::default()
+            },
+        )
+        .map_err(|e| malformed(format!("malformed XML: {e}")))
+    };
+    let xml = parse(text)?;
     let root = xml.root_element();
     if root.tag_name().name() != "svg" {
         return Err(malformed(format!(
@@ -82,16 +81,21 @@ pub fn import_svg(bytes: &[u8], file: &str, opts: &ImportOptions) -> Result<Impo
         )));
     }
     check_arc_radii(&xml).map_err(malformed)?;
-    let mut warnings = unsupported_content(&xml);
-    let (geometries, page_mm, font_warnings) =
-        tree_geometries(&xml, opts, opts.chord_tol_mm, MAX_POINTS).map_err(|e| match e {
+    let scan = svg_scan::scan(&xml, &opts.hidden_layers);
+    // hidden layers the options include: shown by editing their display (same lines)
+    let edited = (!scan.edits.is_empty()).then(|| svg_scan::apply_edits(text, &scan.edits));
+    let reparsed = edited.as_deref().map(parse).transpose()?;
+    let xml = reparsed.as_ref().unwrap_or(&xml);
+    let mut warnings = scan.warnings;
+    let (geometries, page_mm, tree_warnings) =
+        tree_geometries(xml, opts, opts.chord_tol_mm, MAX_POINTS).map_err(|e| match e {
             TreeError::Malformed(cause) => malformed(cause),
             TreeError::TooLarge => ImportError::TooLarge {
                 file: file.into(),
                 detail: too_many_points(opts.chord_tol_mm),
             },
         })?;
-    warnings.extend(font_warnings);
+    warnings.extend(tree_warnings);
     if geometries.is_empty() {
         return Err(nothing_to_mark(
             file,
@@ -99,11 +103,14 @@ pub fn import_svg(bytes: &[u8], file: &str, opts: &ImportOptions) -> Result<Impo
             "the file has no paths or shapes",
         ));
     }
-    Ok(Imported {
+    let imported = Imported {
         geometries,
         warnings,
         page_mm,
-    })
+        skipped_layers: scan.skipped_layers,
+        moved_mm: [0.0, 0.0],
+    };
+    placed(imported, file, opts)
 }
 
 /// Geometries, page size in mm and font warnings of one usvg tree.
@@ -143,14 +150,17 @@ fn tree_geometries(
         path_count: 0,
         text_count: 0,
         layer_names: layer_names(xml),
+        id_lines: svg_scan::id_lines(xml),
         text_families: FxHashMap::default(),
+        invisible: Vec::new(),
         budget,
         overflow: false,
     };
-    walker.group(tree.root(), None);
+    walker.group(tree.root(), None, None);
     if walker.overflow {
         return Err(TreeError::TooLarge);
     }
+    walker.invisible_warning();
     let geometries = std::mem::take(&mut walker.geometries);
     let families = std::mem::take(&mut walker.text_families);
     warnings.extend(miss_warnings(misses.take(), |requested| {
@@ -204,13 +214,6 @@ fn layer_names(xml: &roxmltree::Document) -> FxHashMap<String, String> {
         .collect()
 }
 
-fn describe(node: &roxmltree::Node) -> String {
-    match node.attribute("id") {
-        Some(id) => format!("<{} id=\"{id}\">", node.tag_name().name()),
-        None => format!("<{}>", node.tag_name().name()),
-    }
-}
-
 /// Largest arc radius in path data, in user units (10⁹: 1,000 km in mm, 264 km in px). usvg
 /// turns arcs into curves in `f32`, where radii past ~10³⁸ become infinite, and a radius of
 /// 10⁴⁰–10¹¹⁷ made it loop for minutes and use gigabytes (found by fuzzing); anything past this
@@ -241,34 +244,6 @@ fn check_arc_radii(xml: &roxmltree::Document) -> Result<(), String> {
     }
     Ok(())
 }
-fn unsupported_content(xml: &roxmltree::Document) -> Vec<Warning> {
-    let mut out = Vec::new();
-    let mut stack = vec![xml.root_element()];
-    while let Some(node) = stack.pop() {
-        let name = node.tag_name().name();
-        let svg_ns = node
-            .tag_name()
-            .namespace()
-            .is_none_or(|ns| ns == "http://www.w3.org/2000/svg");
-        if svg_ns && UNSUPPORTED.contains(&name) {
-            let line = xml.text_pos_at(node.range().start).row;
-            out.push(Warning {
-                element: describe(&node),
-                line: Some(line),
-                message: format!("<{name}> is not supported and was skipped (convert it to paths)"),
-            });
-            continue;
-        }
-        if svg_ns && NOT_RENDERED.contains(&name) {
-            continue;
-        }
-        // reverse so that the stack pops in document order
-        let children: Vec<_> = node.children().filter(|c| c.is_element()).collect();
-        stack.extend(children.into_iter().rev());
-    }
-    out
-}
-
 struct Walker<'w> {
     tol_px: f64,
     geometries: Vec<Geometry>,
@@ -277,6 +252,10 @@ struct Walker<'w> {
     text_count: usize,
     /// Top-level group id → layer name.
     layer_names: FxHashMap<String, String>,
+    /// Element id → its line in the file.
+    id_lines: FxHashMap<String, u32>,
+    /// Shapes skipped for `visibility:hidden`: name and line.
+    invisible: Vec<(String, Option<u32>)>,
     /// Requested font family list → the first text element asking for it.
     text_families: FxHashMap<String, String>,
     /// Vertices the walk may still produce.
@@ -292,14 +271,75 @@ fn paint_hex(paint: &usvg::Paint) -> String {
     }
 }
 
+/// A usvg transform (CSS px) followed by px → mm, snapped to the import's grid.
+fn to_mm(t: usvg::Transform) -> impl Fn(usvg::tiny_skia_path::Point) -> Pt {
+    move |q| {
+        let (x, y) = (f64::from(q.x), f64::from(q.y));
+        Pt::new(
+            snap((f64::from(t.sx) * x + f64::from(t.kx) * y + f64::from(t.tx)) * PX_TO_MM),
+            snap((f64::from(t.ky) * x + f64::from(t.sy) * y + f64::from(t.ty)) * PX_TO_MM),
+        )
+    }
+}
+
+fn rule(r: usvg::FillRule) -> Rule {
+    match r {
+        usvg::FillRule::NonZero => Rule::NonZero,
+        usvg::FillRule::EvenOdd => Rule::EvenOdd,
+    }
+}
+
+/// True for a closed outline, by its flag or by its ends meeting.
+fn is_ring(pts: &[Pt], closed: bool) -> bool {
+    closed
+        || (pts.len() > 2
+            && pts
+                .first()
+                .zip(pts.last())
+                .is_some_and(|(a, b)| a.dist(*b) <= super::SAME_POINT_MM))
+}
+
 impl Walker<'_> {
-    /// Walks a group; `layer` is the layer name of the top-level group above, if any.
-    fn group(&mut self, g: &usvg::Group, layer: Option<&str>) {
+    /// Walks a group; `layer` is the layer name of the top-level group above, if any, `clip`
+    /// the region the groups above clip to.
+    fn group(&mut self, g: &usvg::Group, layer: Option<&str>, clip: Option<&Region>) {
+        if self.overflow {
+            return;
+        }
         let named = self.layer_names.get(g.id()).cloned();
         let layer = named.as_deref().or(layer);
+        let mut own: Option<Region> = None;
+        if let Some(cp) = g.clip_path() {
+            own = self.clip_region(cp, g.abs_transform());
+        }
+        if let Some(m) = g.mask() {
+            match self.mask_region(m, g.abs_transform()) {
+                Ok(r) => own = Some(own.map_or(r.clone(), |o| o.intersect(&r))),
+                Err(why) => {
+                    let (element, line) = self.group_name(g);
+                    self.warnings.push(Warning {
+                        element,
+                        line,
+                        message: format!(
+                            "mask #{} is not a plain clip ({why}); the masked content was skipped",
+                            m.id()
+                        ),
+                    });
+                    return;
+                }
+            }
+        }
+        if self.overflow {
+            return;
+        }
+        let combined = match (clip, own) {
+            (Some(a), Some(b)) => Some(a.intersect(&b)),
+            (a, b) => b.or_else(|| a.cloned()),
+        };
+        let clip = combined.as_ref();
         for node in g.children() {
             match node {
-                usvg::Node::Group(child) => self.group(child, layer),
+                usvg::Node::Group(child) => self.group(child, layer, clip),
                 usvg::Node::Path(p) => {
                     self.path_count += 1;
                     let element = if p.id().is_empty() {
@@ -307,17 +347,163 @@ impl Walker<'_> {
                     } else {
                         format!("#{}", p.id())
                     };
-                    self.path(p, &element, layer);
+                    self.path(p, &element, layer, false, clip);
                 }
-                usvg::Node::Text(t) => self.text(t, layer),
+                usvg::Node::Text(t) => self.text(t, layer, clip),
                 // Images were reported from the XML scan, with their line numbers.
                 usvg::Node::Image(_) => {}
             }
         }
     }
 
+    /// A name for a group in warnings: its id, else the id of the first element in it with one.
+    fn group_name(&self, g: &usvg::Group) -> (String, Option<u32>) {
+        fn first_id(g: &usvg::Group) -> Option<String> {
+            if !g.id().is_empty() {
+                return Some(g.id().to_string());
+            }
+            g.children().iter().find_map(|n| match n {
+                usvg::Node::Group(c) => first_id(c),
+                other => (!other.id().is_empty()).then(|| other.id().to_string()),
+            })
+        }
+        match first_id(g) {
+            Some(id) => {
+                let line = self.id_lines.get(&id).copied();
+                (format!("#{id}"), line)
+            }
+            None => ("an element without id".into(), None),
+        }
+    }
+
+    /// The region a clip path lets through, for an element whose transform is `base`; `None`
+    /// when the vertex budget ran out.
+    fn clip_region(&mut self, cp: &usvg::ClipPath, base: usvg::Transform) -> Option<Region> {
+        let t = base.pre_concat(cp.transform());
+        let mut region = self.filled_region(cp.root(), t)?;
+        if let Some(inner) = cp.clip_path() {
+            region = region.intersect(&self.clip_region(inner, base)?);
+        }
+        Some(region)
+    }
+
+    /// The union of the fills of a clip path's content (under `t`, the clip path's frame).
+    fn filled_region(&mut self, g: &usvg::Group, t: usvg::Transform) -> Option<Region> {
+        let mut region = Region::default();
+        for node in g.children() {
+            let r = match node {
+                usvg::Node::Group(child) => {
+                    let mut r = self.filled_region(child, t)?;
+                    if let Some(cp) = child.clip_path() {
+                        r = r
+                            .intersect(&self.clip_region(cp, t.pre_concat(child.abs_transform()))?);
+                    }
+                    r
+                }
+                usvg::Node::Path(p) if p.is_visible() => {
+                    let fill_rule = p.fill().map_or(Rule::NonZero, |f| rule(f.rule()));
+                    let contours: Vec<Vec<Pt>> = self
+                        .subpaths(p, to_mm(t.pre_concat(p.abs_transform())))?
+                        .into_iter()
+                        .map(|(pts, _)| pts)
+                        .collect();
+                    Region::filled(&contours, fill_rule)
+                }
+                usvg::Node::Text(text) => self.filled_region(text.flattened(), t)?,
+                _ => continue,
+            };
+            region = region.union(&r);
+        }
+        Some(region)
+    }
+
+    /// The region a mask lets through when it is a plain clip (opaque white shapes; for
+    /// `mask-type:alpha` any opaque shapes), for an element whose transform is `base`; `Err`
+    /// with what makes it more than a clip.
+    fn mask_region(&mut self, m: &usvg::Mask, base: usvg::Transform) -> Result<Region, String> {
+        let r = m.rect();
+        let corner = |x: f32, y: f32| to_mm(base)(usvg::tiny_skia_path::Point::from_xy(x, y));
+        let rect = Region::quad([
+            corner(r.left(), r.top()),
+            corner(r.right(), r.top()),
+            corner(r.right(), r.bottom()),
+            corner(r.left(), r.bottom()),
+        ]);
+        let content = self.mask_content(m.root(), base, m.kind())?;
+        let mut region = content.intersect(&rect);
+        if let Some(inner) = m.mask() {
+            region = region.intersect(&self.mask_region(inner, base)?);
+        }
+        Ok(region)
+    }
+
+    fn mask_content(
+        &mut self,
+        g: &usvg::Group,
+        base: usvg::Transform,
+        kind: usvg::MaskType,
+    ) -> Result<Region, String> {
+        let mut region = Region::default();
+        for node in g.children() {
+            let r = match node {
+                usvg::Node::Group(child) => {
+                    if child.opacity().get() < 1.0
+                        || child.mask().is_some()
+                        || !child.filters().is_empty()
+                    {
+                        return Err("groups with opacity, masks or filters".into());
+                    }
+                    let mut r = self.mask_content(child, base, kind)?;
+                    if let Some(cp) = child.clip_path() {
+                        let clip = self
+                            .clip_region(cp, base.pre_concat(child.abs_transform()))
+                            .unwrap_or_default();
+                        r = r.intersect(&clip);
+                    }
+                    r
+                }
+                usvg::Node::Path(p) => {
+                    if !p.is_visible() {
+                        continue;
+                    }
+                    if p.stroke().is_some() {
+                        return Err("a stroked shape".into());
+                    }
+                    let Some(f) = p.fill() else {
+                        continue;
+                    };
+                    let opaque_white = match f.paint() {
+                        usvg::Paint::Color(c) => {
+                            f.opacity().get() >= 1.0
+                                && (kind == usvg::MaskType::Alpha
+                                    || (c.red, c.green, c.blue) == (255, 255, 255))
+                        }
+                        _ => false,
+                    };
+                    if !opaque_white {
+                        return Err(match kind {
+                            usvg::MaskType::Luminance => "a shape that is not opaque white".into(),
+                            usvg::MaskType::Alpha => "a shape that is not opaque".into(),
+                        });
+                    }
+                    let Some(subpaths) =
+                        self.subpaths(p, to_mm(base.pre_concat(p.abs_transform())))
+                    else {
+                        return Ok(Region::default());
+                    };
+                    let contours: Vec<Vec<Pt>> = subpaths.into_iter().map(|(pts, _)| pts).collect();
+                    Region::filled(&contours, rule(f.rule()))
+                }
+                usvg::Node::Text(t) => self.mask_content(t.flattened(), base, kind)?,
+                usvg::Node::Image(_) => return Err("an image".into()),
+            };
+            region = region.union(&r);
+        }
+        Ok(region)
+    }
+
     /// A text element: its glyph outlines (closed subpaths) as paths named after the element.
-    fn text(&mut self, t: &usvg::Text, layer: Option<&str>) {
+    fn text(&mut self, t: &usvg::Text, layer: Option<&str>, clip: Option<&Region>) {
         self.text_count += 1;
         let element = if t.id().is_empty() {
             format!("text #{}", self.text_count)
@@ -329,9 +515,10 @@ impl Walker<'_> {
                 .entry(family_list(span.font().families()))
                 .or_insert_with(|| format!("<text> {element}"));
         }
+        // the outline glyphs (colour glyphs come as groups of their own, not read)
         for node in t.flattened().children() {
             if let usvg::Node::Path(p) = node {
-                self.path(p, &element, layer);
+                self.path(p, &element, layer, true, clip);
             }
         }
     }
@@ -342,6 +529,9 @@ impl Walker<'_> {
         p: &usvg::Path,
         map: impl Fn(usvg::tiny_skia_path::Point) -> Pt,
     ) -> Option<Vec<Outline>> {
+        if self.overflow {
+            return None;
+        }
         // chord tolerance in mm, applied after the transform
         let tol_mm = self.tol_px * PX_TO_MM;
         let mut subpaths: Vec<Outline> = Vec::new();
@@ -393,8 +583,58 @@ impl Walker<'_> {
         Some(subpaths)
     }
 
-    fn path(&mut self, p: &usvg::Path, element: &str, layer: Option<&str>) {
+    /// The outlines of a path inside a clip region: a filled path's closed outlines become the
+    /// filled area inside the region (its boundary, hatched like any closed outline); strokes
+    /// (open outlines, and every outline of an unfilled path) are cut at the region's boundary.
+    fn clipped(p: &usvg::Path, subpaths: Vec<Outline>, region: &Region) -> Vec<Outline> {
+        let mut out = Vec::new();
+        match p.fill() {
+            Some(fill) => {
+                let (rings, open): (Vec<Outline>, Vec<Outline>) =
+                    subpaths.into_iter().partition(|(pts, c)| is_ring(pts, *c));
+                let contours: Vec<Vec<Pt>> = rings.iter().map(|(pts, _)| pts.clone()).collect();
+                match region.clip_fill(&contours, rule(fill.rule())) {
+                    None => out.extend(rings),
+                    Some(loops) => out.extend(loops.into_iter().map(|l| (l, true))),
+                }
+                for (pts, _) in open {
+                    match region.clip_stroke(&pts, false) {
+                        None => out.push((pts, false)),
+                        Some(pieces) => out.extend(pieces.into_iter().map(|q| (q, false))),
+                    }
+                }
+            }
+            None => {
+                for (pts, closed) in subpaths {
+                    match region.clip_stroke(&pts, closed) {
+                        None => out.push((pts, closed)),
+                        Some(pieces) => out.extend(pieces.into_iter().map(|q| (q, false))),
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// A path's outlines as geometries; `glyphs` for the outlines of text (a glyph with an empty
+    /// contour, e.g. DejaVu Sans' "u", is not worth a warning); `clip` the region it is clipped
+    /// to.
+    fn path(
+        &mut self,
+        p: &usvg::Path,
+        element: &str,
+        layer: Option<&str>,
+        glyphs: bool,
+        clip: Option<&Region>,
+    ) {
         if self.overflow {
+            return;
+        }
+        if !p.is_visible() {
+            let line = self.id_lines.get(p.id()).copied();
+            if !self.invisible.iter().any(|(e, _)| e == element) {
+                self.invisible.push((element.to_string(), line));
+            }
             return;
         }
         let layer = match (layer, p.stroke(), p.fill()) {
@@ -403,17 +643,12 @@ impl Walker<'_> {
             (None, None, Some(f)) => format!("fill {}", paint_hex(f.paint())),
             (None, None, None) => "none".into(),
         };
-        let t = p.abs_transform();
-        let map = |q: usvg::tiny_skia_path::Point| -> Pt {
-            let (x, y) = (f64::from(q.x), f64::from(q.y));
-            Pt::new(
-                snap((f64::from(t.sx) * x + f64::from(t.kx) * y + f64::from(t.tx)) * PX_TO_MM),
-                snap((f64::from(t.ky) * x + f64::from(t.sy) * y + f64::from(t.ty)) * PX_TO_MM),
-            )
-        };
-        let Some(subpaths) = self.subpaths(p, map) else {
+        let Some(mut subpaths) = self.subpaths(p, to_mm(p.abs_transform())) else {
             return;
         };
+        if let Some(region) = clip {
+            subpaths = Self::clipped(p, subpaths, region);
+        }
         for (sub_index, (pts, closed)) in subpaths.into_iter().enumerate() {
             let source = Source {
                 element: element.to_string(),
@@ -422,11 +657,42 @@ impl Walker<'_> {
             };
             match normalise(pts, closed) {
                 Ok((pts, closed)) => self.geometries.push(Geometry::new(pts, closed, source)),
+                Err(_) if glyphs => {}
                 Err(why) => self.warnings.push(Warning {
                     element: format!("{element} subpath {sub_index}"),
                     line: None,
                     message: format!("{why}; skipped"),
                 }),
+            }
+        }
+    }
+
+    /// One warning for the shapes skipped for `visibility:hidden`.
+    fn invisible_warning(&mut self) {
+        match self.invisible.as_slice() {
+            [] => {}
+            [(element, line)] => self.warnings.push(Warning {
+                element: element.clone(),
+                line: *line,
+                message: "visibility:hidden; skipped".into(),
+            }),
+            many => {
+                let names: Vec<String> = many
+                    .iter()
+                    .map(|(e, line)| match line {
+                        Some(l) => format!("{e} (line {l})"),
+                        None => e.clone(),
+                    })
+                    .collect();
+                self.warnings.push(Warning {
+                    element: "visibility:hidden".into(),
+                    line: None,
+                    message: format!(
+                        "{} shapes skipped: {}",
+                        many.len(),
+                        short_list(&names, "; ")
+                    ),
+                });
             }
         }
     }
