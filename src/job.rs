@@ -68,8 +68,8 @@ pub trait RunRecorder: Send + Sync {
     /// A finished plan: the tool-centre polylines of its marks in marking order, from its
     /// lowered toolpath (idle moves join one mark's end to the next's start).
     fn plan(&self, plan: &Plan, marks: &[&[Pt]]);
-    /// One GA generation: best and mean idle travel.
-    fn generation(&self, generation: usize, best_idle_mm: f64, mean_idle_mm: f64);
+    /// One GA generation: best and mean objective (job time, s, or idle travel, mm).
+    fn generation(&self, generation: usize, best: f64, mean: f64);
 }
 
 /// Context handed to every stage.

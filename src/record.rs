@@ -160,17 +160,15 @@ impl RunRecorder for RerunRecorder {
         self.keep("flush", self.rec.flush_blocking());
     }
 
-    fn generation(&self, generation: usize, best_idle_mm: f64, mean_idle_mm: f64) {
+    fn generation(&self, generation: usize, best: f64, mean: f64) {
         self.rec.set_time_sequence("generation", generation as i64);
         self.keep(
             "log",
-            self.rec
-                .log("hga/best_idle_mm", &rerun::Scalars::single(best_idle_mm)),
+            self.rec.log("hga/best", &rerun::Scalars::single(best)),
         );
         self.keep(
             "log",
-            self.rec
-                .log("hga/mean_idle_mm", &rerun::Scalars::single(mean_idle_mm)),
+            self.rec.log("hga/mean", &rerun::Scalars::single(mean)),
         );
     }
 }

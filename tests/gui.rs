@@ -88,7 +88,7 @@ fn open_demo_run_hha_shows_metrics() {
     wait_idle(&mut h, Duration::from_secs(120));
     let plan = h.state().active_plan().expect("a plan").clone();
     assert_eq!(plan.algo, Algo::Hha);
-    assert_eq!(plan.name, "HHA #1");
+    assert_eq!(plan.name, "HHA · job time · step-and-scan · seed 1");
     common::check_plan(&h.state().session.doc, &plan);
     // the metrics table: worded rows with units, the job time first with the plan's value
     h.get_by_label("Idle travel (mm)");
@@ -409,6 +409,17 @@ fn cancel_an_hga_run() {
     assert!(plan.name.contains("stopped"), "{}", plan.name);
     assert!(!plan.history.is_empty());
     common::check_plan(&h.state().session.doc, &plan);
+    // … never slower than its seed, the HHA plan of the same settings
+    h.get_by_label("Run HHA").click();
+    h.step();
+    wait_idle(&mut h, Duration::from_secs(120));
+    let hha = h.state().active_plan().unwrap().clone();
+    assert_eq!(hha.algo, Algo::Hha);
+    let (ta, th) = (
+        plan.metrics.job_time_s.unwrap(),
+        hha.metrics.job_time_s.unwrap(),
+    );
+    assert!(ta <= th + 1e-12, "cancelled HGA {ta} s vs HHA {th} s");
 }
 
 #[test]
@@ -473,7 +484,10 @@ fn project_round_trip_and_drag_and_drop() {
     let (a, b) = (&h.state().session.doc, &h2.state().session.doc);
     assert_eq!(a.fields, b.fields);
     assert_eq!(a.plans, b.plans);
-    assert_eq!(h2.state().active_plan().unwrap().name, "Baseline #1");
+    assert_eq!(
+        h2.state().active_plan().unwrap().name,
+        "Baseline · job time · step-and-scan"
+    );
     // a bad file is reported, not fatal
     let mut app = App::default();
     assert!(!app.open(&dir.path().join("missing.svg")));
@@ -649,7 +663,10 @@ fn the_cost_switch_decides_what_the_solve_minimises() {
         CostModel::Distance
     );
     let by_distance = solve(&mut h, "Run HHA");
-    assert_eq!(by_distance.name, "HHA #2");
+    assert_eq!(
+        by_distance.name,
+        "HHA · idle distance · step-and-scan · seed 1"
+    );
     assert_ne!(by_time.order, by_distance.order);
     // each plan is best at what it minimised (demo: 9.116 s / 1848 mm against 9.142 s / 1704 mm)
     let (t_time, t_dist) = (
@@ -669,7 +686,7 @@ fn run_as_is_keeps_the_document_order() {
     let mut h = opened(&demo());
     let plan = solve(&mut h, "Run as-is");
     assert_eq!(plan.algo, Algo::AsIs);
-    assert_eq!(plan.name, "As-is #1");
+    assert_eq!(plan.name, "As-is · job time · step-and-scan");
     common::check_plan(&h.state().session.doc, &plan);
     let hha = solve(&mut h, "Run HHA");
     assert!(hha.metrics.job_time_s.unwrap() < plan.metrics.job_time_s.unwrap());
@@ -1131,7 +1148,7 @@ fn a_pen_edit_makes_the_plan_stale_and_re_solve_and_export_writes_the_new_feed()
         ["fill: mark speed unset → 300 mm/s"]
     );
     h.get_by_label("stale");
-    h.get_by_label_contains("HHA #1 is stale: fill: mark speed unset → 300 mm/s since it was made");
+    h.get_by_label_contains("HHA · job time · step-and-scan · seed 1 is stale: fill: mark speed unset → 300 mm/s since it was made");
     // export asks; re-solving is the default answer and writes the new feed
     h.key_press_modifiers(ctrl(), Key::E);
     h.run();
@@ -1166,7 +1183,9 @@ fn a_profile_edit_makes_the_headline_stale() {
     let why = h.state().plan_staleness(0).to_vec();
     assert_eq!(why.len(), 1, "{why:?}");
     assert!(why[0].starts_with("base x max velocity ") && why[0].ends_with("→ 100 mm/s"));
-    h.get_by_label_contains("HHA #1 is stale: base x max velocity");
+    h.get_by_label_contains(
+        "HHA · job time · step-and-scan · seed 1 is stale: base x max velocity",
+    );
     h.get_by_label("stale");
     // the plan keeps the figures and the toolpath of its own profile
     let plan = h.state().session.doc.plans[0].clone();
@@ -1524,7 +1543,11 @@ fn nothing_is_cut_off_on_the_smallest_window() {
     solve(&mut h, "Run HHA");
     for title in ["Scanner offset", "Stage speed, mm/s", "t = 0.00 s of"] {
         let r = h.get_by_label_contains(title).rect();
-        assert!(r.right() <= side(&h) + 0.5, "{title}: {r:?}");
+        assert!(
+            r.right() <= side(&h) + 0.5,
+            "{title}: {r:?} side {}",
+            side(&h)
+        );
     }
     solve(&mut h, "Run as-is");
     h.get_by_label("Compare").click();
@@ -1610,4 +1633,34 @@ fn placement_centres_the_artwork_on_the_base_stroke() {
         "{b:?}"
     );
     assert!(h.state().uncovered().is_empty());
+}
+
+#[test]
+fn convergence_plot_speaks_the_tables_figures_and_names_say_what_a_plan_is() {
+    let mut h = opened(&demo());
+    for label in ["Run HHA", "Run HGA"] {
+        h.get_by_label(label).click();
+        h.step();
+        wait_idle(&mut h, Duration::from_secs(180));
+    }
+    let plans = h.state().session.doc.plans.clone();
+    let (hha, hga) = (&plans[0], &plans[1]);
+    assert_eq!(hha.name, "HHA · job time · step-and-scan · seed 1");
+    assert_eq!(hga.name, "HGA · job time · step-and-scan · seed 1");
+    let (th, ta) = (
+        hha.metrics.job_time_s.unwrap(),
+        hga.metrics.job_time_s.unwrap(),
+    );
+    assert!(ta <= th + 1e-12, "HGA {ta} s vs HHA {th} s");
+    h.get_by_label("Compare").click();
+    h.run();
+    // the table's figures (3 decimals) …
+    h.get_all_by_label(&format!("{th:.3}")).next().unwrap();
+    h.get_all_by_label(&format!("{ta:.3}")).next().unwrap();
+    // … are the plot's HHA line and the end of HGA's best curve, in seconds
+    h.get_by_label_contains(&format!("{} (HHA): {th:.3} s", hha.name));
+    h.get_by_label_contains(&format!("{} as made: {ta:.3} s", hga.name));
+    let last = hga.history.last().unwrap();
+    assert!(last.finished && (last.best - ta).abs() <= 1e-9 * ta);
+    h.get_by_label_contains(&format!("{}: population mean", hga.name));
 }

@@ -4,7 +4,9 @@
 
 mod common;
 
-use galvoplan::document::{Algo, CostModel, Document, MachineProfile, SolverSettings};
+use galvoplan::document::{
+    Algo, CostModel, Document, MachineProfile, ObjectiveKind, SolverSettings,
+};
 use galvoplan::job::{CancelToken, JobCtx, NoProgress};
 use galvoplan::pipeline::{load_svg, order_document, place_document_fields};
 use std::sync::Arc;
@@ -41,6 +43,38 @@ fn hga_on_time_is_no_slower_than_hha() {
     let h = order_document(&hha_doc, &JobCtx::default()).unwrap();
     let (ta, th) = (a.metrics.job_time_s.unwrap(), h.metrics.job_time_s.unwrap());
     assert!(ta <= th + 1e-12, "HGA {ta} s vs HHA {th} s");
+    // one objective: every generation in seconds of job time, the seed (HHA's plan) in
+    // generation 0, the history's end the table's figure
+    assert!(a
+        .history
+        .iter()
+        .all(|h| h.objective == ObjectiveKind::JobTimeS));
+    assert!(
+        a.history[0].best <= th * (1.0 + 1e-9),
+        "{} vs {th}",
+        a.history[0].best
+    );
+    let last = a.history.last().unwrap();
+    assert!(last.finished);
+    assert!((last.best - ta).abs() <= 1e-9 * ta, "{} vs {ta}", last.best);
+}
+
+#[test]
+fn hga_with_passes_and_pens_is_no_slower_than_hha_on_the_same_time_law() {
+    let mut doc = demo(hga(2));
+    for (k, l) in doc.layers.iter_mut().enumerate() {
+        l.pen.passes = 1 + (k % 3) as u32;
+        l.pen.mark_speed_mm_s = Some(150.0 + 100.0 * k as f64);
+    }
+    let a = order_document(&doc, &JobCtx::default()).unwrap();
+    let mut hha_doc = doc.clone();
+    hha_doc.settings.algo = Algo::Hha;
+    let h = order_document(&hha_doc, &JobCtx::default()).unwrap();
+    let (ta, th) = (a.metrics.job_time_s.unwrap(), h.metrics.job_time_s.unwrap());
+    assert!(ta <= th + 1e-12, "HGA {ta} s vs HHA {th} s");
+    // the GA's model of the seed is the lowered HHA plan's time, pens and passes included
+    assert!((a.history[0].best - th).abs() <= 1e-9 * th || a.history[0].best < th);
+    assert!((a.history.last().unwrap().best - ta).abs() <= 1e-9 * ta);
 }
 
 #[test]
@@ -70,11 +104,13 @@ fn hga_is_valid_deterministic_and_no_worse_than_hha() {
     );
     assert_eq!(a.history[0].generation, 0);
     for w in a.history.windows(2) {
-        assert!(w[1].best_idle_mm <= w[0].best_idle_mm + 1e-9);
+        assert!(w[1].best <= w[0].best + 1e-9);
         assert!(w[1].elapsed_s >= w[0].elapsed_s);
-        assert!(w[1].mean_idle_mm >= w[1].best_idle_mm - 1e-9);
+        assert!(w[1].mean >= w[1].best - 1e-9 || w[1].finished);
     }
-    assert!((a.history.last().unwrap().best_idle_mm - a.metrics.idle_mm).abs() < 1e-6);
+    let last = a.history.last().unwrap();
+    assert!(last.finished && last.objective == ObjectiveKind::IdleMm);
+    assert!((last.best - a.metrics.idle_mm).abs() < 1e-6);
 }
 
 #[test]
@@ -118,4 +154,29 @@ fn cancel_returns_the_best_plan_so_far_quickly() {
     );
     common::check_plan(&doc, &plan);
     assert!(!plan.history.is_empty());
+    // never slower than its seed, HHA's plan, after a cancel either
+    let mut hha_doc = doc.clone();
+    hha_doc.settings.algo = Algo::Hha;
+    let h = order_document(&hha_doc, &JobCtx::default()).unwrap();
+    let (ta, th) = (
+        plan.metrics.job_time_s.unwrap(),
+        h.metrics.job_time_s.unwrap(),
+    );
+    assert!(ta <= th + 1e-12, "cancelled HGA {ta} s vs HHA {th} s");
+}
+
+#[test]
+fn a_generation_cap_ends_the_run() {
+    let mut s = hga(4);
+    s.ga.stall_generations = 1_000;
+    s.ga.max_generations = Some(3);
+    let doc = demo(s);
+    let p = order_document(&doc, &JobCtx::default()).unwrap();
+    let generations: Vec<usize> = p
+        .history
+        .iter()
+        .filter(|h| !h.finished)
+        .map(|h| h.generation)
+        .collect();
+    assert_eq!(generations, [0, 1, 2, 3]);
 }

@@ -6,9 +6,9 @@ use super::canvas::{Canvas, CanvasState, Layers, PathLayer};
 use super::paint::colour;
 use super::playback::{self, Playback};
 use super::toolpaths::{Lowered, ToolpathCache};
-use crate::document::{Algo, Document, Metrics, Plan, TimeBreakdown};
+use crate::document::{Algo, Document, Metrics, ObjectiveKind, Plan, TimeBreakdown};
 use egui::{Color32, RichText, Vec2};
-use egui_plot::{HLine, Legend, Line, LineStyle, Plot, PlotPoints};
+use egui_plot::{HLine, Legend, Line, LineStyle, Plot, PlotPoints, Points};
 
 /// State of the compare view.
 #[derive(Debug, Default)]
@@ -206,17 +206,34 @@ const DECIDES_PT: f32 = 16.0;
 /// The metrics table of plan `a` and optionally `b`: job time first and emphasised (the
 /// faster plan marked), its parts, the other metrics with the better value in green, and the
 /// difference of B against A in %.
+///
+/// Plan names say what a plan is and run long, so the columns are headed "A" and "B" under the
+/// names written out (wrapped) above the table; a table of one plan heads its column "Value".
 pub fn metrics_table(ui: &mut egui::Ui, id: &str, a: &Plan, b: Option<&Plan>) {
+    if let Some(b) = b {
+        for (letter, p, col) in [("A", a, colour::PATH_A), ("B", b, colour::PATH_B)] {
+            ui.add(
+                egui::Label::new(
+                    RichText::new(format!("{letter}: {}", p.name))
+                        .strong()
+                        .color(col),
+                )
+                .wrap(),
+            );
+        }
+    }
     egui::Grid::new(id)
         .num_columns(4)
         .striped(true)
         .spacing([14.0, 3.0])
         .show(ui, |ui| {
             ui.label(RichText::new("Metric").strong());
-            ui.label(RichText::new(&a.name).strong().color(colour::PATH_A));
-            if let Some(b) = b {
-                ui.label(RichText::new(&b.name).strong().color(colour::PATH_B));
+            if b.is_some() {
+                ui.label(RichText::new("A").strong().color(colour::PATH_A));
+                ui.label(RichText::new("B").strong().color(colour::PATH_B));
                 ui.label(RichText::new("B vs A").strong());
+            } else {
+                ui.label(RichText::new("Value").strong().color(colour::PATH_A));
             }
             ui.end_row();
             for row in ROWS {
@@ -324,20 +341,32 @@ pub fn stale_notes(ui: &mut egui::Ui, plans: &[(&Plan, &[String])]) {
 /// Width kept for the convergence plot's y tick labels (e.g. `12 345.6`), px.
 const Y_AXIS_WIDTH_PX: f32 = 56.0;
 
-/// The GA convergence plot: best and mean idle travel per generation of every plan with a
-/// history, and the HHA plan's idle travel as a horizontal line.
+/// The GA convergence plot: best (solid) and population mean (dotted, paler) per generation
+/// of every plan with a history, in the plan's objective (job time, s, or idle travel, mm),
+/// ending at the plan's table figure (a marked point); the HHA plan's table figure in the same
+/// objective as a horizontal line.
 pub fn convergence_plot(ui: &mut egui::Ui, plans: &[(&Plan, Color32)], hha: Option<&Plan>) {
     let with_history: Vec<_> = plans
         .iter()
         .filter(|(p, _)| !p.history.is_empty())
         .collect();
+    let kind = with_history
+        .first()
+        .and_then(|(p, _)| p.history.first())
+        .map_or(ObjectiveKind::JobTimeS, |h| h.objective);
     if with_history.is_empty() {
         ui.label("GA convergence: no generation history among the compared plans (run HGA).");
+    } else if kind == ObjectiveKind::StepJobTimeEstimateS {
+        ui.label(
+            "On the fly the GA ranks plans on their job time as if marked step-and-scan (the \
+             on-the-fly time needs the stage route); the table's job times are on the fly.",
+        );
     }
+    let hha_figure = hha.and_then(|h| kind.of_metrics(&h.metrics).map(|v| (h, v)));
     Plot::new("convergence")
         .legend(Legend::default())
         .x_axis_label("Generation")
-        .y_axis_label("Idle travel (mm)")
+        .y_axis_label(kind.words())
         // ticks with as many decimals as their spacing needs, in a column wide enough for them
         .y_axis_formatter(|mark, _| {
             let decimals = (-mark.step_size.log10()).ceil().clamp(0.0, 3.0) as usize;
@@ -350,33 +379,54 @@ pub fn convergence_plot(ui: &mut egui::Ui, plans: &[(&Plan, Color32)], hha: Opti
                 let best: PlotPoints = p
                     .history
                     .iter()
-                    .map(|h| [h.generation as f64, h.best_idle_mm])
+                    .map(|h| [h.generation as f64, h.best])
                     .collect();
                 let mean: PlotPoints = p
                     .history
                     .iter()
-                    .map(|h| [h.generation as f64, h.mean_idle_mm])
+                    .filter(|h| !h.finished)
+                    .map(|h| [h.generation as f64, h.mean])
                     .collect();
                 pui.line(
-                    Line::new(format!("{} best", p.name), best)
+                    Line::new(format!("{}: best", p.name), best)
                         .color(*col)
-                        .width(2.0),
+                        .width(2.5),
                 );
                 pui.line(
-                    Line::new(format!("{} mean", p.name), mean)
-                        .color(col.gamma_multiply(0.6))
-                        .style(LineStyle::dashed_loose()),
+                    Line::new(format!("{}: population mean", p.name), mean)
+                        .color(MEAN_GREY.lerp_to_gamma(*col, 0.35))
+                        .width(1.5)
+                        .style(LineStyle::dotted_dense()),
                 );
+                if let Some(last) = p.history.last().filter(|h| h.finished) {
+                    let label = format!(
+                        "{} as made: {} {}",
+                        p.name,
+                        kind.show(last.best),
+                        kind.unit()
+                    );
+                    pui.points(
+                        Points::new(label, vec![[last.generation as f64, last.best]])
+                            .color(*col)
+                            .radius(5.0),
+                    );
+                }
             }
-            if let Some(h) = hha {
+            if let Some((h, v)) = hha_figure {
                 pui.hline(
-                    HLine::new(format!("{} (HHA)", h.name), h.metrics.idle_mm)
-                        .color(Color32::from_rgb(22, 163, 74))
-                        .width(1.5),
+                    HLine::new(
+                        format!("{} (HHA): {} {}", h.name, kind.show(v), kind.unit()),
+                        v,
+                    )
+                    .color(Color32::from_rgb(22, 163, 74))
+                    .width(1.5),
                 );
             }
         });
 }
+
+/// The grey the population-mean lines are drawn towards (they stay apart from the best lines).
+const MEAN_GREY: Color32 = Color32::from_rgb(140, 140, 140);
 
 fn plan_combo(ui: &mut egui::Ui, label: &str, slot: &mut Option<usize>, plans: &[Plan]) {
     let l = ui.label(label);

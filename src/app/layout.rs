@@ -591,17 +591,21 @@ impl App {
         for k in 0..self.session.doc.plans.len() {
             let p = &self.session.doc.plans[k];
             let stale = self.plan_staleness(k).to_vec();
+            // the name (what the plan is: algorithm, cost, motion, seed) wraps on its own line
+            let selected = self.session.active == Some(k);
+            ui.set_max_width(ui.available_width());
+            if ui
+                .add(egui::Button::selectable(selected, p.name.as_str()).wrap())
+                .clicked()
+            {
+                self.session.active = Some(k);
+            }
             ui.horizontal_wrapped(|ui| {
                 let text = match p.metrics.job_time_s {
-                    Some(t) => format!("{}  job time {t:.2} s", p.name),
-                    None => format!("{}  idle travel {:.1} mm", p.name, p.metrics.idle_mm),
+                    Some(t) => format!("job time {t:.2} s"),
+                    None => format!("idle travel {:.1} mm", p.metrics.idle_mm),
                 };
-                if ui
-                    .selectable_label(self.session.active == Some(k), text)
-                    .clicked()
-                {
-                    self.session.active = Some(k);
-                }
+                ui.label(text);
                 if !stale.is_empty() {
                     ui.label(RichText::new("stale").color(STALE))
                         .on_hover_text(stale_text(&stale));

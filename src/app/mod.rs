@@ -813,23 +813,26 @@ impl App {
         }
     }
 
+    /// The name of the next plan of `algo`: what it is ([`SolverSettings::plan_title`]), with
+    /// " #2", " #3"… when a plan of that name exists.
     fn next_plan_name(&self, algo: Algo) -> String {
-        let label = match algo {
-            Algo::Baseline => "Baseline".to_string(),
-            Algo::AsIs => "As-is".to_string(),
-            Algo::Hha | Algo::Hga => algo.label().to_uppercase(),
+        let mut settings = self.session.doc.settings.clone();
+        settings.algo = algo;
+        let title = settings.plan_title();
+        let taken = |name: &str| {
+            self.session
+                .doc
+                .plans
+                .iter()
+                .any(|p| p.name == name || p.name.strip_suffix(" (stopped)") == Some(name))
         };
-        (1..)
-            .map(|n| format!("{label} #{n}"))
-            .find(|n| {
-                !self
-                    .session
-                    .doc
-                    .plans
-                    .iter()
-                    .any(|p| p.name.starts_with(n.as_str()))
-            })
-            .unwrap_or(label)
+        if !taken(&title) {
+            return title;
+        }
+        (2..)
+            .map(|n| format!("{title} #{n}"))
+            .find(|n| !taken(n))
+            .unwrap_or(title)
     }
 
     fn poll_job(&mut self, ui_ctx: &egui::Context) {

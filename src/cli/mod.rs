@@ -143,9 +143,19 @@ struct JobOpts {
     /// Directional penalty weight w (seed 000 Eq. 7; 0.1 is used with one field).
     #[arg(long, default_value_t = 0.5)]
     direction_weight: f64,
-    /// HGA: do not put the HHA plan into the initial population (seed 000's HGA).
+    /// HGA: do not put the HHA plan into the initial population (seed 000's HGA; it may then
+    /// end worse than HHA).
     #[arg(long)]
     no_hha_seed: bool,
+    /// HGA: stop after this many generations without improvement.
+    #[arg(long, value_name = "N", default_value_t = galvoplan::document::GaParams::default().stall_generations)]
+    ga_stall: usize,
+    /// HGA: stop after this many generations at most (default: no cap).
+    #[arg(long, value_name = "N")]
+    ga_generations: Option<usize>,
+    /// HGA: initial population size (between its min 16 and max 48).
+    #[arg(long, value_name = "N", default_value_t = galvoplan::document::GaParams::default().population)]
+    ga_population: usize,
     /// Run HHA as seed 000 describes it (no local search, no alternation), for comparison.
     #[arg(long)]
     seed_hha: bool,
@@ -244,6 +254,9 @@ impl JobOpts {
             let flag = match e.key.as_str() {
                 "direction_weight" => " (--direction-weight)",
                 "time_limit_s" => " (--time-limit)",
+                "ga.stall_generations" => " (--ga-stall)",
+                "ga.max_generations" => " (--ga-generations)",
+                "ga.population" => " (--ga-population)",
                 _ => "",
             };
             anyhow::anyhow!("invalid settings: {e}{flag}")
@@ -301,6 +314,9 @@ impl JobOpts {
             direction_weight: self.direction_weight,
             ga: galvoplan::document::GaParams {
                 seed_with_hha: !self.no_hha_seed,
+                stall_generations: self.ga_stall,
+                max_generations: self.ga_generations,
+                population: self.ga_population,
                 ..Default::default()
             },
             hatch: self.hatch()?,

@@ -23,7 +23,8 @@ pub use pens::{
     DEFAULT_LAYER, MAX_PASSES, PENS_VERSION,
 };
 pub use plan::{
-    GenerationRecord, Metrics, MotionFigures, Plan, ScanField, StageTimes, Step, TimeBreakdown,
+    GenerationRecord, Metrics, MotionFigures, ObjectiveKind, Plan, ScanField, StageTimes, Step,
+    TimeBreakdown,
 };
 pub use profile::{
     AxisLimits, GcodeDialect, GcodeMode, LaserTiming, MachineProfile, ProfileError, ScannerSpeeds,

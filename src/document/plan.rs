@@ -3,7 +3,7 @@
 use crate::geom::{BBox, Pt};
 use serde::{Deserialize, Serialize};
 
-use super::Algo;
+use super::{Algo, CostModel, MotionMode};
 
 /// A scan field: the base parks at `center` and the scanner reaches `size` around it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -172,19 +172,84 @@ pub struct Metrics {
     pub solve_s: StageTimes,
 }
 
+/// What the values of a GA history measure: the plan's objective.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ObjectiveKind {
+    /// Idle travel, mm (`--cost distance`; histories made before the objective was recorded).
+    #[default]
+    IdleMm,
+    /// Job time, s (`--cost time`, step-and-scan): the figure the plan's table shows.
+    JobTimeS,
+    /// Job time as if marked step-and-scan, s: on the fly the GA ranks chromosomes on it (the
+    /// job time on the fly needs the stage route); an estimate, not the table's figure.
+    StepJobTimeEstimateS,
+}
+
+impl ObjectiveKind {
+    /// The objective of a solve with this cost model and motion.
+    pub fn of(cost: CostModel, motion: MotionMode) -> Self {
+        match (cost, motion) {
+            (CostModel::Distance, _) => ObjectiveKind::IdleMm,
+            (CostModel::Time, MotionMode::Step) => ObjectiveKind::JobTimeS,
+            (CostModel::Time, MotionMode::OnTheFly) => ObjectiveKind::StepJobTimeEstimateS,
+        }
+    }
+    /// Its unit.
+    pub fn unit(self) -> &'static str {
+        match self {
+            ObjectiveKind::IdleMm => "mm",
+            _ => "s",
+        }
+    }
+    /// What it is, in words, with its unit (a plot's axis label).
+    pub fn words(self) -> &'static str {
+        match self {
+            ObjectiveKind::IdleMm => "Idle travel (mm)",
+            ObjectiveKind::JobTimeS => "Job time (s)",
+            ObjectiveKind::StepJobTimeEstimateS => "Job time if marked step-and-scan (s, estimate)",
+        }
+    }
+    /// A value with the decimals its unit needs (ms for times, 0.1 mm for travel).
+    pub fn show(self, v: f64) -> String {
+        match self {
+            ObjectiveKind::IdleMm => format!("{v:.1}"),
+            _ => format!("{v:.3}"),
+        }
+    }
+    /// The plan's table figure for this objective, when the table has it (an estimate has
+    /// none).
+    pub fn of_metrics(self, m: &Metrics) -> Option<f64> {
+        match self {
+            ObjectiveKind::IdleMm => Some(m.idle_mm),
+            ObjectiveKind::JobTimeS => m.job_time_s,
+            ObjectiveKind::StepJobTimeEstimateS => None,
+        }
+    }
+}
+
 /// One GA generation in a plan's convergence history.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct GenerationRecord {
     /// Generation number (0 = initial population).
     pub generation: usize,
-    /// Best idle travel, mm.
-    pub best_idle_mm: f64,
-    /// Mean idle travel of the population, mm.
-    pub mean_idle_mm: f64,
+    /// Best objective value so far (in `objective`'s unit).
+    #[serde(alias = "best_idle_mm")]
+    pub best: f64,
+    /// Mean objective value of the population.
+    #[serde(alias = "mean_idle_mm")]
+    pub mean: f64,
+    /// What `best` and `mean` measure.
+    #[serde(default)]
+    pub objective: ObjectiveKind,
     /// Population size.
     pub population: usize,
     /// Seconds since the start of the run.
     pub elapsed_s: f64,
+    /// The plan as made (the GA's best, refined and lowered like every plan, or its seed when
+    /// that is better): `best` is then the plan's table figure. Only the last record.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub finished: bool,
 }
 
 /// The result of one ordering run.

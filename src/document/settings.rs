@@ -44,6 +44,34 @@ impl Algo {
     }
 }
 
+impl SolverSettings {
+    /// What a plan made with these settings is, in words: algorithm, cost, motion (with the
+    /// stage route on the fly) and, for the searches that draw random numbers, the seed, e.g.
+    /// `HGA · job time · on the fly (taut) · seed 3`. Plans are named after it.
+    pub fn plan_title(&self) -> String {
+        let algo = match self.algo {
+            Algo::AsIs => "As-is",
+            Algo::Baseline => "Baseline",
+            Algo::Hha => "HHA",
+            Algo::Hga => "HGA",
+        };
+        let cost = match self.cost_model {
+            CostModel::Time => "job time",
+            CostModel::Distance => "idle distance",
+        };
+        let motion = match (self.motion, self.stage_route) {
+            (MotionMode::Step, _) => "step-and-scan",
+            (MotionMode::OnTheFly, StageRouteKind::Taut) => "on the fly (taut)",
+            (MotionMode::OnTheFly, StageRouteKind::Lsa) => "on the fly (lsa)",
+            (MotionMode::OnTheFly, StageRouteKind::CetspGa) => "on the fly (cetsp-ga)",
+        };
+        match self.algo {
+            Algo::Hha | Algo::Hga => format!("{algo} · {cost} · {motion} · seed {}", self.seed),
+            Algo::AsIs | Algo::Baseline => format!("{algo} · {cost} · {motion}"),
+        }
+    }
+}
+
 /// How start vertices are chosen once the order is fixed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "lowercase")]
@@ -139,6 +167,9 @@ pub struct GaParams {
     pub mutation_rate: f64,
     /// Stop after this many generations without improvement.
     pub stall_generations: usize,
+    /// Stop after this many generations (none: only the stall, the time limit or a cancel end
+    /// the run).
+    pub max_generations: Option<usize>,
     /// Seed the population with the HHA plan.
     pub seed_with_hha: bool,
 }
@@ -152,6 +183,7 @@ impl Default for GaParams {
             elite_fraction: 0.2,
             mutation_rate: 0.3,
             stall_generations: 5,
+            max_generations: None,
             seed_with_hha: true,
         }
     }

@@ -570,6 +570,30 @@ pub fn settings_specs() -> Vec<FieldSpec<SolverSettings>> {
             usize,
             |t| t.ga.stall_generations
         ),
+        FieldSpec {
+            label: "GA generations at most",
+            unit: "",
+            key: "ga.max_generations",
+            help: "stop after this many generations; empty: no cap (the stall or the time limit \
+                   ends the run)",
+            rule: Rule::Whole(1, u64::MAX),
+            optional: true,
+            shapes_plan: true,
+            show: |t| {
+                t.ga.max_generations
+                    .map_or_else(String::new, |v| v.to_string())
+            },
+            number: |t| t.ga.max_generations.map(|v| v as f64),
+            parse: |t, s| {
+                t.ga.max_generations = if s.trim().is_empty() {
+                    None
+                } else {
+                    let v = parse_whole(s)?;
+                    Some(usize::try_from(v).map_err(|_| format!("must be smaller, not {v}"))?)
+                };
+                Ok(())
+            },
+        },
     ];
     // how hard a solve searches, not what job it makes: a plan is not stale for them
     for s in &mut search {

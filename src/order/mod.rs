@@ -7,6 +7,7 @@ pub mod cost;
 pub mod hga;
 pub mod hha;
 pub mod metrics;
+pub mod objective;
 mod passes;
 pub mod time;
 pub mod tsp;
@@ -17,8 +18,8 @@ pub use baseline::baseline_order;
 pub use passes::expand_passes;
 
 use crate::document::{
-    Algo, CostModel, GenerationRecord, Geometry, MachineProfile, MotionMode, Plan, PlanInputs,
-    ScanField, SolverSettings, Step,
+    Algo, CostModel, GenerationRecord, Geometry, MachineProfile, MotionMode, ObjectiveKind, Plan,
+    PlanInputs, ScanField, SolverSettings, Step,
 };
 use crate::job::{Cancelled, JobCtx};
 use crate::motion::{lower_motion, MotionError, OtfError, Toolpath};
@@ -68,50 +69,128 @@ pub fn order_plan(
     };
     let t0 = std::time::Instant::now();
     let mut detail = Vec::new();
-    let (ordering, seed_ordering, history) =
-        run_algorithm(geometries, fields, profile, settings, ctx, &mut detail)?;
-    let (ordering, taut) = if settings.motion == MotionMode::OnTheFly && settings.algo != Algo::AsIs
-    {
-        let t = std::time::Instant::now();
-        let best = faster_on_the_fly(&lower, ordering)?;
-        detail.push(("bands".into(), t.elapsed().as_secs_f64()));
-        (best.0, Some(best.1))
-    } else {
-        (ordering, None)
-    };
-    let (ordering, toolpath) = if settings.cost_model == CostModel::Time
-        && settings.algo != Algo::AsIs
-        && settings.motion == MotionMode::Step
-    {
-        let t = std::time::Instant::now();
-        // under HHA a time limit ends the last search (HGA spends it on its generations)
-        let until = (settings.algo == Algo::Hha)
-            .then(|| hha::deadline(settings, t0, hha::LAST_SEARCH_SHARE))
-            .flatten();
-        let mut best = time_ordering(&lower, ordering, until)?;
-        if let Some(seed) = seed_ordering {
-            // HGA's own objective is idle travel: on time, its HHA seed may still be faster
-            let other = time_ordering(&lower, seed, until)?;
-            best = faster(best, other);
+    let (ordering, toolpath, history) = match settings.algo {
+        Algo::Hga => hga_plan(&lower, t0, &mut detail)?,
+        Algo::AsIs | Algo::Baseline | Algo::Hha => {
+            let ordering = run_algorithm(geometries, fields, profile, settings, ctx, &mut detail)?;
+            let (ordering, toolpath) =
+                finish(&lower, ordering, hha_until(settings, t0), &mut detail)?;
+            (ordering, toolpath, Vec::new())
         }
-        detail.push(("time".into(), t.elapsed().as_secs_f64()));
-        best
-    } else {
-        let toolpath = match taut {
-            Some(toolpath) => toolpath,
-            None => lower.toolpath(&ordering)?,
-        };
-        (ordering, toolpath)
     };
     let order_s = t0.elapsed().as_secs_f64();
     let mut plan = lower.plan(&ordering);
     let mut m = metrics::compute(geometries, &plan.fields, &plan.order, profile, &toolpath);
     m.solve_s.order = order_s;
     m.solve_s.order_detail = detail;
-    plan.name = settings.algo.label().into();
+    plan.name = settings.plan_title();
     plan.metrics = m;
     plan.history = history;
     Ok((plan, toolpath))
+}
+
+/// When HHA's last search ends under a time limit (none for the other algorithms: HGA spends
+/// its limit on its generations).
+fn hha_until(settings: &SolverSettings, t0: std::time::Instant) -> Option<std::time::Instant> {
+    (settings.algo == Algo::Hha)
+        .then(|| hha::deadline(settings, t0, hha::LAST_SEARCH_SHARE))
+        .flatten()
+}
+
+/// What every algorithm's ordering goes through to become a plan: on the fly, the sweep of
+/// field-wide bands when it runs faster; under `--cost time` in step-and-scan, the refinement
+/// for job time (kept only when faster; its searches end at `until`); then the lowering.
+/// As-is orders are only lowered.
+fn finish(
+    lower: &Candidates,
+    ordering: Ordering,
+    until: Option<std::time::Instant>,
+    detail: &mut Vec<(String, f64)>,
+) -> Result<(Ordering, Toolpath), OrderError> {
+    let settings = &lower.inputs.settings;
+    let t = std::time::Instant::now();
+    if settings.algo == Algo::AsIs {
+        let toolpath = lower.toolpath(&ordering)?;
+        return Ok((ordering, toolpath));
+    }
+    if settings.motion == MotionMode::OnTheFly {
+        let best = faster_on_the_fly(lower, ordering)?;
+        detail.push(("bands".into(), t.elapsed().as_secs_f64()));
+        return Ok(best);
+    }
+    if settings.cost_model == CostModel::Time {
+        let best = time_ordering(lower, ordering, until)?;
+        detail.push(("time".into(), t.elapsed().as_secs_f64()));
+        return Ok(best);
+    }
+    let toolpath = lower.toolpath(&ordering)?;
+    Ok((ordering, toolpath))
+}
+
+/// HGA as a race on the plan's objective: the HHA plan, finished like any plan, seeds the GA
+/// (when the settings say so); the GA ranks chromosomes on the same objective
+/// ([`objective`]); its best is finished the same way, and the better of the two finished
+/// plans is returned, so HGA is never worse than its seed, also after a cancel or a time
+/// limit. The history ends with the returned plan's table figure (when the GA's objective is
+/// that figure: not on the fly, where it ranks on an estimate).
+fn hga_plan(
+    lower: &Candidates,
+    t0: std::time::Instant,
+    detail: &mut Vec<(String, f64)>,
+) -> Result<(Ordering, Toolpath, Vec<GenerationRecord>), OrderError> {
+    let (geometries, fields, inputs, ctx) =
+        (lower.geometries, lower.fields, lower.inputs, lower.ctx);
+    let settings = &inputs.settings;
+    let kind = ObjectiveKind::of(settings.cost_model, settings.motion);
+    let t = std::time::Instant::now();
+    let seed = if settings.ga.seed_with_hha {
+        let o = hha::hha_order(geometries, fields, &inputs.profile, settings, ctx, detail)?;
+        let until = hha::deadline(settings, t0, hha::LAST_SEARCH_SHARE);
+        Some(finish(lower, o, until, detail)?)
+    } else {
+        None
+    };
+    detail.push(("hha_seed".into(), t.elapsed().as_secs_f64()));
+    let step_time = objective::StepTime::new(geometries, fields, &inputs.layers, &inputs.profile);
+    let of = |steps: &[Step]| match kind {
+        ObjectiveKind::IdleMm => metrics::idle_mm(geometries, steps),
+        ObjectiveKind::JobTimeS | ObjectiveKind::StepJobTimeEstimateS => {
+            step_time.job_time_s(steps)
+        }
+    };
+    let fitness = hga::Fitness { kind, of: &of };
+    let t = std::time::Instant::now();
+    let seed_ordering = seed.as_ref().map(|s| &s.0);
+    let r = hga::hga_order(
+        geometries,
+        fields,
+        &inputs.profile,
+        settings,
+        seed_ordering,
+        &fitness,
+        ctx,
+    )?;
+    detail.push(("ga".into(), t.elapsed().as_secs_f64()));
+    let mut history = r.history;
+    let ga = finish(lower, r.ordering, None, detail)?;
+    let value = |c: &(Ordering, Toolpath)| match kind {
+        ObjectiveKind::IdleMm => metrics::idle_mm(geometries, &lower.plan(&c.0).order),
+        ObjectiveKind::JobTimeS | ObjectiveKind::StepJobTimeEstimateS => c.1.duration_s(),
+    };
+    let best = match seed {
+        Some(seed) if value(&seed) <= value(&ga) => seed,
+        _ => ga,
+    };
+    if let (Some(last), ObjectiveKind::IdleMm | ObjectiveKind::JobTimeS) = (history.last(), kind) {
+        let finished = GenerationRecord {
+            best: value(&best),
+            elapsed_s: t.elapsed().as_secs_f64(),
+            finished: true,
+            ..last.clone()
+        };
+        history.push(finished);
+    }
+    Ok((best.0, best.1, history))
 }
 
 /// The one lower-and-compare helper: turns candidate orderings into plans of the solve's
@@ -161,8 +240,7 @@ fn faster(a: (Ordering, Toolpath), b: (Ordering, Toolpath)) -> (Ordering, Toolpa
     }
 }
 
-/// The ordering of the settings' algorithm, HGA's HHA seed ordering (when it had one) and HGA's
-/// convergence history.
+/// The ordering of the settings' algorithm (HGA goes through [`hga_plan`]).
 fn run_algorithm(
     geometries: &[Geometry],
     fields: &[ScanField],
@@ -170,17 +248,12 @@ fn run_algorithm(
     settings: &SolverSettings,
     ctx: &JobCtx,
     detail: &mut Vec<(String, f64)>,
-) -> Result<(Ordering, Option<Ordering>, Vec<GenerationRecord>), OrderError> {
+) -> Result<Ordering, OrderError> {
     Ok(match settings.algo {
-        Algo::AsIs => (as_is_order(geometries, fields, ctx)?, None, Vec::new()),
-        Algo::Baseline => (baseline_order(geometries, fields, ctx)?, None, Vec::new()),
-        Algo::Hha => {
-            let ordering = hha::hha_order(geometries, fields, profile, settings, ctx, detail)?;
-            (ordering, None, Vec::new())
-        }
-        Algo::Hga => {
-            let (r, seed) = run_hga(geometries, fields, profile, settings, ctx, detail)?;
-            (r.ordering, seed, r.history)
+        Algo::AsIs => as_is_order(geometries, fields, ctx)?,
+        Algo::Baseline => baseline_order(geometries, fields, ctx)?,
+        Algo::Hha | Algo::Hga => {
+            hha::hha_order(geometries, fields, profile, settings, ctx, detail)?
         }
     })
 }
@@ -200,37 +273,6 @@ fn faster_on_the_fly(
     }
     let by_bands = lower.toolpath(&bands)?;
     Ok(faster((ordering, by_fields), (bands, by_bands)))
-}
-
-/// HGA, seeded with the HHA plan when the settings say so; returns the seed plan too.
-fn run_hga(
-    geometries: &[Geometry],
-    fields: &[ScanField],
-    profile: &MachineProfile,
-    settings: &SolverSettings,
-    ctx: &JobCtx,
-    detail: &mut Vec<(String, f64)>,
-) -> Result<(hga::HgaResult, Option<Ordering>), OrderError> {
-    let t = std::time::Instant::now();
-    let seed_plan = if settings.ga.seed_with_hha {
-        Some(hha::hha_order(
-            geometries, fields, profile, settings, ctx, detail,
-        )?)
-    } else {
-        None
-    };
-    detail.push(("hha_seed".into(), t.elapsed().as_secs_f64()));
-    let t = std::time::Instant::now();
-    let r = hga::hga_order(
-        geometries,
-        fields,
-        profile,
-        settings,
-        seed_plan.as_ref(),
-        ctx,
-    )?;
-    detail.push(("ga".into(), t.elapsed().as_secs_f64()));
-    Ok((r, seed_plan))
 }
 
 /// The fields of `order` (ids) in that order.

@@ -22,6 +22,8 @@ pub struct Shared<'a> {
     pub neighbours: Vec<Vec<usize>>,
     /// Use the exact vertex DP after VEA.
     pub exact_vertices: bool,
+    /// The objective of strokes in marking order (see `super::Fitness`).
+    pub fitness: &'a (dyn Fn(&[Step]) -> f64 + Sync),
 }
 
 impl Shared<'_> {
@@ -65,13 +67,13 @@ impl Shared<'_> {
     }
 
     /// CEA: a TSP pass over the geometry order from the corner with a free end and the field
-    /// penalty (seed 000 Algorithm 1), then vertex enhancement (VEA; then the exact DP when
-    /// enabled), with the field runs made contiguous in between. Sets `c.idle_mm`.
+    /// penalty (seed 000 Algorithm 1), started from the nodes in `start` (all when `None`), then
+    /// vertex enhancement (VEA; then the exact DP when enabled), with the field runs made
+    /// contiguous in between. Sets `c.cost` to the fitness of the result.
     pub fn enhance(
         &self,
         c: &mut Chromosome,
-        seed: u64,
-        kicks: usize,
+        start: Option<&[usize]>,
         ctx: &JobCtx,
     ) -> Result<(), Cancelled> {
         ctx.check()?;
@@ -81,11 +83,7 @@ impl Shared<'_> {
         order.extend(c.sco.iter().map(|&g| g + 1));
         let mut tour = Tour { order, flipped };
         let ls = LocalSearch::with_neighbours(&prob, &self.neighbours, LsOptions::default());
-        if kicks > 0 {
-            ls.iterated(&mut tour, kicks, seed, ctx)?;
-        } else {
-            ls.run(&mut tour, None, ctx)?;
-        }
+        ls.run(&mut tour, start, ctx)?;
         c.sco = tour.order.iter().skip(1).map(|&v| v - 1).collect();
         for (g, geom) in self.geometries.iter().enumerate() {
             if !geom.closed {
@@ -101,7 +99,7 @@ impl Shared<'_> {
         for s in &steps {
             c.vo[s.geometry] = s.choice(&self.geometries[s.geometry]);
         }
-        c.idle_mm = crate::order::metrics::idle_mm(self.geometries, &steps);
+        c.cost = (self.fitness)(&steps);
         Ok(())
     }
 

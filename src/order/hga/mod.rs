@@ -9,7 +9,21 @@
 //! probability 30 % (new random vertices for every geometry of one random field) and enhances
 //! every offspring. ps grows by 50 % (to at most 48) after a generation without improvement and
 //! shrinks by 20 % (to at least 16) after one with; the run stops after 5 generations without
-//! improvement, at the time limit, or on cancel — returning the best plan found so far.
+//! improvement, after `max_generations` (when set), at the time limit, or on cancel —
+//! returning the best plan found so far.
+//!
+//! **One objective.** Seed 000 ranks chromosomes on idle travel; here the fitness is the plan's
+//! objective, handed in by the caller (`order::objective`): the job time under `--cost time`,
+//! idle millimetres under `--cost distance`. Enhancement still shortens travel (its local
+//! search is a distance TSP), but elitism, the best and the stall test all read the objective,
+//! so the seed (HHA's finished plan) can only be replaced by a chromosome that beats it.
+//!
+//! **Cheap offspring.** An offspring differs from its parents only around the crossover's cut
+//! points, where the second parent's order skips the middle's genes, and in a mutated field;
+//! its local search starts from those nodes only (don't-look bits on the rest), so a
+//! generation costs about the changed part plus O(n) bookkeeping and one O(n) evaluation per
+//! offspring, not a search of every node.
+//!
 //! Random draws happen on the calling thread in a fixed order and enhancement is parallel
 //! (rayon) but deterministic, so a seed gives the same plan on any number of threads.
 
@@ -17,7 +31,8 @@ pub mod cea;
 
 use super::{OrderError, Ordering};
 use crate::document::{
-    GaParams, GenerationRecord, Geometry, MachineProfile, ScanField, SolverSettings, VertexMode,
+    GaParams, GenerationRecord, Geometry, MachineProfile, ObjectiveKind, ScanField, SolverSettings,
+    Step, VertexMode,
 };
 use crate::geom::Pt;
 use crate::job::{Cancelled, JobCtx};
@@ -36,8 +51,17 @@ pub struct Chromosome {
     pub sco: Vec<usize>,
     /// Start choice per geometry (vertex order), indexed by geometry.
     pub vo: Vec<usize>,
-    /// Idle travel of the enhanced chromosome, mm (the fitness is its reciprocal).
-    pub idle_mm: f64,
+    /// The objective of the enhanced chromosome (s or mm; lower is fitter).
+    pub cost: f64,
+}
+
+/// The objective HGA ranks chromosomes on: what it measures and how to compute it from strokes
+/// in marking order.
+pub struct Fitness<'a> {
+    /// What the values are.
+    pub kind: ObjectiveKind,
+    /// The value of an order (one step per stroke, passes not repeated).
+    pub of: &'a (dyn Fn(&[Step]) -> f64 + Sync),
 }
 
 /// What an HGA run returns.
@@ -45,7 +69,7 @@ pub struct Chromosome {
 pub struct HgaResult {
     /// The best plan's ordering.
     pub ordering: Ordering,
-    /// Best and mean idle per generation.
+    /// Best and mean objective per generation.
     pub history: Vec<GenerationRecord>,
     /// True when the run was cancelled (the ordering is the best found until then).
     pub cancelled: bool,
@@ -73,7 +97,7 @@ fn two_point_crossover(p1: &Chromosome, p2: &Chromosome, a: usize, b: usize) -> 
     Chromosome {
         sco,
         vo,
-        idle_mm: f64::INFINITY,
+        cost: f64::INFINITY,
     }
 }
 
@@ -95,42 +119,135 @@ fn random_chromosome(
     Chromosome {
         sco,
         vo,
-        idle_mm: f64::INFINITY,
+        cost: f64::INFINITY,
     }
 }
 
-/// Enhances chromosomes in parallel; `Err` when cancelled.
+/// Enhances chromosomes in parallel, each from its own start nodes (`None`: all); `Err` when
+/// cancelled.
 fn enhance_all(
     shared: &Shared,
     pop: &mut [Chromosome],
-    seeds: &[u64],
-    kicks: usize,
+    starts: &[Option<Vec<usize>>],
     ctx: &JobCtx,
 ) -> Result<(), Cancelled> {
     pop.par_iter_mut()
-        .zip(seeds.par_iter())
-        .map(|(c, &s)| shared.enhance(c, s, kicks, ctx))
+        .zip(starts.par_iter())
+        .map(|(c, start)| shared.enhance(c, start.as_deref(), ctx))
         .collect::<Result<Vec<()>, Cancelled>>()
         .map(|_| ())
 }
 
 fn stats(pop: &[Chromosome]) -> (f64, f64) {
-    let best = pop.iter().map(|c| c.idle_mm).fold(f64::INFINITY, f64::min);
-    let mean = pop.iter().map(|c| c.idle_mm).sum::<f64>() / pop.len().max(1) as f64;
+    let best = pop.iter().map(|c| c.cost).fold(f64::INFINITY, f64::min);
+    let mean = pop.iter().map(|c| c.cost).sum::<f64>() / pop.len().max(1) as f64;
     (best, mean)
 }
 
-/// Runs HGA on allocated fields; `seed_plan` (e.g. the HHA result) joins the initial population.
+/// The path nodes (geometry g is node g + 1) where `child`'s order differs from both parents':
+/// a gene whose successor is neither parent's successor for it, that successor, and the genes
+/// of `mutated`; the local search starts from these.
+fn changed_nodes(child: &[usize], p1: &[usize], p2: &[usize], mutated: &[usize]) -> Vec<usize> {
+    let n = child.len();
+    let succ = |order: &[usize]| {
+        let mut s = vec![usize::MAX; n];
+        for w in order.windows(2) {
+            s[w[0]] = w[1];
+        }
+        s
+    };
+    let (s1, s2) = (succ(p1), succ(p2));
+    let mut out: Vec<usize> = Vec::new();
+    if child.first() != p1.first() && child.first() != p2.first() {
+        out.push(0);
+    }
+    for w in child.windows(2) {
+        if s1[w[0]] != w[1] && s2[w[0]] != w[1] {
+            out.push(w[0] + 1);
+            out.push(w[1] + 1);
+        }
+    }
+    out.extend(mutated.iter().map(|&g| g + 1));
+    out.sort_unstable();
+    out.dedup();
+    out
+}
+
+/// Runs HGA on allocated fields, ranking chromosomes on `fitness`; `seed_plan` (HHA's finished
+/// plan) joins the initial population, so the result is never worse than it on `fitness`.
 pub fn hga_order(
     geometries: &[Geometry],
     fields: &[ScanField],
     profile: &MachineProfile,
     settings: &SolverSettings,
     seed_plan: Option<&Ordering>,
+    fitness: &Fitness,
     ctx: &JobCtx,
 ) -> Result<HgaResult, OrderError> {
     let t0 = Instant::now();
     let ga: &GaParams = &settings.ga;
+    let shared = shared(geometries, fields, profile, settings, fitness, ctx)?;
+    let mut rng = ChaCha8Rng::seed_from_u64(settings.seed);
+    let mut run = Run {
+        ga,
+        fields,
+        t0,
+        limit_s: settings.time_limit_s.unwrap_or(f64::INFINITY),
+        kind: fitness.kind,
+        history: Vec::new(),
+        ctx,
+    };
+    let mut ps = ga
+        .population
+        .clamp(ga.population_min.max(2), ga.population_max.max(2));
+    let (mut pop, mut cancelled) = initial_population(&shared, ps, seed_plan, &mut rng, ctx)?;
+    let (mut best, mean) = stats(&pop);
+    run.record(0, best, mean, pop.len());
+    let mut stall = 0;
+    let mut generation = 0;
+    while !cancelled && !run.over(generation, stall) {
+        generation += 1;
+        let (offspring, was_cancelled) = run.offspring(&shared, &pop, ps, &mut rng);
+        cancelled = was_cancelled;
+        let elite_n = ((ga.elite_fraction * ps as f64).ceil() as usize).clamp(2, pop.len());
+        pop.truncate(elite_n);
+        pop.extend(offspring);
+        pop.sort_by(|a, b| a.cost.total_cmp(&b.cost));
+        let (b, mean) = stats(&pop);
+        if b < best - 1e-9 * best.abs().max(1.0) {
+            best = b;
+            stall = 0;
+            ps = ((ps as f64 * 0.8).round() as usize).max(ga.population_min);
+        } else {
+            stall += 1;
+            ps = ((ps as f64 * 1.5).round() as usize).min(ga.population_max);
+        }
+        run.record(generation, best, mean, pop.len());
+    }
+    let steps = shared.steps(&pop[0]);
+    let mut field_order: Vec<usize> = Vec::new();
+    for s in &steps {
+        if field_order.last() != Some(&s.field) {
+            field_order.push(s.field);
+        }
+    }
+    Ok(HgaResult {
+        ordering: Ordering { field_order, steps },
+        history: run.history,
+        cancelled,
+    })
+}
+
+/// What every chromosome of a run shares: allocation, the corner, neighbour lists on the
+/// geometries' centroids (node 0: the corner), the fitness.
+fn shared<'a>(
+    geometries: &'a [Geometry],
+    fields: &[ScanField],
+    profile: &MachineProfile,
+    settings: &SolverSettings,
+    fitness: &'a Fitness<'a>,
+    ctx: &JobCtx,
+) -> Result<Shared<'a>, OrderError> {
     let mut field_of = vec![0usize; geometries.len()];
     for f in fields {
         for &g in &f.geometries {
@@ -138,86 +255,139 @@ pub fn hga_order(
         }
     }
     let corner = Pt::new(-profile.field_mm[0] / 2.0, -profile.field_mm[1] / 2.0);
-    // neighbour lists on the geometries' centroids, shared by every chromosome (node 0: corner)
     let mut pts = vec![corner];
     pts.extend(geometries.iter().map(Geometry::centroid));
     let mut nprob = PathProblem::points(&pts, &vec![0.0; pts.len()], 0.0);
     nprob.nodes = pts.iter().map(|&q| Node::point(q, 0.0)).collect();
-    let shared = Shared {
+    Ok(Shared {
         geometries,
         field_of,
         corner,
         penalty: profile.field_mm[0].hypot(profile.field_mm[1]),
         neighbours: neighbour_lists(&nprob, 12, ctx)?,
         exact_vertices: settings.vertex == VertexMode::Exact,
-    };
-    let mut rng = ChaCha8Rng::seed_from_u64(settings.seed);
-    let limit_s = settings.time_limit_s.unwrap_or(f64::INFINITY);
-    let mut ps = ga
-        .population
-        .clamp(ga.population_min.max(2), ga.population_max.max(2));
-    // initial population: 3·ps random, all-minimum and all-maximum VO, the seed plan
+        fitness: fitness.of,
+    })
+}
+
+/// 3·ps random chromosomes, all-minimum and all-maximum VO, enhanced; then the seed plan as it
+/// is (its cost computed, not enhanced: it is already a finished plan). Sorted, fittest first;
+/// with whether a cancel cut the enhancement short.
+fn initial_population(
+    shared: &Shared,
+    ps: usize,
+    seed_plan: Option<&Ordering>,
+    rng: &mut ChaCha8Rng,
+    ctx: &JobCtx,
+) -> Result<(Vec<Chromosome>, bool), OrderError> {
+    let geometries = shared.geometries;
     let mut pop: Vec<Chromosome> = (0..3 * ps)
-        .map(|_| random_chromosome(geometries, &mut rng, None))
+        .map(|_| random_chromosome(geometries, rng, None))
         .collect();
-    pop.push(random_chromosome(geometries, &mut rng, Some(false)));
-    pop.push(random_chromosome(geometries, &mut rng, Some(true)));
-    let seeds: Vec<u64> = (0..pop.len()).map(|_| rng.random()).collect();
+    pop.push(random_chromosome(geometries, rng, Some(false)));
+    pop.push(random_chromosome(geometries, rng, Some(true)));
     ctx.progress(
         "order",
         0,
         0,
         format!("HGA: initial population of {}", pop.len()),
     );
-    let mut history = Vec::new();
-    let mut cancelled = enhance_all(&shared, &mut pop, &seeds, 0, ctx).is_err();
+    let starts = vec![None; pop.len()];
+    let cancelled = enhance_all(shared, &mut pop, &starts, ctx).is_err();
     if let Some(plan) = seed_plan {
         let mut vo = vec![0; geometries.len()];
         for s in &plan.steps {
             vo[s.geometry] = s.choice(&geometries[s.geometry]);
         }
-        let steps = plan.steps.clone();
-        let idle_mm = super::metrics::idle_mm(geometries, &steps);
         pop.push(Chromosome {
-            sco: steps.iter().map(|s| s.geometry).collect(),
+            sco: plan.steps.iter().map(|s| s.geometry).collect(),
             vo,
-            idle_mm,
+            cost: (shared.fitness)(&plan.steps),
         });
     }
-    pop.retain(|c| c.idle_mm.is_finite());
+    pop.retain(|c| c.cost.is_finite());
     if pop.is_empty() {
         return Err(OrderError::Cancelled(Cancelled));
     }
-    pop.sort_by(|a, b| a.idle_mm.total_cmp(&b.idle_mm));
-    let (mut best, mean) = stats(&pop);
-    let record = |g: usize, best: f64, mean: f64, ps: usize, h: &mut Vec<GenerationRecord>| {
-        h.push(GenerationRecord {
+    pop.sort_by(|a, b| a.cost.total_cmp(&b.cost));
+    Ok((pop, cancelled))
+}
+
+/// One run's budget, history and reporting.
+struct Run<'a> {
+    ga: &'a GaParams,
+    fields: &'a [ScanField],
+    t0: Instant,
+    limit_s: f64,
+    kind: ObjectiveKind,
+    history: Vec<GenerationRecord>,
+    ctx: &'a JobCtx,
+}
+
+impl Run<'_> {
+    /// True when the run should stop before `generation + 1`: stalled, at the cap, or out of
+    /// time.
+    fn over(&self, generation: usize, stall: usize) -> bool {
+        stall >= self.ga.stall_generations
+            || self.ga.max_generations.is_some_and(|m| generation >= m)
+            || self.t0.elapsed().as_secs_f64() >= self.limit_s
+    }
+
+    /// Records a generation and reports it: best and mean in the objective's unit, and how far
+    /// the run has got (of the generation cap, or of the time limit).
+    fn record(&mut self, g: usize, best: f64, mean: f64, population: usize) {
+        let elapsed_s = self.t0.elapsed().as_secs_f64();
+        self.history.push(GenerationRecord {
             generation: g,
-            best_idle_mm: best,
-            mean_idle_mm: mean,
-            population: ps,
-            elapsed_s: t0.elapsed().as_secs_f64(),
+            best,
+            mean,
+            objective: self.kind,
+            population,
+            elapsed_s,
+            finished: false,
         });
-        if let Some(r) = ctx.recorder() {
+        if let Some(r) = self.ctx.recorder() {
             r.generation(g, best, mean);
         }
-        ctx.progress(
+        let unit = self.kind.unit();
+        let (done, total, of) = match self.ga.max_generations {
+            Some(m) => (g as u64, m as u64, format!(" of {m}")),
+            None => (g as u64, 0, String::new()),
+        };
+        let time = if self.limit_s.is_finite() {
+            format!(", {elapsed_s:.1} of {:.1} s", self.limit_s)
+        } else {
+            format!(", {elapsed_s:.1} s")
+        };
+        self.ctx.progress(
             "order",
-            g as u64,
-            0,
-            format!("HGA generation {g}: best {best:.1} mm, mean {mean:.1} mm, population {ps}"),
+            done,
+            total,
+            format!(
+                "HGA generation {g}{of}{time}: best {} {unit}, mean {} {unit}, population \
+                 {population}",
+                self.kind.show(best),
+                self.kind.show(mean)
+            ),
         );
-    };
-    record(0, best, mean, pop.len(), &mut history);
-    let mut stall = 0;
-    let mut generation = 0;
-    while !cancelled && stall < ga.stall_generations && t0.elapsed().as_secs_f64() < limit_s {
-        generation += 1;
-        let elite_n = ((ga.elite_fraction * ps as f64).ceil() as usize).clamp(2, pop.len());
-        let elite: Vec<Chromosome> = pop[..elite_n].to_vec();
+    }
+
+    /// The offspring of one generation, enhanced from their changed nodes, with whether a
+    /// cancel cut the enhancement short (the unfinished ones are dropped).
+    fn offspring(
+        &self,
+        shared: &Shared,
+        pop: &[Chromosome],
+        ps: usize,
+        rng: &mut ChaCha8Rng,
+    ) -> (Vec<Chromosome>, bool) {
+        let ga = self.ga;
+        let geometries = shared.geometries;
+        let elite = &pop[..((ga.elite_fraction * ps as f64).ceil() as usize).clamp(2, pop.len())];
         let crossovers = ((0.5 * (1.0 - ga.elite_fraction) * ps as f64).round() as usize).max(1);
         let n = geometries.len();
         let mut offspring = Vec::with_capacity(2 * crossovers);
+        let mut starts = Vec::with_capacity(2 * crossovers);
         for _ in 0..crossovers {
             let i = rng.random_range(0..elite.len());
             let mut j = rng.random_range(0..elite.len() - 1);
@@ -230,46 +400,22 @@ pub fn hga_order(
             }
             for (p1, p2) in [(&elite[i], &elite[j]), (&elite[j], &elite[i])] {
                 let mut child = two_point_crossover(p1, p2, a, b);
-                if rng.random_bool(ga.mutation_rate.clamp(0.0, 1.0)) && !fields.is_empty() {
-                    let f = &fields[rng.random_range(0..fields.len())];
+                let mut mutated: &[usize] = &[];
+                if rng.random_bool(ga.mutation_rate.clamp(0.0, 1.0)) && !self.fields.is_empty() {
+                    let f = &self.fields[rng.random_range(0..self.fields.len())];
                     for &g in &f.geometries {
                         child.vo[g] = rng.random_range(0..geometries[g].start_choices());
                     }
+                    mutated = &f.geometries;
                 }
+                starts.push(Some(changed_nodes(&child.sco, &p1.sco, &p2.sco, mutated)));
                 offspring.push(child);
             }
         }
-        let seeds: Vec<u64> = (0..offspring.len()).map(|_| rng.random()).collect();
-        cancelled = enhance_all(&shared, &mut offspring, &seeds, 0, ctx).is_err();
-        offspring.retain(|c| c.idle_mm.is_finite());
-        let mut next = elite;
-        next.extend(offspring);
-        next.sort_by(|a, b| a.idle_mm.total_cmp(&b.idle_mm));
-        pop = next;
-        let (b, mean) = stats(&pop);
-        if b < best - 1e-9 {
-            best = b;
-            stall = 0;
-            ps = ((ps as f64 * 0.8).round() as usize).max(ga.population_min);
-        } else {
-            stall += 1;
-            ps = ((ps as f64 * 1.5).round() as usize).min(ga.population_max);
-        }
-        record(generation, best, mean, pop.len(), &mut history);
+        let cancelled = enhance_all(shared, &mut offspring, &starts, self.ctx).is_err();
+        offspring.retain(|c| c.cost.is_finite());
+        (offspring, cancelled)
     }
-    let winner = &pop[0];
-    let steps = shared.steps(winner);
-    let mut field_order: Vec<usize> = Vec::new();
-    for s in &steps {
-        if field_order.last() != Some(&s.field) {
-            field_order.push(s.field);
-        }
-    }
-    Ok(HgaResult {
-        ordering: Ordering { field_order, steps },
-        history,
-        cancelled,
-    })
 }
 
 #[cfg(test)]
@@ -290,12 +436,12 @@ mod tests {
         let p1 = Chromosome {
             sco: vec![0, 1, 2, 3, 5, 4, 6],
             vo: vo1,
-            idle_mm: 0.0,
+            cost: 0.0,
         };
         let p2 = Chromosome {
             sco: vec![1, 0, 6, 4, 5, 3, 2],
             vo: vo2,
-            idle_mm: 0.0,
+            cost: 0.0,
         };
         // os1 takes the middle from p1 and the rest from p2 (the seed's naming swaps the parents)
         let os1 = two_point_crossover(&p2, &p1, 2, 4);
