@@ -338,6 +338,34 @@ pub fn stale_notes(ui: &mut egui::Ui, plans: &[(&Plan, &[String])]) {
     }
 }
 
+/// Says so plainly when an HGA plan that was not seeded with HHA's plan is slower than the
+/// HHA plan beside it (seeded, HGA never is).
+fn unseeded_note(ui: &mut egui::Ui, a: &Plan, b: &Plan) {
+    for (ga, hha) in [(a, b), (b, a)] {
+        if ga.algo != Algo::Hga || hha.algo != Algo::Hha || ga.settings.ga.seed_with_hha {
+            continue;
+        }
+        let (Some(tg), Some(th)) = (ga.metrics.job_time_s, hha.metrics.job_time_s) else {
+            continue;
+        };
+        if tg > th {
+            ui.add(
+                egui::Label::new(
+                    RichText::new(format!(
+                        "{} was not seeded with the HHA plan (\"Seed the GA with the HHA plan\" \
+                         is off in Solver settings), and is {:.2} % slower than {}.",
+                        ga.name,
+                        (tg - th) / th * 100.0,
+                        hha.name
+                    ))
+                    .color(WORSE_FG),
+                )
+                .wrap(),
+            );
+        }
+    }
+}
+
 /// Width kept for the convergence plot's y tick labels (e.g. `12 345.6`), px.
 const Y_AXIS_WIDTH_PX: f32 = 56.0;
 
@@ -587,6 +615,9 @@ pub fn show(
                     notes.push((b, stale_of(kb)));
                 }
                 stale_notes(ui, &notes);
+                if let Some(b) = b {
+                    unseeded_note(ui, a, b);
+                }
                 metrics_table(ui, "compare-metrics", a, b);
             });
     };

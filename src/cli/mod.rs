@@ -147,7 +147,7 @@ struct JobOpts {
     /// end worse than HHA).
     #[arg(long)]
     no_hha_seed: bool,
-    /// HGA: stop after this many generations without improvement.
+    /// HGA: without a time limit, stop after this many generations without improvement.
     #[arg(long, value_name = "N", default_value_t = galvoplan::document::GaParams::default().stall_generations)]
     ga_stall: usize,
     /// HGA: stop after this many generations at most (default: no cap).

@@ -564,7 +564,7 @@ pub fn settings_specs() -> Vec<FieldSpec<SolverSettings>> {
         whole!(
             "GA stall generations",
             "ga.stall_generations",
-            "stop after this many generations without improvement",
+            "without a time limit, stop after this many generations without improvement",
             1,
             u64::MAX,
             usize,

@@ -144,12 +144,31 @@ pub fn optimal_vertices(
     steps: &mut [Step],
     ctx: &JobCtx,
 ) -> Result<f64, Cancelled> {
+    optimal_vertices_between(geometries, steps, None, None, ctx)
+}
+
+/// [`optimal_vertices`] for a run of steps inside a longer order whose neighbours keep their
+/// choices: the idle travel counted includes the move from `before` (the previous stroke's
+/// end) to the run's first start and from the run's last end to `after` (the next stroke's
+/// start). Exact for the run given its neighbours (within the candidate sets); returns that
+/// idle travel, mm.
+pub fn optimal_vertices_between(
+    geometries: &[Geometry],
+    steps: &mut [Step],
+    before: Option<Pt>,
+    after: Option<Pt>,
+    ctx: &JobCtx,
+) -> Result<f64, Cancelled> {
     let n = steps.len();
     if n == 0 {
-        return Ok(0.0);
+        return Ok(before.zip(after).map_or(0.0, |(a, b)| a.dist(b)));
     }
     let cands: Vec<Vec<usize>> = (0..n).map(|k| candidates(geometries, steps, k)).collect();
-    let mut cost: Vec<f64> = vec![0.0; cands[0].len()];
+    let g0 = &geometries[steps[0].geometry];
+    let mut cost: Vec<f64> = cands[0]
+        .iter()
+        .map(|&c| before.map_or(0.0, |a| a.dist(ends(g0, c).0)))
+        .collect();
     let mut back: Vec<Vec<u32>> = Vec::with_capacity(n);
     back.push(Vec::new());
     for k in 1..n {
@@ -175,6 +194,12 @@ pub fn optimal_vertices(
         }
         cost = next;
         back.push(arg);
+    }
+    if let Some(b) = after {
+        let gl = &geometries[steps[n - 1].geometry];
+        for (v, &c) in cost.iter_mut().zip(&cands[n - 1]) {
+            *v += ends(gl, c).1.dist(b);
+        }
     }
     let (mut best_b, best) = cost
         .iter()
@@ -252,6 +277,56 @@ mod tests {
             );
             assert!((idle_mm(&gs, &steps) - dp).abs() < 1e-9);
             assert!(dp <= idle_mm(&gs, &v) + 1e-9);
+        }
+    }
+
+    #[test]
+    fn an_anchored_window_is_optimal_given_its_neighbours() {
+        for seed in 0..20 {
+            let gs = shapes(seed);
+            // the middle three strokes are re-optimised; the first and last keep their choices
+            let mut steps: Vec<Step> = (0..gs.len())
+                .map(|g| Step::from_choice(g, 0, &gs[g], g % gs[g].start_choices()))
+                .collect();
+            let end_of = |s: &Step| gs[s.geometry].ends(s.choice(&gs[s.geometry]));
+            let (before, after) = (end_of(&steps[0]).1, end_of(&steps[4]).0);
+            let mut best = f64::INFINITY;
+            let mut middle = steps[1..4].to_vec();
+            let mut probe = steps.clone();
+            brute_window(&gs, &mut probe, &mut middle, 0, &mut best);
+            let got = optimal_vertices_between(
+                &gs,
+                &mut steps[1..4],
+                Some(before),
+                Some(after),
+                &JobCtx::default(),
+            )
+            .unwrap();
+            let whole = idle_mm(&gs, &steps);
+            assert!((got - whole).abs() < 1e-9, "seed {seed}: {got} vs {whole}");
+            assert!(
+                (whole - best).abs() < 1e-9,
+                "seed {seed}: {whole} vs brute {best}"
+            );
+        }
+    }
+
+    /// Brute force over the choices of `middle` (steps 1..4 of `all`), scoring the whole order.
+    fn brute_window(
+        gs: &[Geometry],
+        all: &mut Vec<Step>,
+        middle: &mut Vec<Step>,
+        k: usize,
+        best: &mut f64,
+    ) {
+        if k == middle.len() {
+            all[1..4].copy_from_slice(middle);
+            *best = best.min(idle_mm(gs, all));
+            return;
+        }
+        for c in 0..gs[middle[k].geometry].start_choices() {
+            set_choice(middle, gs, k, c);
+            brute_window(gs, all, middle, k + 1, best);
         }
     }
 

@@ -6,7 +6,26 @@ use crate::geom::Pt;
 use crate::job::{Cancelled, JobCtx};
 use crate::order::cost::TravelCost;
 use crate::order::tsp::{LocalSearch, LsOptions, Node, PathProblem, Tour, NO_CLUSTER};
-use crate::order::vertex::{optimal_vertices, vea};
+use crate::order::vertex::{optimal_vertices, optimal_vertices_between, vea};
+
+/// Steps on each side of a changed position whose start choices are re-optimised with it.
+pub const VERTEX_WINDOW_MARGIN: usize = 4;
+
+/// Where a chromosome came from: its parents' orders (twice the same for a mutant) and the
+/// genes a mutation gave new start choices.
+pub struct Lineage<'a> {
+    /// The parents' geometry orders.
+    pub parents: [&'a [usize]; 2],
+    /// Mutated genes (geometries).
+    pub mutated: &'a [usize],
+}
+
+impl Lineage<'_> {
+    /// The path nodes where `order` differs from both parents ([`super::changed_nodes`]).
+    pub fn changed_nodes(&self, order: &[usize]) -> Vec<usize> {
+        super::changed_nodes(order, self.parents[0], self.parents[1], self.mutated)
+    }
+}
 
 /// What every chromosome of one run shares.
 pub struct Shared<'a> {
@@ -67,13 +86,20 @@ impl Shared<'_> {
     }
 
     /// CEA: a TSP pass over the geometry order from the corner with a free end and the field
-    /// penalty (seed 000 Algorithm 1), started from the nodes in `start` (all when `None`), then
-    /// vertex enhancement (VEA; then the exact DP when enabled), with the field runs made
-    /// contiguous in between. Sets `c.cost` to the fitness of the result.
+    /// penalty (seed 000 Algorithm 1), then vertex enhancement (VEA; then the exact DP when
+    /// enabled), with the field runs made contiguous in between. Sets `c.cost` to the fitness
+    /// of the result.
+    ///
+    /// A chromosome made from others (`lineage`: an offspring, or a mutant of the seed) is
+    /// enhanced where it differs from them only: the local search starts from the nodes whose
+    /// neighbours are new, and with exact vertices the start choices are re-optimised in
+    /// windows around the positions whose neighbours are new (±[`VERTEX_WINDOW_MARGIN`] steps,
+    /// anchored to the fixed choices beside them). Elsewhere every gene keeps the choice it had
+    /// in its parent, next to the same neighbours.
     pub fn enhance(
         &self,
         c: &mut Chromosome,
-        start: Option<&[usize]>,
+        lineage: Option<&Lineage>,
         ctx: &JobCtx,
     ) -> Result<(), Cancelled> {
         ctx.check()?;
@@ -83,7 +109,8 @@ impl Shared<'_> {
         order.extend(c.sco.iter().map(|&g| g + 1));
         let mut tour = Tour { order, flipped };
         let ls = LocalSearch::with_neighbours(&prob, &self.neighbours, LsOptions::default());
-        ls.run(&mut tour, start, ctx)?;
+        let start = lineage.map(|l| l.changed_nodes(&c.sco));
+        ls.run(&mut tour, start.as_deref(), ctx)?;
         c.sco = tour.order.iter().skip(1).map(|&v| v - 1).collect();
         for (g, geom) in self.geometries.iter().enumerate() {
             if !geom.closed {
@@ -92,14 +119,61 @@ impl Shared<'_> {
         }
         make_contiguous(&mut c.sco, &self.field_of);
         let mut steps = self.steps(c);
-        vea(self.geometries, &mut steps, ctx)?;
-        if self.exact_vertices {
-            optimal_vertices(self.geometries, &mut steps, ctx)?;
+        match lineage {
+            Some(l) if self.exact_vertices => {
+                let changed = l.changed_nodes(&c.sco);
+                self.vertices_in_windows(&mut steps, &changed, ctx)?;
+            }
+            _ => {
+                vea(self.geometries, &mut steps, ctx)?;
+                if self.exact_vertices {
+                    optimal_vertices(self.geometries, &mut steps, ctx)?;
+                }
+            }
         }
         for s in &steps {
             c.vo[s.geometry] = s.choice(&self.geometries[s.geometry]);
         }
         c.cost = (self.fitness)(&steps);
+        Ok(())
+    }
+
+    /// Exact start choices in windows around the positions of `changed` path nodes (node g + 1
+    /// is geometry g; node 0, the corner, is the first position), each anchored to the strokes
+    /// before and after it.
+    fn vertices_in_windows(
+        &self,
+        steps: &mut [Step],
+        changed: &[usize],
+        ctx: &JobCtx,
+    ) -> Result<(), Cancelled> {
+        let n = steps.len();
+        let mut position = vec![0usize; self.geometries.len()];
+        for (k, s) in steps.iter().enumerate() {
+            position[s.geometry] = k;
+        }
+        let mut dirty: Vec<usize> = changed
+            .iter()
+            .map(|&v| if v == 0 { 0 } else { position[v - 1] })
+            .collect();
+        dirty.sort_unstable();
+        let mut k = 0;
+        while k < dirty.len() {
+            let lo = dirty[k].saturating_sub(VERTEX_WINDOW_MARGIN);
+            let mut hi = (dirty[k] + VERTEX_WINDOW_MARGIN + 1).min(n);
+            while k + 1 < dirty.len() && dirty[k + 1].saturating_sub(VERTEX_WINDOW_MARGIN) <= hi {
+                k += 1;
+                hi = (dirty[k] + VERTEX_WINDOW_MARGIN + 1).min(n);
+            }
+            k += 1;
+            let end_of = |s: &Step| {
+                let g = &self.geometries[s.geometry];
+                g.ends(s.choice(g))
+            };
+            let before = lo.checked_sub(1).map(|j| end_of(&steps[j]).1);
+            let after = steps.get(hi).map(|s| end_of(s).0);
+            optimal_vertices_between(self.geometries, &mut steps[lo..hi], before, after, ctx)?;
+        }
         Ok(())
     }
 

@@ -1,16 +1,19 @@
 //! The hybrid genetic algorithm (seed 000 §3.3).
 //!
 //! A chromosome is a geometry order (SCO) and a start choice per geometry (VO; kept per
-//! geometry, so a gene carries its vertex wherever crossover puts it). The initial population
-//! holds 3·ps random chromosomes plus two special ones (all minimum and all maximum VO) and,
-//! optionally, the HHA plan; each is improved by the chromosome enhancement algorithm ([`cea`]).
+//! geometry, so a gene carries its vertex wherever crossover puts it). Unseeded, the initial
+//! population holds 3·ps random chromosomes plus two special ones (all minimum and all maximum
+//! VO), as seed 000 says; seeded with the HHA plan (the default), it holds that plan and
+//! 3·ps + 2 mutants of it (local double bridges, a field's vertices redrawn), since random
+//! chromosomes of a large job each cost a full search and all rank far below the seed. Each is
+//! improved by the chromosome enhancement algorithm ([`cea`]).
 //! Every generation keeps the best 20 % (elitism), fills the rest with the offspring of
 //! 0.5 · 0.8 · ps two-point crossovers of random elite pairs, mutates an offspring with
 //! probability 30 % (new random vertices for every geometry of one random field) and enhances
 //! every offspring. ps grows by 50 % (to at most 48) after a generation without improvement and
-//! shrinks by 20 % (to at least 16) after one with; the run stops after 5 generations without
-//! improvement, after `max_generations` (when set), at the time limit, or on cancel —
-//! returning the best plan found so far.
+//! shrinks by 20 % (to at least 16) after one with; the run stops after `max_generations`
+//! (when set), at the time limit, on cancel, or — without a time limit — after 5 generations
+//! without improvement, returning the best plan found so far.
 //!
 //! **One objective.** Seed 000 ranks chromosomes on idle travel; here the fitness is the plan's
 //! objective, handed in by the caller (`order::objective`): the job time under `--cost time`,
@@ -37,7 +40,7 @@ use crate::document::{
 use crate::geom::Pt;
 use crate::job::{Cancelled, JobCtx};
 use crate::order::tsp::{neighbour_lists, Node, PathProblem};
-use cea::Shared;
+use cea::{Lineage, Shared};
 use rand::seq::SliceRandom;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -123,17 +126,17 @@ fn random_chromosome(
     }
 }
 
-/// Enhances chromosomes in parallel, each from its own start nodes (`None`: all); `Err` when
-/// cancelled.
+/// Enhances chromosomes in parallel, each where it differs from its lineage (`None`: all of
+/// it); `Err` when cancelled.
 fn enhance_all(
     shared: &Shared,
     pop: &mut [Chromosome],
-    starts: &[Option<Vec<usize>>],
+    lineages: &[Option<Lineage>],
     ctx: &JobCtx,
 ) -> Result<(), Cancelled> {
     pop.par_iter_mut()
-        .zip(starts.par_iter())
-        .map(|(c, start)| shared.enhance(c, start.as_deref(), ctx))
+        .zip(lineages.par_iter())
+        .map(|(c, lineage)| shared.enhance(c, lineage.as_ref(), ctx))
         .collect::<Result<Vec<()>, Cancelled>>()
         .map(|_| ())
 }
@@ -200,7 +203,8 @@ pub fn hga_order(
     let mut ps = ga
         .population
         .clamp(ga.population_min.max(2), ga.population_max.max(2));
-    let (mut pop, mut cancelled) = initial_population(&shared, ps, seed_plan, &mut rng, ctx)?;
+    let (mut pop, mut cancelled) =
+        initial_population(&shared, ps, ga.mutation_rate, seed_plan, &mut rng, ctx)?;
     let (mut best, mean) = stats(&pop);
     run.record(0, best, mean, pop.len());
     let mut stall = 0;
@@ -270,47 +274,110 @@ fn shared<'a>(
     })
 }
 
-/// 3·ps random chromosomes, all-minimum and all-maximum VO, enhanced; then the seed plan as it
-/// is (its cost computed, not enhanced: it is already a finished plan). Sorted, fittest first;
-/// with whether a cancel cut the enhancement short.
+/// The initial population, enhanced, sorted fittest first, with whether a cancel cut the
+/// enhancement short. Unseeded: seed 000's 3·ps random chromosomes and the all-minimum and
+/// all-maximum VO ones. Seeded: the seed plan as it is (its cost computed, not enhanced: it is
+/// a finished plan) and 3·ps + 2 mutants of it, each enhanced where it differs from the seed.
+/// Random chromosomes of a large job take a full search each (≈ 0.4 s on texture-3043's 9,129
+/// strokes) and all rank far below the seed, so the seeded population starts near it instead.
 fn initial_population(
     shared: &Shared,
     ps: usize,
+    mutation_rate: f64,
     seed_plan: Option<&Ordering>,
     rng: &mut ChaCha8Rng,
     ctx: &JobCtx,
 ) -> Result<(Vec<Chromosome>, bool), OrderError> {
     let geometries = shared.geometries;
-    let mut pop: Vec<Chromosome> = (0..3 * ps)
-        .map(|_| random_chromosome(geometries, rng, None))
-        .collect();
-    pop.push(random_chromosome(geometries, rng, Some(false)));
-    pop.push(random_chromosome(geometries, rng, Some(true)));
-    ctx.progress(
-        "order",
-        0,
-        0,
-        format!("HGA: initial population of {}", pop.len()),
-    );
-    let starts = vec![None; pop.len()];
-    let cancelled = enhance_all(shared, &mut pop, &starts, ctx).is_err();
-    if let Some(plan) = seed_plan {
+    let n = 3 * ps + 2;
+    ctx.progress("order", 0, 0, format!("HGA: initial population of {n}"));
+    let seed = seed_plan.map(|plan| {
         let mut vo = vec![0; geometries.len()];
         for s in &plan.steps {
             vo[s.geometry] = s.choice(&geometries[s.geometry]);
         }
-        pop.push(Chromosome {
+        Chromosome {
             sco: plan.steps.iter().map(|s| s.geometry).collect(),
             vo,
             cost: (shared.fitness)(&plan.steps),
-        });
-    }
+        }
+    });
+    let (mut pop, cancelled) = match &seed {
+        None => {
+            let mut pop: Vec<Chromosome> = (0..3 * ps)
+                .map(|_| random_chromosome(geometries, rng, None))
+                .collect();
+            pop.push(random_chromosome(geometries, rng, Some(false)));
+            pop.push(random_chromosome(geometries, rng, Some(true)));
+            let lineages: Vec<Option<Lineage>> = (0..pop.len()).map(|_| None).collect();
+            let cancelled = enhance_all(shared, &mut pop, &lineages, ctx).is_err();
+            (pop, cancelled)
+        }
+        Some(seed) => {
+            let (mut pop, mutated): (Vec<Chromosome>, Vec<Vec<usize>>) = (0..n)
+                .map(|_| mutant(seed, shared, mutation_rate, rng))
+                .unzip();
+            let lineages: Vec<Option<Lineage>> = mutated
+                .iter()
+                .map(|m| {
+                    Some(Lineage {
+                        parents: [&seed.sco, &seed.sco],
+                        mutated: m,
+                    })
+                })
+                .collect();
+            let cancelled = enhance_all(shared, &mut pop, &lineages, ctx).is_err();
+            (pop, cancelled)
+        }
+    };
+    pop.extend(seed);
     pop.retain(|c| c.cost.is_finite());
     if pop.is_empty() {
         return Err(OrderError::Cancelled(Cancelled));
     }
     pop.sort_by(|a, b| a.cost.total_cmp(&b.cost));
     Ok((pop, cancelled))
+}
+
+/// Most genes a mutant's double bridge spans, as a share of the order.
+const MUTANT_SPAN_SHARE: f64 = 0.05;
+
+/// A mutant of `seed`: one to three local double bridges (three adjacent runs of the order
+/// `A B C` become `A C B`, which 2-opt and Or-opt moves cannot undo in one step) and, with
+/// the mutation rate, new random start choices for one field; with the mutated genes.
+fn mutant(
+    seed: &Chromosome,
+    shared: &Shared,
+    mutation_rate: f64,
+    rng: &mut ChaCha8Rng,
+) -> (Chromosome, Vec<usize>) {
+    let mut c = seed.clone();
+    c.cost = f64::INFINITY;
+    let n = c.sco.len();
+    if n >= 4 {
+        let span = ((n as f64 * MUTANT_SPAN_SHARE) as usize).clamp(3, n - 1);
+        for _ in 0..rng.random_range(1..=3) {
+            let a = rng.random_range(0..n - span);
+            let b = a + rng.random_range(1..span - 1);
+            let e = a + span;
+            let m = rng.random_range(b + 1..e);
+            // [a, b) [b, m) [m, e) → [a, b) [m, e) [b, m)
+            c.sco[b..e].rotate_left(m - b);
+        }
+    }
+    let geometries = shared.geometries;
+    let mut mutated = Vec::new();
+    if n > 0 && rng.random_bool(mutation_rate.clamp(0.0, 1.0)) {
+        let g = c.sco[rng.random_range(0..n)];
+        let field = shared.field_of[g];
+        for &h in &c.sco {
+            if shared.field_of[h] == field {
+                c.vo[h] = rng.random_range(0..geometries[h].start_choices());
+                mutated.push(h);
+            }
+        }
+    }
+    (c, mutated)
 }
 
 /// One run's budget, history and reporting.
@@ -325,10 +392,12 @@ struct Run<'a> {
 }
 
 impl Run<'_> {
-    /// True when the run should stop before `generation + 1`: stalled, at the cap, or out of
-    /// time.
+    /// True when the run should stop before `generation + 1`: at the cap, out of time, or —
+    /// without a time limit — stalled. An operator who gives the GA a time limit gives it that
+    /// time: the stall does not end the run then.
     fn over(&self, generation: usize, stall: usize) -> bool {
-        stall >= self.ga.stall_generations
+        let stalled = !self.limit_s.is_finite() && stall >= self.ga.stall_generations;
+        stalled
             || self.ga.max_generations.is_some_and(|m| generation >= m)
             || self.t0.elapsed().as_secs_f64() >= self.limit_s
     }
@@ -387,7 +456,7 @@ impl Run<'_> {
         let crossovers = ((0.5 * (1.0 - ga.elite_fraction) * ps as f64).round() as usize).max(1);
         let n = geometries.len();
         let mut offspring = Vec::with_capacity(2 * crossovers);
-        let mut starts = Vec::with_capacity(2 * crossovers);
+        let mut lineages = Vec::with_capacity(2 * crossovers);
         for _ in 0..crossovers {
             let i = rng.random_range(0..elite.len());
             let mut j = rng.random_range(0..elite.len() - 1);
@@ -408,11 +477,14 @@ impl Run<'_> {
                     }
                     mutated = &f.geometries;
                 }
-                starts.push(Some(changed_nodes(&child.sco, &p1.sco, &p2.sco, mutated)));
+                lineages.push(Some(Lineage {
+                    parents: [&p1.sco, &p2.sco],
+                    mutated,
+                }));
                 offspring.push(child);
             }
         }
-        let cancelled = enhance_all(shared, &mut offspring, &starts, self.ctx).is_err();
+        let cancelled = enhance_all(shared, &mut offspring, &lineages, self.ctx).is_err();
         offspring.retain(|c| c.cost.is_finite());
         (offspring, cancelled)
     }
@@ -421,6 +493,19 @@ impl Run<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn an_offspring_is_searched_from_where_it_differs_from_both_parents() {
+        let p1 = [0, 1, 2, 3, 4, 5, 6];
+        let p2 = [6, 5, 4, 3, 2, 1, 0];
+        // p1's middle 2..=4 kept, the rest in p2's order: 6 5 | 2 3 4 | 1 0
+        let child = [6, 5, 2, 3, 4, 1, 0];
+        // 5→2 and 4→1 are new (neither parent has them); 6→5, 2→3, 3→4, 1→0 are inherited
+        assert_eq!(changed_nodes(&child, &p1, &p2, &[]), vec![2, 3, 5, 6]);
+        // a mutated gene joins (node = gene + 1); a first gene of neither parent adds the corner
+        let child = [5, 6, 0, 1, 2, 3, 4];
+        assert_eq!(changed_nodes(&child, &p1, &p2, &[3]), vec![0, 1, 4, 7]);
+    }
 
     #[test]
     fn crossover_matches_the_seed_example() {
