@@ -70,6 +70,9 @@ pub struct BenchRow {
     pub direction_changes: Stat,
     /// Job time (the lowered toolpath's duration), s.
     pub job_time_s: Stat,
+    /// A lower bound on the job time of any order of the first seed's fields (step-and-scan;
+    /// `order::objective::step_job_time_lower_bound_s`), s.
+    pub job_time_lower_bound_s: Option<f64>,
     /// Stage moves and settling in the job time, s.
     pub stage_time_s: Stat,
     /// Length of the stage's route, mm.
@@ -139,7 +142,7 @@ pub fn run_instance(
 ) -> Result<BenchRow, PipelineError> {
     let mut times: [Vec<f64>; 5] = Default::default();
     let mut quality: [Vec<f64>; 11] = Default::default();
-    let (mut geometries, mut marked_mm, mut lower) = (0, 0.0, None);
+    let (mut geometries, mut marked_mm, mut lower, mut job_lb) = (0, 0.0, None, None);
     for k in 0..seeds.max(1) {
         let mut s = settings.clone();
         s.seed = settings.seed.wrapping_add(k as u64);
@@ -187,6 +190,14 @@ pub fn run_instance(
                 }
                 geometries = doc.geometries.len();
                 marked_mm = m.marked_mm;
+                job_lb = (plan.motion == crate::document::MotionMode::Step).then(|| {
+                    crate::order::objective::step_job_time_lower_bound_s(
+                        &doc.geometries,
+                        &plan.fields,
+                        &doc.layers,
+                        &doc.profile,
+                    )
+                });
                 lower = m.fields_lower_bound;
             }
         }
@@ -208,6 +219,7 @@ pub fn run_instance(
         marked_mm,
         direction_changes: Stat::of(&dc),
         job_time_s: Stat::of(&jt),
+        job_time_lower_bound_s: job_lb,
         stage_time_s: Stat::of(&st),
         stage_route_mm: Stat::of(&route),
         scan_peak_offset_mm: Stat::of(&offset),
@@ -224,12 +236,12 @@ pub fn run_instance(
 /// Formats rows as a Markdown table (quality as mean ± sd when several seeds ran).
 pub fn format_table(rows: &[BenchRow]) -> String {
     let mut s = String::from(
-        "| instance | geometries | fields | LB | overlap % | idle mm | base mm | marked mm | dir. changes | job s | stage s | route mm | offset mm | peak stage mm/s | stage speed var. mm/s | import ms | fields ms | order ms | export ms | total ms |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "| instance | geometries | fields | LB | overlap % | idle mm | base mm | marked mm | dir. changes | job s | job LB s | stage s | route mm | offset mm | peak stage mm/s | stage speed var. mm/s | import ms | fields ms | order ms | export ms | total ms |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
         let sd = r.seeds > 1;
         s.push_str(&format!(
-            "| {} | {} | {} | {} | {} | {} | {} | {:.1} | {} | {} | {} | {} | {} | {} | {} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} |\n",
+            "| {} | {} | {} | {} | {} | {} | {} | {:.1} | {} | {} | {} | {} | {} | {} | {} | {} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} |\n",
             r.instance,
             r.geometries,
             r.fields.show(if sd { 1 } else { 0 }, sd),
@@ -239,7 +251,9 @@ pub fn format_table(rows: &[BenchRow]) -> String {
             r.base_mm.show(1, sd),
             r.marked_mm,
             r.direction_changes.show(if sd { 1 } else { 0 }, sd),
-            r.job_time_s.show(2, sd),
+            r.job_time_s.show(3, sd),
+            r.job_time_lower_bound_s
+                .map_or("–".to_string(), |v| format!("{v:.3}")),
             r.stage_time_s.show(2, sd),
             r.stage_route_mm.show(0, sd),
             r.scan_peak_offset_mm.show(2, sd),

@@ -113,6 +113,103 @@ impl<'a> StepTime<'a> {
     }
 }
 
+/// A lower bound on the step-and-scan job time of any order of these strokes on these fields
+/// (s): no ordering, HHA's, HGA's or an exhaustive one, can beat it. It is the sum of
+///
+/// * every stroke's marking and laser delays, once per pass (fixed by the strokes);
+/// * the stage's moves: the stage visits every distinct field centre, so its moves form a path
+///   through them, at least a minimum spanning tree of the centres under the stage's move time
+///   (settling included; Prim, O(fields²));
+/// * the scanner's jumps inside fields: every stroke of a field but the one marked first is
+///   reached by a jump from another stroke of that field, at least the jump delay plus the
+///   distance between the two strokes' bounding boxes at jump speed; the field's largest such
+///   term is left out (the first stroke's jump may hide in the stage move).
+///
+/// The gap between a plan's job time and this bound is the most any better order could gain.
+pub fn step_job_time_lower_bound_s(
+    geometries: &[Geometry],
+    fields: &[ScanField],
+    layers: &[Layer],
+    profile: &MachineProfile,
+) -> f64 {
+    let model = StepTime::new(geometries, fields, layers, profile);
+    let marking: f64 = geometries
+        .iter()
+        .zip(&model.mark_s)
+        .map(|(g, t)| t * f64::from(pen_of(layers, g).map_or(1, |p| p.passes.max(1))))
+        .sum();
+    let mut centres: Vec<Pt> = Vec::new();
+    for f in fields.iter().filter(|f| !f.geometries.is_empty()) {
+        if !centres.contains(&f.center) {
+            centres.push(f.center);
+        }
+    }
+    let stage = spanning_tree_s(&centres, &model.stage);
+    let jumps: f64 = fields
+        .iter()
+        .map(|f| {
+            let boxes: Vec<crate::geom::BBox> = f
+                .geometries
+                .iter()
+                .filter_map(|&g| geometries.get(g).map(Geometry::bbox))
+                .collect();
+            let nearest: Vec<f64> = (0..boxes.len())
+                .map(|i| {
+                    let gap = (0..boxes.len())
+                        .filter(|&j| j != i)
+                        .map(|j| box_gap_mm(&boxes[i], &boxes[j]))
+                        .fold(f64::INFINITY, f64::min);
+                    gap / model.jump_speed_mm_s + model.jump_delay_s
+                })
+                .filter(|t| t.is_finite())
+                .collect();
+            let largest = nearest.iter().copied().fold(0.0, f64::max);
+            nearest.iter().sum::<f64>() - largest
+        })
+        .sum();
+    marking + stage + jumps
+}
+
+/// The least distance between two boxes (0 when they overlap), mm.
+fn box_gap_mm(a: &crate::geom::BBox, b: &crate::geom::BBox) -> f64 {
+    let dx = (b.min_x - a.max_x).max(a.min_x - b.max_x).max(0.0);
+    let dy = (b.min_y - a.max_y).max(a.min_y - b.max_y).max(0.0);
+    dx.hypot(dy)
+}
+
+/// Weight of a minimum spanning tree of `points` under the stage's move time (Prim), s.
+fn spanning_tree_s(points: &[Pt], stage: &StageDynamics) -> f64 {
+    let n = points.len();
+    if n < 2 {
+        return 0.0;
+    }
+    let mut best = vec![f64::INFINITY; n];
+    let mut done = vec![false; n];
+    let mut total = 0.0;
+    let mut next = 0;
+    for _ in 0..n {
+        done[next] = true;
+        let mut pick: Option<usize> = None;
+        for j in 0..n {
+            if done[j] {
+                continue;
+            }
+            best[j] = best[j].min(stage.move_time_s(points[next], points[j]));
+            if pick.is_none_or(|k| best[j] < best[k]) {
+                pick = Some(j);
+            }
+        }
+        match pick {
+            Some(k) => {
+                total += best[k];
+                next = k;
+            }
+            None => break,
+        }
+    }
+    total
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -3,9 +3,9 @@
 //! A chromosome is a geometry order (SCO) and a start choice per geometry (VO; kept per
 //! geometry, so a gene carries its vertex wherever crossover puts it). Unseeded, the initial
 //! population holds 3·ps random chromosomes plus two special ones (all minimum and all maximum
-//! VO), as seed 000 says; seeded with the HHA plan (the default), it holds that plan and
-//! 3·ps + 2 mutants of it (local double bridges, a field's vertices redrawn), since random
-//! chromosomes of a large job each cost a full search and all rank far below the seed. Each is
+//! VO), as seed 000 says, and the HHA plan when seeded (the default); a large seeded job gets
+//! mutants of the HHA plan (local double bridges, a field's vertices redrawn) instead of the
+//! random ones, which each cost a full search and all rank far below the seed. Each is
 //! improved by the chromosome enhancement algorithm ([`cea`]).
 //! Every generation keeps the best 20 % (elitism), fills the rest with the offspring of
 //! 0.5 · 0.8 · ps two-point crossovers of random elite pairs, mutates an offspring with
@@ -21,11 +21,12 @@
 //! search is a distance TSP), but elitism, the best and the stall test all read the objective,
 //! so the seed (HHA's finished plan) can only be replaced by a chromosome that beats it.
 //!
-//! **Cheap offspring.** An offspring differs from its parents only around the crossover's cut
-//! points, where the second parent's order skips the middle's genes, and in a mutated field;
-//! its local search starts from those nodes only (don't-look bits on the rest), so a
-//! generation costs about the changed part plus O(n) bookkeeping and one O(n) evaluation per
-//! offspring, not a search of every node.
+//! **Cheap offspring on large jobs.** An offspring differs from its parents only around the
+//! crossover's cut points, where the second parent's order skips the middle's genes, and in a
+//! mutated field; on a job of more than [`LOCAL_ENHANCEMENT_MIN_GEOMETRIES`] its local search
+//! starts from those nodes only (don't-look bits on the rest) and its start choices are
+//! re-optimised around them, so a generation costs about the changed part plus O(n)
+//! bookkeeping and one O(n) evaluation per offspring, not a search of every node.
 //!
 //! Random draws happen on the calling thread in a fixed order and enhancement is parallel
 //! (rayon) but deterministic, so a seed gives the same plan on any number of threads.
@@ -275,11 +276,12 @@ fn shared<'a>(
 }
 
 /// The initial population, enhanced, sorted fittest first, with whether a cancel cut the
-/// enhancement short. Unseeded: seed 000's 3·ps random chromosomes and the all-minimum and
-/// all-maximum VO ones. Seeded: the seed plan as it is (its cost computed, not enhanced: it is
-/// a finished plan) and 3·ps + 2 mutants of it, each enhanced where it differs from the seed.
-/// Random chromosomes of a large job take a full search each (≈ 0.4 s on texture-3043's 9,129
-/// strokes) and all rank far below the seed, so the seeded population starts near it instead.
+/// enhancement short: seed 000's 3·ps random chromosomes and the all-minimum and all-maximum
+/// VO ones, plus the seed plan as it is (its cost computed, not enhanced: it is a finished
+/// plan). A seeded job of more than [`LOCAL_ENHANCEMENT_MIN_GEOMETRIES`] gets 3·ps + 2 mutants
+/// of the seed instead of the random chromosomes, each enhanced where it differs from the seed:
+/// random ones take a full search each (≈ 0.2 s on texture-3043's 9,129 strokes, 21 s for the
+/// population) and all rank far below the seed.
 fn initial_population(
     shared: &Shared,
     ps: usize,
@@ -302,8 +304,9 @@ fn initial_population(
             cost: (shared.fitness)(&plan.steps),
         }
     });
+    let random = seed.is_none() || geometries.len() <= LOCAL_ENHANCEMENT_MIN_GEOMETRIES;
     let (mut pop, cancelled) = match &seed {
-        None => {
+        _ if random => {
             let mut pop: Vec<Chromosome> = (0..3 * ps)
                 .map(|_| random_chromosome(geometries, rng, None))
                 .collect();
@@ -313,6 +316,7 @@ fn initial_population(
             let cancelled = enhance_all(shared, &mut pop, &lineages, ctx).is_err();
             (pop, cancelled)
         }
+        None => (Vec::new(), false),
         Some(seed) => {
             let (mut pop, mutated): (Vec<Chromosome>, Vec<Vec<usize>>) = (0..n)
                 .map(|_| mutant(seed, shared, mutation_rate, rng))
@@ -338,6 +342,13 @@ fn initial_population(
     pop.sort_by(|a, b| a.cost.total_cmp(&b.cost));
     Ok((pop, cancelled))
 }
+
+/// Jobs of more geometries than this are searched locally: mutants of the seed instead of
+/// random chromosomes in the initial population, and offspring enhanced only where they differ
+/// from their parents. Below it a full search per chromosome is cheap (≈ 5 ms per 100
+/// geometries here) and worth its diversity and depth: with local enhancement throughout, HGA
+/// under `--cost distance` ended 1–3 % higher on ISW-200, ISW-489 and rnd-122 (5 seeds).
+const LOCAL_ENHANCEMENT_MIN_GEOMETRIES: usize = 2_000;
 
 /// Most genes a mutant's double bridge spans, as a share of the order.
 const MUTANT_SPAN_SHARE: f64 = 0.05;
@@ -477,7 +488,7 @@ impl Run<'_> {
                     }
                     mutated = &f.geometries;
                 }
-                lineages.push(Some(Lineage {
+                lineages.push((n > LOCAL_ENHANCEMENT_MIN_GEOMETRIES).then_some(Lineage {
                     parents: [&p1.sco, &p2.sco],
                     mutated,
                 }));
