@@ -40,12 +40,19 @@ impl CompareState {
             self.a = (0..n).rev().find(|&k| Some(k) != self.b);
         }
     }
-    /// Shows `new` as B and the previous B as A (after a solve).
-    pub fn push(&mut self, new: usize) {
-        if self.b != Some(new) {
-            self.a = self.b.or(self.a);
-            self.b = Some(new);
+    /// Shows the new plan `new` (an index into `plans`) as B after a solve. A plan of the same
+    /// algorithm as B (a re-run) takes B's place and A stays, so that a race set up between
+    /// two algorithms stays on screen; otherwise the previous B moves to A.
+    pub fn push(&mut self, new: usize, plans: &[Plan]) {
+        if self.b == Some(new) {
+            return;
         }
+        let algo = |k: Option<usize>| k.and_then(|k| plans.get(k)).map(|p| p.algo);
+        let rerun = algo(self.b).is_some() && algo(self.b) == algo(Some(new));
+        if !rerun {
+            self.a = self.b.or(self.a);
+        }
+        self.b = Some(new);
     }
 }
 
@@ -373,14 +380,17 @@ const Y_AXIS_WIDTH_PX: f32 = 56.0;
 /// of every plan with a history, in the plan's objective (job time, s, or idle travel, mm),
 /// ending at the plan's table figure (a marked point); the HHA plan's table figure in the same
 /// objective as a horizontal line.
-pub fn convergence_plot(ui: &mut egui::Ui, plans: &[(&Plan, Color32)], hha: Option<&Plan>) {
+///
+/// Plans are named in the legend by their letter (A, B: the table's columns, whose headings
+/// carry the full names), so that the legend stays short on a small window.
+pub fn convergence_plot(ui: &mut egui::Ui, plans: &[(&Plan, Color32, &str)], hha: Option<&Plan>) {
     let with_history: Vec<_> = plans
         .iter()
-        .filter(|(p, _)| !p.history.is_empty())
+        .filter(|(p, _, _)| !p.history.is_empty())
         .collect();
     let kind = with_history
         .first()
-        .and_then(|(p, _)| p.history.first())
+        .and_then(|(p, _, _)| p.history.first())
         .map_or(ObjectiveKind::JobTimeS, |h| h.objective);
     if with_history.is_empty() {
         ui.label("GA convergence: no generation history among the compared plans (run HGA).");
@@ -390,7 +400,7 @@ pub fn convergence_plot(ui: &mut egui::Ui, plans: &[(&Plan, Color32)], hha: Opti
              on-the-fly time needs the stage route); the table's job times are on the fly.",
         );
     }
-    let hha_figure = hha.and_then(|h| kind.of_metrics(&h.metrics).map(|v| (h, v)));
+    let hha_figure = hha.and_then(|h| kind.of_metrics(&h.metrics));
     Plot::new("convergence")
         .legend(Legend::default())
         .x_axis_label("Generation")
@@ -403,7 +413,7 @@ pub fn convergence_plot(ui: &mut egui::Ui, plans: &[(&Plan, Color32)], hha: Opti
         .y_axis_min_width(Y_AXIS_WIDTH_PX)
         .allow_scroll(false)
         .show(ui, |pui| {
-            for (p, col) in &with_history {
+            for (p, col, letter) in &with_history {
                 let best: PlotPoints = p
                     .history
                     .iter()
@@ -416,23 +426,19 @@ pub fn convergence_plot(ui: &mut egui::Ui, plans: &[(&Plan, Color32)], hha: Opti
                     .map(|h| [h.generation as f64, h.mean])
                     .collect();
                 pui.line(
-                    Line::new(format!("{}: best", p.name), best)
+                    Line::new(format!("{letter}: best"), best)
                         .color(*col)
                         .width(2.5),
                 );
                 pui.line(
-                    Line::new(format!("{}: population mean", p.name), mean)
-                        .color(MEAN_GREY.lerp_to_gamma(*col, 0.35))
+                    Line::new(format!("{letter}: population mean"), mean)
+                        .color(MEAN_GREY.lerp_to_gamma(*col, 0.12))
                         .width(1.5)
                         .style(LineStyle::dotted_dense()),
                 );
                 if let Some(last) = p.history.last().filter(|h| h.finished) {
-                    let label = format!(
-                        "{} as made: {} {}",
-                        p.name,
-                        kind.show(last.best),
-                        kind.unit()
-                    );
+                    let label =
+                        format!("{letter} as made: {} {}", kind.show(last.best), kind.unit());
                     pui.points(
                         Points::new(label, vec![[last.generation as f64, last.best]])
                             .color(*col)
@@ -440,14 +446,11 @@ pub fn convergence_plot(ui: &mut egui::Ui, plans: &[(&Plan, Color32)], hha: Opti
                     );
                 }
             }
-            if let Some((h, v)) = hha_figure {
+            if let Some(v) = hha_figure {
                 pui.hline(
-                    HLine::new(
-                        format!("{} (HHA): {} {}", h.name, kind.show(v), kind.unit()),
-                        v,
-                    )
-                    .color(Color32::from_rgb(22, 163, 74))
-                    .width(1.5),
+                    HLine::new(format!("HHA plan: {} {}", kind.show(v), kind.unit()), v)
+                        .color(Color32::from_rgb(22, 163, 74))
+                        .width(1.5),
                 );
             }
         });
@@ -598,11 +601,11 @@ pub fn show(
         }
     }
     ui.add_space(4.0);
-    let mut plans = vec![(a, colour::PATH_A)];
+    let mut plans = vec![(a, colour::PATH_A, if b.is_some() { "A" } else { "Plan" })];
     if let Some(b) = b {
-        plans.push((b, colour::PATH_B));
+        plans.push((b, colour::PATH_B, "B"));
     }
-    let history = plans.iter().any(|(p, _)| !p.history.is_empty());
+    let history = plans.iter().any(|(p, _, _)| !p.history.is_empty());
     let metrics = |ui: &mut egui::Ui| {
         // both ways: on a narrow view the table scrolls sideways rather than losing columns
         egui::ScrollArea::both()

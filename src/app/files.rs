@@ -135,6 +135,13 @@ pub fn reimport(
         hidden_layers: hidden,
         included: import.included,
     };
+    // a hidden layer left out again goes from the layer table (with its pen)
+    let left_out: Vec<String> = work.import.skipped().map(|l| l.name.clone()).collect();
+    let artwork = &work.artwork;
+    work.layers.retain(|l| {
+        !left_out.iter().any(|n| n.eq_ignore_ascii_case(&l.name))
+            || artwork.iter().any(|g| g.layer == l.name)
+    });
     work.derived_with = None;
     let before = work.geometry_rev;
     derive_geometries(&mut work, ctx).map_err(|e| e.to_string())?;

@@ -66,6 +66,8 @@ pub enum JobResult {
         /// Why fields could not be placed (the document is taken all the same, its
         /// geometries uncovered), in the GUI's words.
         problem: Option<String>,
+        /// The artwork moved or grew (imported again): the canvases fit the view to it.
+        refit: bool,
     },
     /// An export written.
     Exported {

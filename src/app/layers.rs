@@ -212,8 +212,11 @@ impl LayerEditor {
         ui.add_enabled_ui(enabled, |ui| {
             ui.horizontal(|ui| {
                 let label = ui.label("Placement").on_hover_text(
-                    "Where the artwork goes on the machine; choosing another imports the file \
-                     again",
+                    "Where the artwork goes on the machine (choosing another imports the file \
+                     again): automatic keeps the file's coordinates and centres the artwork on \
+                     the base stroke when it lies out of reach; centred puts the middle of its \
+                     bounding box on the middle of the base stroke; corner at x, y puts its \
+                     top-left corner there (mm)",
                 );
                 let mut choice = import.place;
                 let combo = egui::ComboBox::from_id_salt("placement")
@@ -556,10 +559,10 @@ fn outline_ui(ui: &mut egui::Ui, k: usize, layer: &Layer) -> Option<Layer> {
 /// A placement in the panel's words.
 pub fn place_words(place: &Place) -> String {
     match place {
-        Place::Auto => "as in the file, centred when out of reach".into(),
+        Place::Auto => "automatic".into(),
         Place::AsIs => "as in the file".into(),
-        Place::Centre => "centred on the base stroke".into(),
-        Place::Corner(_) => "top-left corner at a point".into(),
+        Place::Centre => "centred".into(),
+        Place::Corner(_) => "corner at x, y".into(),
     }
 }
 

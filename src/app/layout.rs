@@ -449,17 +449,39 @@ impl App {
             ));
             let far = self.session.out_of_reach.len();
             let near = self.session.uncovered.len() - far;
-            if far > 0 {
+            // larger than a field (cut them, or mark on the fly) or beyond the reach (move the
+            // artwork): each told what helps it
+            let [fw, fh] = self.session.doc.profile.field_mm;
+            let large = self
+                .session
+                .out_of_reach
+                .iter()
+                .filter(|&&g| {
+                    let b = self.session.doc.geometries[g].bbox();
+                    b.width() > fw || b.height() > fh
+                })
+                .count();
+            let beyond = far - large;
+            let advice = [
+                (
+                    large,
+                    "larger than a scan field: tick \"Split oversize geometries\" in Solver \
+                     settings and press \"Re-place automatically\", or choose \"On the fly\" as \
+                     the motion.",
+                ),
+                (
+                    beyond,
+                    "beyond the stage's stroke plus half a field: choose \"Placement: \
+                     centred\" in the Layers panel to move the artwork within reach.",
+                ),
+            ];
+            for (n, what) in advice.into_iter().filter(|(n, _)| *n > 0) {
                 ui.add(
                     egui::Label::new(
                         RichText::new(format!(
-                            "{} (dashed purple) cannot be held by any scan field: {} \
-                     larger than a field or {} beyond the stage's stroke plus half a field. Tick \
-                     \"Split oversize geometries\" in Solver settings and press \"Re-place \
-                     automatically\", or choose \"On the fly\" as the motion.",
-                            super::count(far, "geometry", "geometries"),
-                            if far == 1 { "it is" } else { "they are" },
-                            if far == 1 { "lies" } else { "lie" }
+                            "{} (dashed purple) cannot be held by any scan field, {} {what}",
+                            super::count(n, "geometry", "geometries"),
+                            if n == 1 { "it is" } else { "they are" },
                         ))
                         .color(colour::OUT_OF_REACH),
                     )

@@ -457,6 +457,7 @@ impl App {
                     doc: Box::new(work),
                     what: "re-place fields automatically".into(),
                     problem: None,
+                    refit: false,
                 })
             },
         );
@@ -477,6 +478,7 @@ impl App {
                     doc: Box::new(doc),
                     what,
                     problem,
+                    refit: true,
                 })
             },
         );
@@ -512,6 +514,7 @@ impl App {
                 doc: Box::new(work),
                 what,
                 problem: None,
+                refit: false,
             })
         });
     }
@@ -842,9 +845,18 @@ impl App {
         self.runtime.job = None;
         match outcome {
             JobOutcome::Done(JobResult::Opened { path, opened }) => self.opened(&path, *opened),
-            JobOutcome::Done(JobResult::Placed { doc, what, problem }) => {
+            JobOutcome::Done(JobResult::Placed {
+                doc,
+                what,
+                problem,
+                refit,
+            }) => {
                 if self.execute(Command::SetContent { doc, what }).is_ok() {
                     self.view.layer_editor.clear_error();
+                    if refit {
+                        self.view.workbench.fit_requested = true;
+                        self.view.compare.canvas.fit_requested = true;
+                    }
                     if let Some(p) = problem {
                         self.set_status(format!("scan fields not placed: {p}"), true);
                         self.session.problem = Some(p);
@@ -879,7 +891,7 @@ impl App {
                     elapsed.as_secs_f64()
                 );
                 let k = self.session.add_plan(*plan, lowered);
-                self.view.compare.push(k);
+                self.view.compare.push(k, &self.session.doc.plans);
                 match self.session.toolpaths.get(k) {
                     Some(Err(why)) => {
                         let msg = format!("{msg}; {why}");
@@ -1118,8 +1130,7 @@ pub fn gui_error(e: &crate::pipeline::PipelineError) -> String {
              automatically\" to cut them at field borders, or choose \"On the fly\" as the motion"
         ),
         Some(Remedy::Place) => format!(
-            "{e}; choose \"Placement: centred on the base stroke\" in the Layers panel to move it \
-             within reach"
+            "{e}; choose \"Placement: centred\" in the Layers panel to move it within reach"
         ),
         None => e.to_string(),
     }

@@ -23,7 +23,8 @@
 //!
 //! **Cheap offspring on large jobs.** An offspring differs from its parents only around the
 //! crossover's cut points, where the second parent's order skips the middle's genes, and in a
-//! mutated field; on a job of more than [`LOCAL_ENHANCEMENT_MIN_GEOMETRIES`] its local search
+//! mutated field; on a job of more than [`LOCAL_ENHANCEMENT_MIN_GEOMETRIES`] (or under a time
+//! limit: [`local_search`]) its local search
 //! starts from those nodes only (don't-look bits on the rest) and its start choices are
 //! re-optimised around them, so a generation costs about the changed part plus O(n)
 //! bookkeeping and one O(n) evaluation per offspring, not a search of every node.
@@ -197,6 +198,7 @@ pub fn hga_order(
         fields,
         t0,
         limit_s: settings.time_limit_s.unwrap_or(f64::INFINITY),
+        local: local_search(geometries.len(), settings.time_limit_s),
         kind: fitness.kind,
         history: Vec::new(),
         ctx,
@@ -204,8 +206,15 @@ pub fn hga_order(
     let mut ps = ga
         .population
         .clamp(ga.population_min.max(2), ga.population_max.max(2));
-    let (mut pop, mut cancelled) =
-        initial_population(&shared, ps, ga.mutation_rate, seed_plan, &mut rng, ctx)?;
+    let (mut pop, mut cancelled) = initial_population(
+        &shared,
+        ps,
+        run.local,
+        ga.mutation_rate,
+        seed_plan,
+        &mut rng,
+        ctx,
+    )?;
     let (mut best, mean) = stats(&pop);
     run.record(0, best, mean, pop.len());
     let mut stall = 0;
@@ -278,13 +287,14 @@ fn shared<'a>(
 /// The initial population, enhanced, sorted fittest first, with whether a cancel cut the
 /// enhancement short: seed 000's 3·ps random chromosomes and the all-minimum and all-maximum
 /// VO ones, plus the seed plan as it is (its cost computed, not enhanced: it is a finished
-/// plan). A seeded job of more than [`LOCAL_ENHANCEMENT_MIN_GEOMETRIES`] gets 3·ps + 2 mutants
+/// plan). A seeded run that searches locally ([`local_search`]) gets 3·ps + 2 mutants
 /// of the seed instead of the random chromosomes, each enhanced where it differs from the seed:
 /// random ones take a full search each (≈ 0.2 s on texture-3043's 9,129 strokes, 21 s for the
 /// population) and all rank far below the seed.
 fn initial_population(
     shared: &Shared,
     ps: usize,
+    local: bool,
     mutation_rate: f64,
     seed_plan: Option<&Ordering>,
     rng: &mut ChaCha8Rng,
@@ -304,7 +314,7 @@ fn initial_population(
             cost: (shared.fitness)(&plan.steps),
         }
     });
-    let random = seed.is_none() || geometries.len() <= LOCAL_ENHANCEMENT_MIN_GEOMETRIES;
+    let random = seed.is_none() || !local;
     let (mut pop, cancelled) = match &seed {
         _ if random => {
             let mut pop: Vec<Chromosome> = (0..3 * ps)
@@ -349,6 +359,13 @@ fn initial_population(
 /// geometries here) and worth its diversity and depth: with local enhancement throughout, HGA
 /// under `--cost distance` ended 1–3 % higher on ISW-200, ISW-489 and rnd-122 (5 seeds).
 const LOCAL_ENHANCEMENT_MIN_GEOMETRIES: usize = 2_000;
+
+/// True when the run searches locally: on a large job, and under a time limit (a short limit
+/// would otherwise go on the random initial population: with `--time-limit 0.5` on ISW-489 the
+/// GA made one generation).
+fn local_search(geometries: usize, time_limit_s: Option<f64>) -> bool {
+    geometries > LOCAL_ENHANCEMENT_MIN_GEOMETRIES || time_limit_s.is_some()
+}
 
 /// Most genes a mutant's double bridge spans, as a share of the order.
 const MUTANT_SPAN_SHARE: f64 = 0.05;
@@ -397,6 +414,8 @@ struct Run<'a> {
     fields: &'a [ScanField],
     t0: Instant,
     limit_s: f64,
+    /// Search locally ([`local_search`]).
+    local: bool,
     kind: ObjectiveKind,
     history: Vec<GenerationRecord>,
     ctx: &'a JobCtx,
@@ -488,7 +507,7 @@ impl Run<'_> {
                     }
                     mutated = &f.geometries;
                 }
-                lineages.push((n > LOCAL_ENHANCEMENT_MIN_GEOMETRIES).then_some(Lineage {
+                lineages.push(self.local.then_some(Lineage {
                     parents: [&p1.sco, &p2.sco],
                     mutated,
                 }));
