@@ -395,11 +395,11 @@ impl Canvas<'_> {
                 format!(", {:.0} × {:.0} mm", f.size[0], f.size[1])
             };
             lines.push(format!(
-                "{word} {}: centre ({:.2}, {:.2}) mm{size}, {} geometries{}",
+                "{word} {}: centre ({:.2}, {:.2}) mm{size}, {}{}",
                 super::field_number(self.fields, self.visiting, f.id),
                 f.center.x,
                 f.center.y,
-                f.geometries.len(),
+                super::count(f.geometries.len(), "geometry", "geometries"),
                 if f.locked { ", locked" } else { "" }
             ));
             if word == "region" {

@@ -579,12 +579,12 @@ impl App {
         ui.heading(heading);
         ui.add(
             egui::Label::new(format!(
-                "centre ({:.2}, {:.2}) mm, {:.0} × {:.0} mm, {} geometries{}",
+                "centre ({:.2}, {:.2}) mm, {:.0} × {:.0} mm, {}{}",
                 f.center.x,
                 f.center.y,
                 f.size[0],
                 f.size[1],
-                f.geometries.len(),
+                super::count(f.geometries.len(), "geometry", "geometries"),
                 if f.locked { ", locked" } else { "" }
             ))
             .wrap(),

@@ -946,11 +946,11 @@ impl App {
                         .find(|f| Some(f.id) == self.view.selected)
                     {
                         let msg = format!(
-                            "moved {} to ({:.1}, {:.1}) mm: {} geometries, {} uncovered",
+                            "moved {} to ({:.1}, {:.1}) mm: {}, {} uncovered",
                             self.field_name(f.id),
                             f.center.x,
                             f.center.y,
-                            f.geometries.len(),
+                            count(f.geometries.len(), "geometry", "geometries"),
                             self.session.uncovered.len()
                         );
                         self.set_status(msg, false);

@@ -77,11 +77,15 @@ pub(super) fn artwork_message(extent: &[f64; 4], stroke: &[f64; 2], field: &[f64
         )
     } else {
         format!(
-            "{size} at x {x0:.1}…{x1:.1}, y {y0:.1}…{y1:.1} mm, out of reach where it lies: the laser reaches x {:.1}…{:.1}, y {:.1}…{:.1} mm ({parts}); it fits once moved: place it centred on the base stroke or with its corner at a chosen point",
+            "{size} at x {x0:.1}…{x1:.1}, y {y0:.1}…{y1:.1} mm, out of reach where it lies: the laser reaches x {:.1}…{:.1}, y {:.1}…{:.1} mm ({parts}); it fits once moved: place it centred on the base stroke or with its top-left corner at x {:.1}…{:.1}, y {:.1}…{:.1} mm",
             -field[0] / 2.0,
             stroke[0] + field[0] / 2.0,
             -field[1] / 2.0,
             stroke[1] + field[1] / 2.0,
+            -field[0] / 2.0,
+            stroke[0] + field[0] / 2.0 - w,
+            -field[1] / 2.0,
+            stroke[1] + field[1] / 2.0 - h,
         )
     }
 }

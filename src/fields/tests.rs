@@ -69,7 +69,7 @@ fn oversize_and_out_of_reach_are_listed() {
         "the artwork is 5.0 × 5.0 mm at x 340.0…345.0, y 10.0…15.0 mm, out of reach where it \
          lies: the laser reaches x -35.0…335.0, y -35.0…335.0 mm (300.0 × 300.0 mm base stroke \
          + 70.0 × 70.0 mm scan field); it fits once moved: place it centred on the base stroke \
-         or with its corner at a chosen point"
+         or with its top-left corner at x -35.0…330.0, y -35.0…330.0 mm"
     );
 }
 
