@@ -1,5 +1,5 @@
 //! The work-area canvas: pan and zoom, field selection and dragging, hover information.
-//! Drawing is in [`super::paint`]; the canvas never changes the document, it returns
+//! Drawing is in `super::paint`; the canvas never changes the document, it returns
 //! [`CanvasAction`]s that the app turns into commands.
 
 use super::paint;

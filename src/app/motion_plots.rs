@@ -265,7 +265,7 @@ fn nice_step(v: f64) -> f64 {
         .unwrap_or(10.0 * decade)
 }
 
-/// Grid of the time axes: labelled 1-2-5 steps at least [`TIME_LABEL_PX`] apart, so that a
+/// Grid of the time axes: labelled 1-2-5 steps at least `TIME_LABEL_PX` apart, so that a
 /// job of any length on a plot of any width has several labelled times (a power-of-ten grid
 /// leaves only "0" on a narrow plot of a few seconds), with finer unlabelled lines between.
 pub fn time_grid_spacer(input: egui_plot::GridInput) -> Vec<egui_plot::GridMark> {

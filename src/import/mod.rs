@@ -1,4 +1,4 @@
-//! Import of artwork (SVG, DXF) into [`Geometry`](crate::document::Geometry) polylines in mm.
+//! Import of artwork (SVG, DXF) into [`Geometry`] polylines in mm.
 //!
 //! [`import_file`] is the one entry point for files: it chooses the format by extension (and by
 //! content when the extension says nothing) and every error names the file and the format.

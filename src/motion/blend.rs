@@ -66,7 +66,7 @@ pub struct Overload {
 
 impl CornerBlends {
     /// Blends the corners of `vertices` (non-empty, times strictly increasing) at acceleration
-    /// `accel_mm_s2`; the [`Overload`] spans where overlapping ramps would exceed it.
+    /// `accel_mm_s2`; the `Overload` spans where overlapping ramps would exceed it.
     pub fn new(vertices: &[(f64, f64)], accel_mm_s2: f64) -> Result<Self, Overload> {
         let Some(&(_, start_mm)) = vertices.first() else {
             return Err(Overload { spans: Vec::new() });

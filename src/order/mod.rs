@@ -52,7 +52,7 @@ pub struct Ordering {
 /// plan with its metrics (stage times other than `order` are left for the caller to fill in)
 /// and the toolpath they were computed on, so that the caller need not lower the plan again.
 /// Every candidate is judged on the inputs' time law, pens and passes included
-/// ([`Candidates`]).
+/// (`Candidates`).
 pub fn order_plan(
     geometries: &[Geometry],
     fields: &[ScanField],

@@ -7,13 +7,13 @@
 //! * the **pattern** is a sequence of points at 1 mm resolution (§IV). Here it is the tool's
 //!   marked path in marking order (the plan's order replaces the paper's nearest algorithm,
 //!   Algorithm 3: the route must follow the order in which the scanner marks), each point with
-//!   the tool's nominal time there ([`Pattern`]);
-//! * the **LSA points** ([`lsa`], §III-B and §III-C-2) are the union of the RDP (Algorithm 1)
+//!   the tool's nominal time there (`Pattern`);
+//! * the **LSA points** (`lsa`, §III-B and §III-C-2) are the union of the RDP (Algorithm 1)
 //!   and VW (Algorithm 2) simplifications of every 100-point segment of the pattern, thinned by
 //!   the half-padding-radius deduction. The `lsa` route ([`lsa_route`]) is the polyline through
 //!   them, the paper's benchmark; the stage passes each LSA point at the tool's time there;
-//! * the **GA** ([`ga`], §III-C) optimises, per LSA point, a turning point within `r` of it and
-//!   a movement speed, so that the route covers the pattern within `r` ([`cover`]), keeps the
+//! * the **GA** (`ga`, §III-C) optimises, per LSA point, a turning point within `r` of it and
+//!   a movement speed, so that the route covers the pattern within `r` (`cover`), keeps the
 //!   tool within `r` of the stage at every instant (the within-radius value) and is short.
 
 mod cover;

@@ -21,7 +21,7 @@ pub struct Lineage<'a> {
 }
 
 impl Lineage<'_> {
-    /// The path nodes where `order` differs from both parents ([`super::changed_nodes`]).
+    /// The path nodes where `order` differs from both parents (`super::changed_nodes`).
     pub fn changed_nodes(&self, order: &[usize]) -> Vec<usize> {
         super::changed_nodes(order, self.parents[0], self.parents[1], self.mutated)
     }

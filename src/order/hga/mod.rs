@@ -23,8 +23,8 @@
 //!
 //! **Cheap offspring on large jobs.** An offspring differs from its parents only around the
 //! crossover's cut points, where the second parent's order skips the middle's genes, and in a
-//! mutated field; on a job of more than [`LOCAL_ENHANCEMENT_MIN_GEOMETRIES`] (or under a time
-//! limit: [`local_search`]) its local search
+//! mutated field; on a job of more than `LOCAL_ENHANCEMENT_MIN_GEOMETRIES` (or under a time
+//! limit: `local_search`) its local search
 //! starts from those nodes only (don't-look bits on the rest) and its start choices are
 //! re-optimised around them, so a generation costs about the changed part plus O(n)
 //! bookkeeping and one O(n) evaluation per offspring, not a search of every node.

@@ -89,7 +89,7 @@ fn exit_point(c: Pt, u: Pt, f: [f64; 2]) -> Pt {
 }
 
 /// Fields up to this count also try the exact field path over the gaps between the fields'
-/// nearest geometries (see [`field_order_candidates`]): Held–Karp over 15 free fields is
+/// nearest geometries (see `field_order_candidates`): Held–Karp over 15 free fields is
 /// 2¹⁵ · 15² ≈ 7 · 10⁶ steps (tens of ms); beyond it a field path is a sweep over many fields,
 /// where the centre distance decides well.
 pub const GAP_PATH_MAX_FIELDS: usize = 16;

@@ -57,7 +57,7 @@ impl IlsBudget {
     }
 
     /// The same budget with its kick count (when finite) divided by `d`, but not below
-    /// [`DIVIDED_KICKS_MIN`] (small paths keep their whole budget: their kicks are cheap, and a
+    /// `DIVIDED_KICKS_MIN` (small paths keep their whole budget: their kicks are cheap, and a
     /// few kicks leave a small path far from its optimum).
     pub fn divided(self, d: usize) -> Self {
         Self {
@@ -118,8 +118,8 @@ const KICKS_MAX: usize = 1500;
 /// 1,000 kicks gave +2.57 / +2.65 / +2.72 %, in less time (BENCHMARKS, issue 16).
 const KICK_WORK_MAX: usize = 20_000_000;
 
-/// Kicks of the default budget for a path of `n` nodes: [`KICKS_PER_NODE`] per node, at least 32,
-/// at most [`KICKS_MAX`] and [`KICK_WORK_MAX`]` / n` (at least 8).
+/// Kicks of the default budget for a path of `n` nodes: `KICKS_PER_NODE` per node, at least 32,
+/// at most `KICKS_MAX` and `KICK_WORK_MAX`` / n` (at least 8).
 pub fn default_kicks(n: usize) -> usize {
     (KICKS_PER_NODE * n)
         .clamp(32, KICKS_MAX)
