@@ -274,14 +274,17 @@ fn metrics_row(ui: &mut egui::Ui, row: &Row, a: &Plan, b: Option<&Plan>) {
     match (va, vb) {
         (Some(x), Some(y)) if x.abs() > 1e-12 && row.kind != RowKind::Effort => {
             let pct = (y - x) / x * 100.0;
-            let text = if pct.abs() < 0.05 {
-                "0.0 %".to_string()
+            // the deciding figure to 0.01 %: plans of a race (HHA, HGA) differ by tenths
+            let decimals = if row.kind == RowKind::Decides { 2 } else { 1 };
+            let zero = 0.5 * 10f64.powi(-decimals);
+            let text = if pct.abs() < zero {
+                format!("{:.*} %", decimals as usize, 0.0)
             } else {
-                format!("{pct:+.1} %")
+                format!("{pct:+.*} %", decimals as usize)
             };
             let t = RichText::new(text).monospace();
             let ranked = matches!(row.kind, RowKind::Decides | RowKind::Ranked);
-            let t = if !ranked || pct.abs() < 0.05 {
+            let t = if !ranked || pct.abs() < zero {
                 t
             } else if pct < 0.0 {
                 t.color(BETTER_FG)
