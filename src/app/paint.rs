@@ -517,10 +517,19 @@ fn plan_caption(p: &PathLayer<'_>) -> String {
         .map_or("job time unknown".to_string(), |t| {
             format!("job time {t:.2} s")
         });
+    // a plan named for what it is already says its motion (older plans' names do not)
+    let motion = |words: &str| {
+        if p.plan.name.contains(words) {
+            String::new()
+        } else {
+            format!(" · {words}")
+        }
+    };
     match p.lowered {
         Ok(l) if l.on_the_fly() => format!(
-            "{}: {job} · on the fly · idle travel {:.0} mm · stage route {:.0} mm",
+            "{}: {job}{} · idle travel {:.0} mm · stage route {:.0} mm",
             p.plan.name,
+            motion("on the fly"),
             m.idle_mm,
             route_length_mm(&l.route_mm)
         ),
@@ -528,9 +537,9 @@ fn plan_caption(p: &PathLayer<'_>) -> String {
             "{}: {job}{} · idle travel {:.0} mm · stage travel {:.0} mm · {} scan fields",
             p.plan.name,
             if lowered.is_ok() {
-                " · step-and-scan"
+                motion("step-and-scan")
             } else {
-                ""
+                String::new()
             },
             m.idle_mm,
             m.base_mm,
