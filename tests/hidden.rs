@@ -641,7 +641,7 @@ fn cli_place_centre_plans_the_331_mm_sheet_and_as_is_refuses_it_with_a_suggestio
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{err}");
     assert!(
-        err.contains("artwork placed (--place centre): moved by (-15.5000, -25.5000) mm"),
+        err.contains("artwork placed (--place centre): moved by (-15.5, -25.5) mm"),
         "{err}"
     );
     let r: serde_json::Value =

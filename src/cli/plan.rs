@@ -56,9 +56,11 @@ pub fn run(a: &PlanArgs) -> Result<()> {
     if opts.place != Place::Auto && (dx != 0.0 || dy != 0.0) {
         let n = doc.profile.gcode.decimals;
         eprintln!(
-            "galvoplan: {}: artwork placed (--place {}): moved by ({dx:.n$}, {dy:.n$}) mm",
+            "galvoplan: {}: artwork placed (--place {}): moved by ({}, {}) mm",
             a.input.display(),
-            opts.place
+            opts.place,
+            galvoplan::geom::format_mm(dx, n),
+            galvoplan::geom::format_mm(dy, n)
         );
     }
     if let Some(lib) = &pens {

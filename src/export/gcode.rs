@@ -81,17 +81,7 @@ struct Words<'a> {
 impl Words<'_> {
     /// A number with the dialect's decimals, trailing zeros trimmed, no negative zero.
     fn num(&self, v: f64) -> String {
-        let s = format!("{:.*}", self.profile.gcode.decimals, v);
-        let s = if s.contains('.') {
-            s.trim_end_matches('0').trim_end_matches('.').to_string()
-        } else {
-            s
-        };
-        if s == "-0" {
-            "0".into()
-        } else {
-            s
-        }
+        crate::geom::format_mm(v, self.profile.gcode.decimals)
     }
     /// A machine position (mirrored about the page height when the dialect flips Y).
     fn position(&self, p: Pt) -> Pt {

@@ -188,9 +188,33 @@ pub fn point_segment_dist(p: Pt, a: Pt, b: Pt) -> f64 {
     p.dist(a.plus(ab.scale(t)))
 }
 
+/// A length in mm with `decimals` decimals, trailing zeros trimmed and no negative zero
+/// (`-15.5000` → `-15.5`, `-0.0000` → `0`): how G-code words and messages write a coordinate.
+pub fn format_mm(v: f64, decimals: usize) -> String {
+    let s = format!("{v:.decimals$}");
+    let s = if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    };
+    if s == "-0" {
+        "0".into()
+    } else {
+        s
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn lengths_are_written_without_trailing_zeros_or_negative_zero() {
+        assert_eq!(format_mm(-15.5, 4), "-15.5");
+        assert_eq!(format_mm(170.0, 4), "170");
+        assert_eq!(format_mm(-0.00001, 4), "0");
+        assert_eq!(format_mm(0.12345, 3), "0.123");
+    }
 
     #[test]
     fn bbox_and_length() {

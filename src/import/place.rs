@@ -126,8 +126,17 @@ pub fn place_artwork(im: &mut Imported, opts: &ImportOptions) -> Result<(), Plac
             message: format!(
                 "lies out of reach where the file puts it (x {:.1}…{:.1}, y {:.1}…{:.1} mm; the \
                  laser reaches x {:.1}…{:.1}, y {:.1}…{:.1} mm): centred on the base stroke, moved \
-                 by ({dx:.n$}, {dy:.n$}) mm",
-                b.min_x, b.max_x, b.min_y, b.max_y, r.min_x, r.max_x, r.min_y, r.max_y
+                 by ({}, {}) mm",
+                b.min_x,
+                b.max_x,
+                b.min_y,
+                b.max_y,
+                r.min_x,
+                r.max_x,
+                r.min_y,
+                r.max_y,
+                crate::geom::format_mm(dx, n),
+                crate::geom::format_mm(dy, n)
             ),
         });
     }
@@ -214,7 +223,7 @@ mod tests {
         assert!(
             im.warnings[0]
                 .message
-                .contains("moved by (-25.5000, -25.5000) mm"),
+                .contains("moved by (-25.5, -25.5) mm"),
             "{}",
             im.warnings[0]
         );
