@@ -361,8 +361,7 @@ impl App {
 
     fn layers_ui(&mut self, ui: &mut egui::Ui) {
         let busy = self.runtime.job.as_ref().map(|j| j.name.clone());
-        let import =
-            super::files::can_reimport(&self.session.doc).then_some(&self.session.doc.import);
+        let import = (self.session.can_reimport).then_some(&self.session.doc.import);
         let action = self.view.layer_editor.ui(
             ui,
             &self.session.doc.layers,

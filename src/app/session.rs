@@ -37,6 +37,9 @@ pub struct Session {
     pub stale: Vec<Vec<String>>,
     /// A problem with the open document (e.g. fields could not be placed).
     pub problem: Option<String>,
+    /// The artwork's file is there to be imported again (placement, hidden layers); checked
+    /// when the document changes, not every frame.
+    pub can_reimport: bool,
 }
 
 impl Session {
@@ -179,6 +182,7 @@ impl Session {
             .filter(|&k| !can_be_covered(&self.doc.geometries[k], &self.doc.profile))
             .collect();
         self.layer_counts = layer_counts(&self.doc);
+        self.can_reimport = super::files::can_reimport(&self.doc);
         if self.active.is_some_and(|k| k >= self.doc.plans.len()) {
             self.active = self.doc.plans.len().checked_sub(1);
         }

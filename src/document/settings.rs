@@ -55,16 +55,23 @@ impl SolverSettings {
             Algo::Hha => "HHA",
             Algo::Hga => "HGA",
         };
-        let cost = match self.cost_model {
-            CostModel::Time => "job time",
-            CostModel::Distance => "idle distance",
+        // cost and motion in the words of the settings table (the stale reasons say the same)
+        let words = |key: &str| {
+            super::spec::settings_specs()
+                .into_iter()
+                .find(|s| s.key == key)
+                .map_or_else(String::new, |s| (s.show)(self))
         };
-        let motion = match (self.motion, self.stage_route) {
-            (MotionMode::Step, _) => "step-and-scan",
-            (MotionMode::OnTheFly, StageRouteKind::Taut) => "on the fly (taut)",
-            (MotionMode::OnTheFly, StageRouteKind::Lsa) => "on the fly (lsa)",
-            (MotionMode::OnTheFly, StageRouteKind::CetspGa) => "on the fly (cetsp-ga)",
-        };
+        let (cost, mut motion) = (words("cost_model"), words("motion"));
+        if self.motion == MotionMode::OnTheFly {
+            // the route as the command line spells it, short enough for a plan's name
+            let route = match self.stage_route {
+                StageRouteKind::Taut => "taut",
+                StageRouteKind::Lsa => "lsa",
+                StageRouteKind::CetspGa => "cetsp-ga",
+            };
+            motion = format!("{motion} ({route})");
+        }
         match self.algo {
             Algo::Hha | Algo::Hga => format!("{algo} · {cost} · {motion} · seed {}", self.seed),
             Algo::AsIs | Algo::Baseline => format!("{algo} · {cost} · {motion}"),

@@ -146,19 +146,10 @@ pub fn place_artwork(im: &mut Imported, opts: &ImportOptions) -> Result<(), Plac
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::document::{Geometry, Source};
+    use crate::document::Geometry;
 
     fn square(x: f64, y: f64, side: f64) -> Geometry {
-        Geometry::new(
-            vec![
-                Pt::new(x, y),
-                Pt::new(x + side, y),
-                Pt::new(x + side, y + side),
-                Pt::new(x, y + side),
-            ],
-            true,
-            Source::default(),
-        )
+        crate::fields::tests_support::rect(x, y, side, side)
     }
 
     fn machine(place: Place) -> ImportOptions {

@@ -16,18 +16,10 @@
 //! large jobs); the step-and-scan figure is then an estimate used only to rank chromosomes, and
 //! the plan's own choice between candidates is made on their lowered toolpaths.
 
-use crate::document::{pen_of, CostModel, Geometry, Layer, MachineProfile, ScanField, Step};
+use crate::document::{pen_of, Geometry, Layer, MachineProfile, ScanField, Step};
 use crate::geom::Pt;
 use crate::motion::StageDynamics;
 use std::collections::HashMap;
-
-/// The unit of an objective value.
-pub fn unit(cost: CostModel) -> &'static str {
-    match cost {
-        CostModel::Time => "s",
-        CostModel::Distance => "mm",
-    }
-}
 
 /// Job time of a step-and-scan order, without lowering (see the module text).
 pub struct StepTime<'a> {
@@ -214,22 +206,9 @@ fn spanning_tree_s(points: &[Pt], stage: &StageDynamics) -> f64 {
 mod tests {
     use super::*;
     use crate::document::{Plan, PlanInputs, SolverSettings};
+    use crate::fields::tests_support::rect;
     use crate::geom::Pt;
     use crate::motion::lower;
-
-    fn square(x: f64, y: f64, s: f64) -> Geometry {
-        Geometry::new(
-            vec![
-                Pt::new(x, y),
-                Pt::new(x + s, y),
-                Pt::new(x + s, y + s),
-                Pt::new(x, y + s),
-                Pt::new(x, y),
-            ],
-            true,
-            crate::document::Source::default(),
-        )
-    }
 
     #[test]
     fn the_step_time_equals_the_lowered_job_time() {
@@ -239,7 +218,8 @@ mod tests {
             .map(|k| {
                 let c = centre(k / 2);
                 if k % 2 == 0 {
-                    square(c.x - 20.0, c.y - 10.0, 4.0 + k as f64)
+                    let side = 4.0 + k as f64;
+                    rect(c.x - 20.0, c.y - 10.0, side, side)
                 } else {
                     // an open stroke: reversed on odd choices
                     Geometry::new(

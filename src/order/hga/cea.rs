@@ -11,19 +11,58 @@ use crate::order::vertex::{optimal_vertices, optimal_vertices_between, vea};
 /// Steps on each side of a changed position whose start choices are re-optimised with it.
 pub const VERTEX_WINDOW_MARGIN: usize = 4;
 
-/// Where a chromosome came from: its parents' orders (twice the same for a mutant) and the
-/// genes a mutation gave new start choices.
+/// A parent's order as its lineage reads it: its first gene and each gene's successor
+/// (`usize::MAX` for the last), made once per parent and generation, not per offspring.
+pub struct Parent {
+    first: Option<usize>,
+    succ: Vec<usize>,
+}
+
+impl Parent {
+    /// The parent with geometry order `order`.
+    pub fn of(order: &[usize]) -> Self {
+        let mut succ = vec![usize::MAX; order.len()];
+        for w in order.windows(2) {
+            succ[w[0]] = w[1];
+        }
+        Self {
+            first: order.first().copied(),
+            succ,
+        }
+    }
+}
+
+/// Where a chromosome came from: its parents (twice the same for a mutant) and the genes a
+/// mutation gave new start choices.
 pub struct Lineage<'a> {
-    /// The parents' geometry orders.
-    pub parents: [&'a [usize]; 2],
+    /// The parents.
+    pub parents: [&'a Parent; 2],
     /// Mutated genes (geometries).
     pub mutated: &'a [usize],
 }
 
 impl Lineage<'_> {
-    /// The path nodes where `order` differs from both parents (`super::changed_nodes`).
+    /// The path nodes (geometry g is node g + 1) where `order` differs from both parents: a
+    /// gene whose successor is neither parent's successor for it, that successor, the corner
+    /// (node 0) when the first gene is neither parent's, and the mutated genes; the local
+    /// search starts from these.
     pub fn changed_nodes(&self, order: &[usize]) -> Vec<usize> {
-        super::changed_nodes(order, self.parents[0], self.parents[1], self.mutated)
+        let [p1, p2] = self.parents;
+        let mut out: Vec<usize> = Vec::new();
+        let first = order.first().copied();
+        if first != p1.first && first != p2.first {
+            out.push(0);
+        }
+        for w in order.windows(2) {
+            if p1.succ[w[0]] != w[1] && p2.succ[w[0]] != w[1] {
+                out.push(w[0] + 1);
+                out.push(w[1] + 1);
+            }
+        }
+        out.extend(self.mutated.iter().map(|&g| g + 1));
+        out.sort_unstable();
+        out.dedup();
+        out
     }
 }
 

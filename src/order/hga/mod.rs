@@ -42,7 +42,7 @@ use crate::document::{
 use crate::geom::Pt;
 use crate::job::{Cancelled, JobCtx};
 use crate::order::tsp::{neighbour_lists, Node, PathProblem};
-use cea::{Lineage, Shared};
+use cea::{Lineage, Parent, Shared};
 use rand::seq::SliceRandom;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -143,39 +143,16 @@ fn enhance_all(
         .map(|_| ())
 }
 
+/// How many of a population of `len` (fittest first) are kept as elite at size `ps`: the elite
+/// fraction of `ps`, at least the two parents a crossover needs.
+fn elite_count(ga: &GaParams, ps: usize, len: usize) -> usize {
+    ((ga.elite_fraction * ps as f64).ceil() as usize).clamp(2, len)
+}
+
 fn stats(pop: &[Chromosome]) -> (f64, f64) {
     let best = pop.iter().map(|c| c.cost).fold(f64::INFINITY, f64::min);
     let mean = pop.iter().map(|c| c.cost).sum::<f64>() / pop.len().max(1) as f64;
     (best, mean)
-}
-
-/// The path nodes (geometry g is node g + 1) where `child`'s order differs from both parents':
-/// a gene whose successor is neither parent's successor for it, that successor, and the genes
-/// of `mutated`; the local search starts from these.
-fn changed_nodes(child: &[usize], p1: &[usize], p2: &[usize], mutated: &[usize]) -> Vec<usize> {
-    let n = child.len();
-    let succ = |order: &[usize]| {
-        let mut s = vec![usize::MAX; n];
-        for w in order.windows(2) {
-            s[w[0]] = w[1];
-        }
-        s
-    };
-    let (s1, s2) = (succ(p1), succ(p2));
-    let mut out: Vec<usize> = Vec::new();
-    if child.first() != p1.first() && child.first() != p2.first() {
-        out.push(0);
-    }
-    for w in child.windows(2) {
-        if s1[w[0]] != w[1] && s2[w[0]] != w[1] {
-            out.push(w[0] + 1);
-            out.push(w[1] + 1);
-        }
-    }
-    out.extend(mutated.iter().map(|&g| g + 1));
-    out.sort_unstable();
-    out.dedup();
-    out
 }
 
 /// Runs HGA on allocated fields, ranking chromosomes on `fitness`; `seed_plan` (HHA's finished
@@ -223,8 +200,7 @@ pub fn hga_order(
         generation += 1;
         let (offspring, was_cancelled) = run.offspring(&shared, &pop, ps, &mut rng);
         cancelled = was_cancelled;
-        let elite_n = ((ga.elite_fraction * ps as f64).ceil() as usize).clamp(2, pop.len());
-        pop.truncate(elite_n);
+        pop.truncate(elite_count(ga, ps, pop.len()));
         pop.extend(offspring);
         pop.sort_by(|a, b| a.cost.total_cmp(&b.cost));
         let (b, mean) = stats(&pop);
@@ -331,11 +307,12 @@ fn initial_population(
             let (mut pop, mutated): (Vec<Chromosome>, Vec<Vec<usize>>) = (0..n)
                 .map(|_| mutant(seed, shared, mutation_rate, rng))
                 .unzip();
+            let parent = Parent::of(&seed.sco);
             let lineages: Vec<Option<Lineage>> = mutated
                 .iter()
                 .map(|m| {
                     Some(Lineage {
-                        parents: [&seed.sco, &seed.sco],
+                        parents: [&parent, &parent],
                         mutated: m,
                     })
                 })
@@ -482,7 +459,13 @@ impl Run<'_> {
     ) -> (Vec<Chromosome>, bool) {
         let ga = self.ga;
         let geometries = shared.geometries;
-        let elite = &pop[..((ga.elite_fraction * ps as f64).ceil() as usize).clamp(2, pop.len())];
+        let elite = &pop[..elite_count(ga, ps, pop.len())];
+        // each elite parent's successors, once for all its offspring (local search only)
+        let parents: Vec<Parent> = if self.local {
+            elite.iter().map(|c| Parent::of(&c.sco)).collect()
+        } else {
+            Vec::new()
+        };
         let crossovers = ((0.5 * (1.0 - ga.elite_fraction) * ps as f64).round() as usize).max(1);
         let n = geometries.len();
         let mut offspring = Vec::with_capacity(2 * crossovers);
@@ -497,8 +480,8 @@ impl Run<'_> {
             if a > b {
                 std::mem::swap(&mut a, &mut b);
             }
-            for (p1, p2) in [(&elite[i], &elite[j]), (&elite[j], &elite[i])] {
-                let mut child = two_point_crossover(p1, p2, a, b);
+            for (i1, i2) in [(i, j), (j, i)] {
+                let mut child = two_point_crossover(&elite[i1], &elite[i2], a, b);
                 let mut mutated: &[usize] = &[];
                 if rng.random_bool(ga.mutation_rate.clamp(0.0, 1.0)) && !self.fields.is_empty() {
                     let f = &self.fields[rng.random_range(0..self.fields.len())];
@@ -507,8 +490,8 @@ impl Run<'_> {
                     }
                     mutated = &f.geometries;
                 }
-                lineages.push(self.local.then_some(Lineage {
-                    parents: [&p1.sco, &p2.sco],
+                lineages.push(self.local.then(|| Lineage {
+                    parents: [&parents[i1], &parents[i2]],
                     mutated,
                 }));
                 offspring.push(child);
@@ -526,15 +509,25 @@ mod tests {
 
     #[test]
     fn an_offspring_is_searched_from_where_it_differs_from_both_parents() {
-        let p1 = [0, 1, 2, 3, 4, 5, 6];
-        let p2 = [6, 5, 4, 3, 2, 1, 0];
+        let (p1, p2) = (
+            Parent::of(&[0, 1, 2, 3, 4, 5, 6]),
+            Parent::of(&[6, 5, 4, 3, 2, 1, 0]),
+        );
+        let from = |mutated: &'static [usize]| Lineage {
+            parents: [&p1, &p2],
+            mutated,
+        };
         // p1's middle 2..=4 kept, the rest in p2's order: 6 5 | 2 3 4 | 1 0
-        let child = [6, 5, 2, 3, 4, 1, 0];
         // 5→2 and 4→1 are new (neither parent has them); 6→5, 2→3, 3→4, 1→0 are inherited
-        assert_eq!(changed_nodes(&child, &p1, &p2, &[]), vec![2, 3, 5, 6]);
+        assert_eq!(
+            from(&[]).changed_nodes(&[6, 5, 2, 3, 4, 1, 0]),
+            vec![2, 3, 5, 6]
+        );
         // a mutated gene joins (node = gene + 1); a first gene of neither parent adds the corner
-        let child = [5, 6, 0, 1, 2, 3, 4];
-        assert_eq!(changed_nodes(&child, &p1, &p2, &[3]), vec![0, 1, 4, 7]);
+        assert_eq!(
+            from(&[3]).changed_nodes(&[5, 6, 0, 1, 2, 3, 4]),
+            vec![0, 1, 4, 7]
+        );
     }
 
     #[test]
