@@ -355,18 +355,25 @@ fn unseeded_note(ui: &mut egui::Ui, a: &Plan, b: &Plan) {
         if ga.algo != Algo::Hga || hha.algo != Algo::Hha || ga.settings.ga.seed_with_hha {
             continue;
         }
-        let (Some(tg), Some(th)) = (ga.metrics.job_time_s, hha.metrics.job_time_s) else {
+        // on the GA's own objective (the job time when it ranked on an estimate)
+        let kind = ObjectiveKind::of(ga.settings.cost_model, ga.motion);
+        let figure = |p: &Plan| kind.of_metrics(&p.metrics).or(p.metrics.job_time_s);
+        let (Some(vg), Some(vh)) = (figure(ga), figure(hha)) else {
             continue;
         };
-        if tg > th {
+        if vg > vh {
+            let pct = (vg - vh) / vh * 100.0;
+            let worse = if kind == ObjectiveKind::IdleMm {
+                format!("has {pct:.2} % more idle travel")
+            } else {
+                format!("is {pct:.2} % slower")
+            };
             ui.add(
                 egui::Label::new(
                     RichText::new(format!(
                         "{} was not seeded with the HHA plan (\"Seed the GA with the HHA plan\" \
-                         is off in Solver settings), and is {:.2} % slower than {}.",
-                        ga.name,
-                        (tg - th) / th * 100.0,
-                        hha.name
+                         is off in Solver settings), and {worse} than {}.",
+                        ga.name, hha.name
                     ))
                     .color(WORSE_FG),
                 )

@@ -118,7 +118,7 @@ pub fn reimport(
         doc.settings.clone(),
         &opts,
     )
-    .map_err(|e| e.to_string())?;
+    .map_err(|e| super::gui_error(&e))?;
     let mut work = doc.clone();
     work.artwork = loaded.doc.artwork;
     work.page_mm = loaded.doc.page_mm;
@@ -144,7 +144,7 @@ pub fn reimport(
     });
     work.derived_with = None;
     let before = work.geometry_rev;
-    derive_geometries(&mut work, ctx).map_err(|e| e.to_string())?;
+    derive_geometries(&mut work, ctx).map_err(|e| super::gui_error(&e))?;
     if work.geometry_rev == before {
         return Ok((work, None));
     }
