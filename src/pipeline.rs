@@ -1,8 +1,9 @@
 //! The whole pipeline on a [`Document`]: import → fields → order → metrics, with stage times.
 
 use crate::document::{
-    is_hatch_output, sync_layers, ArtworkImport, DerivedKey, Document, MachineProfile, MotionMode,
-    Pen, PenLibrary, Plan, PlanInputs, ScanField, SolverSettings, StageRouteKind,
+    is_hatch_output, sync_layers, ArtworkImport, DerivedKey, Document, MachineProfile, Motion,
+    MotionMode, Pen, PenLibrary, Plan, PlanInputs, ScanField, SolverSettings, StageRouteKind,
+    Warning,
 };
 use crate::fields::{check_artwork, place_fields, split_oversize, FieldError, Placement};
 use crate::hatch::{layer_geometries, HatchError};
@@ -183,9 +184,17 @@ pub fn plan_document_lowered(
 ) -> Result<(Plan, Toolpath), PipelineError> {
     let hatch_s = derive_geometries(doc, ctx)?;
     let t0 = Instant::now();
-    let lower_bound = place_document_fields(doc, ctx)?;
-    let fields_s = t0.elapsed().as_secs_f64();
-    let (mut plan, toolpath) = order_document_lowered(doc, ctx)?;
+    let (lower_bound, made) = place_and_choose(doc, ctx)?;
+    // the orderings of a whole-or-cut choice are the order stage's time, not the field stage's
+    let choice_s = made.as_ref().map_or(0.0, |(p, _)| p.metrics.solve_s.order);
+    let fields_s = (t0.elapsed().as_secs_f64() - choice_s).max(0.0);
+    let (mut plan, toolpath) = match made {
+        Some((plan, toolpath)) => {
+            log_inputs(doc, ctx);
+            complete_plan(doc, plan, toolpath, ctx)?
+        }
+        None => order_document_lowered(doc, ctx)?,
+    };
     plan.metrics.solve_s.hatch = hatch_s;
     plan.metrics.solve_s.fields = fields_s;
     plan.metrics.fields_lower_bound = Some(lower_bound);
@@ -263,7 +272,7 @@ pub fn apply_pen_library(doc: &mut Document, library: &PenLibrary) -> Vec<String
 /// stage. True when a route was planned: the plan must then be lowered along it.
 fn plan_seed_route(doc: &Document, plan: &mut Plan, ctx: &JobCtx) -> Result<bool, PipelineError> {
     let s = &plan.settings;
-    if plan.motion != MotionMode::OnTheFly || s.stage_route == StageRouteKind::Taut {
+    if plan.motion != Motion::OnTheFly || s.stage_route == StageRouteKind::Taut {
         return Ok(false);
     }
     let t = Instant::now();
@@ -316,10 +325,24 @@ fn relower(doc: &Document, plan: &mut Plan) -> Result<Toolpath, PipelineError> {
 }
 
 /// The field stage alone: makes the geometries from the layers (when they changed, see
-/// [`derive_geometries`]), splits oversize
-/// geometries when the settings say so, then places the fields (keeping locked ones) and
-/// allocates the geometries. Returns the lower bound on fields.
+/// [`derive_geometries`]), splits oversize geometries when the settings say so, then places the
+/// fields (keeping locked ones) and allocates the geometries. Returns the lower bound on fields.
+///
+/// Geometries larger than a field cannot be marked step-and-scan whole. On the fly they can:
+/// unless the settings cut them (`split_oversize`), a solve that may fly marks them whole or cut
+/// at field borders, whichever the lowered job time says is faster ([`whole_or_cut`]); a
+/// step-and-scan solve stops with [`FieldError::Oversize`].
 pub fn place_document_fields(doc: &mut Document, ctx: &JobCtx) -> Result<usize, PipelineError> {
+    place_and_choose(doc, ctx).map(|(lower_bound, _)| lower_bound)
+}
+
+/// A plan and its toolpath made while choosing the geometries, reusable by the solve.
+type Made = Option<(Plan, Toolpath)>;
+
+/// [`place_document_fields`], with the plan the whole-or-cut choice made on the chosen
+/// geometries when it is the plan the solve would make (not under HGA, whose choice is made on
+/// HHA plans).
+fn place_and_choose(doc: &mut Document, ctx: &JobCtx) -> Result<(usize, Made), PipelineError> {
     derive_geometries(doc, ctx)?;
     if doc.geometries.is_empty() && !doc.artwork.is_empty() {
         return Err(PipelineError::AllDisabled {
@@ -343,16 +366,109 @@ pub fn place_document_fields(doc: &mut Document, ctx: &JobCtx) -> Result<usize, 
     }
     let locked: Vec<ScanField> = doc.fields.iter().filter(|f| f.locked).cloned().collect();
     let placed = place_fields(&doc.geometries, &doc.profile, &doc.settings, &locked, ctx);
-    let placement = match placed {
-        // on the fly the stage follows the work: a geometry larger than the field needs no cut,
-        // and one region holding everything is ordered as a whole
-        Err(FieldError::Oversize { .. }) if doc.settings.motion == MotionMode::OnTheFly => {
-            whole_work_region(&doc.geometries)
+    match placed {
+        Err(FieldError::Oversize { .. }) if doc.settings.motion.may_fly() => {
+            check_artwork(&doc.geometries, &doc.profile).map_err(|source| {
+                PipelineError::Fields {
+                    file: file.clone(),
+                    source,
+                }
+            })?;
+            whole_or_cut(doc, &locked, ctx)
         }
-        other => other.map_err(|source| PipelineError::Fields { file, source })?,
+        other => {
+            let placement = other.map_err(|source| PipelineError::Fields { file, source })?;
+            doc.fields = placement.fields;
+            Ok((placement.lower_bound, None))
+        }
+    }
+}
+
+/// Geometries larger than a field, in a solve that may fly: plans them whole (one region
+/// around everything, on the fly) and cut at field borders (fields placed on the pieces, in
+/// every motion the settings allow), and keeps the faster on the lowered job time. The
+/// document gets the chosen geometries and fields, and a warning saying what was chosen and
+/// why. Returns the lower bound on fields and the chosen plan (see [`place_and_choose`]).
+fn whole_or_cut(
+    doc: &mut Document,
+    locked: &[ScanField],
+    ctx: &JobCtx,
+) -> Result<(usize, Made), PipelineError> {
+    let file = doc.source.clone().unwrap_or_else(|| "document".into());
+    let as_order_error = |source| PipelineError::Order {
+        file: file.clone(),
+        source,
     };
-    doc.fields = placement.fields;
-    Ok(placement.lower_bound)
+    // the choice is made on HHA plans when the solve is HGA (its GA runs once, afterwards)
+    let mut judge = doc.clone();
+    if judge.settings.algo == crate::document::Algo::Hga {
+        judge.settings.algo = crate::document::Algo::Hha;
+    }
+    let reusable = judge.settings.algo == doc.settings.algo;
+    // whole: one region, on the fly only
+    let whole_region = whole_work_region(&judge.geometries);
+    let mut inputs = PlanInputs::of(&judge);
+    inputs.settings.motion = MotionMode::OnTheFly;
+    let whole = order_plan(&judge.geometries, &whole_region.fields, &inputs, ctx)
+        .map_err(as_order_error)?;
+    // cut: fields on the pieces, every motion allowed
+    let mut pieces = judge.geometries.clone();
+    let cuts = split_oversize(&mut pieces, judge.profile.field_mm);
+    let cut_placement = place_fields(&pieces, &judge.profile, &judge.settings, locked, ctx)
+        .map_err(|source| PipelineError::Fields {
+            file: file.clone(),
+            source,
+        })?;
+    let cut = order_plan(&pieces, &cut_placement.fields, &PlanInputs::of(&judge), ctx)
+        .map_err(as_order_error)?;
+    let (whole_s, cut_s) = (whole.1.duration_s(), cut.1.duration_s());
+    // the chosen plan's order stage: both candidates' orderings
+    let order_s = whole.0.metrics.solve_s.order + cut.0.metrics.solve_s.order;
+    let mut detail = vec![
+        ("whole".to_string(), whole.0.metrics.solve_s.order),
+        ("cut".to_string(), cut.0.metrics.solve_s.order),
+    ];
+    let (mut made, lower_bound) = if cut_s < whole_s {
+        doc.set_geometries(pieces);
+        doc.fields = cut_placement.fields;
+        doc.warnings.extend(cuts);
+        doc.warnings.push(choice_warning(format!(
+            "geometries larger than a scan field are cut at field borders: the job takes {} s cut against {} s marked whole on the fly",
+            format_s(cut_s),
+            format_s(whole_s)
+        )));
+        (cut, cut_placement.lower_bound)
+    } else {
+        doc.fields = whole_region.fields;
+        doc.warnings.push(choice_warning(format!(
+            "geometries larger than a scan field are marked whole on the fly: the job takes {} s against {} s cut at field borders",
+            format_s(whole_s),
+            format_s(cut_s)
+        )));
+        (whole, whole_region.lower_bound)
+    };
+    made.0.geometry_rev = doc.geometry_rev;
+    made.0.settings.motion = doc.settings.motion;
+    made.0.name = doc.settings.plan_title_as(made.0.motion);
+    let solve = &mut made.0.metrics.solve_s;
+    detail.append(&mut solve.order_detail);
+    solve.order = order_s;
+    solve.order_detail = detail;
+    Ok((lower_bound, reusable.then_some(made)))
+}
+
+/// A warning about a choice the solve made (no element of the drawing).
+fn choice_warning(message: String) -> Warning {
+    Warning {
+        element: String::new(),
+        line: None,
+        message,
+    }
+}
+
+/// A job time in s with the report's three decimals.
+fn format_s(s: f64) -> String {
+    format!("{s:.3}")
 }
 
 /// One region around all the geometries (on-the-fly ordering when some geometry is larger than
@@ -389,13 +505,29 @@ pub fn order_document_lowered(
     ctx: &JobCtx,
 ) -> Result<(Plan, Toolpath), PipelineError> {
     let file = doc.source.clone().unwrap_or_else(|| "document".into());
+    log_inputs(doc, ctx);
+    let inputs = PlanInputs::of(doc);
+    let (plan, toolpath) = order_plan(&doc.geometries, &doc.fields, &inputs, ctx)
+        .map_err(|source| PipelineError::Order { file, source })?;
+    complete_plan(doc, plan, toolpath, ctx)
+}
+
+/// Records the geometries and fields a solve starts from (with a recorder).
+fn log_inputs(doc: &Document, ctx: &JobCtx) {
     if let Some(r) = ctx.recorder() {
         r.geometry(&doc.geometries);
         r.fields(&doc.fields);
     }
-    let inputs = PlanInputs::of(doc);
-    let (mut plan, mut toolpath) = order_plan(&doc.geometries, &doc.fields, &inputs, ctx)
-        .map_err(|source| PipelineError::Order { file, source })?;
+}
+
+/// What follows the ordering: seed 001's stage route when the plan flies along one (and the
+/// lowering along it), and the plan's recording.
+fn complete_plan(
+    doc: &Document,
+    mut plan: Plan,
+    mut toolpath: Toolpath,
+    ctx: &JobCtx,
+) -> Result<(Plan, Toolpath), PipelineError> {
     plan.metrics.solve_s.total = plan.metrics.solve_s.order;
     if plan_seed_route(doc, &mut plan, ctx)? {
         toolpath = relower(doc, &mut plan)?;

@@ -118,6 +118,8 @@ fn oversize_geometry_is_listed() {
         &p.display().to_string(),
         "-o",
         &dir.path().join("o.gcode").display().to_string(),
+        "--motion",
+        "step",
     ]);
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
@@ -125,6 +127,26 @@ fn oversize_geometry_is_listed() {
         err.contains("big.svg") && err.contains("#huge") && err.contains("100.00 × 20.00 mm"),
         "{err}"
     );
+    // the default motion (auto) marks it whole on the fly or cut, whichever is faster, and says so
+    let auto_report = dir.path().join("auto.json");
+    let out = galvoplan(&[
+        "plan",
+        &p.display().to_string(),
+        "-o",
+        &dir.path().join("auto.gcode").display().to_string(),
+        "--report",
+        &auto_report.display().to_string(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("larger than a scan field are"), "{err}");
+    let auto: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(auto_report).unwrap()).unwrap();
+    assert!(auto["plan"].as_str().unwrap().contains("auto: "), "{auto}");
     let report = dir.path().join("o.json");
     let out = galvoplan(&[
         "plan",

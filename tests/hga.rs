@@ -5,7 +5,7 @@
 mod common;
 
 use galvoplan::document::{
-    Algo, CostModel, Document, MachineProfile, ObjectiveKind, SolverSettings,
+    Algo, CostModel, Document, MachineProfile, MotionMode, ObjectiveKind, SolverSettings,
 };
 use galvoplan::job::{CancelToken, JobCtx, NoProgress};
 use galvoplan::pipeline::{load_svg, order_document, place_document_fields};
@@ -25,9 +25,11 @@ fn demo(settings: SolverSettings) -> Document {
     doc
 }
 
+/// HGA in step-and-scan (its objective is then the table's job time).
 fn hga(seed: u64) -> SolverSettings {
     SolverSettings {
         algo: Algo::Hga,
+        motion: MotionMode::Step,
         seed,
         ..SolverSettings::default()
     }

@@ -146,7 +146,7 @@ fn the_ordering_toolpath_is_the_plans_lowering() {
         place_document_fields(&mut doc, &JobCtx::default()).unwrap();
         let (plan, toolpath) = order_document_lowered(&doc, &JobCtx::default()).unwrap();
         let case = format!("{name} {motion:?} {stage_route:?} pens {pens}");
-        assert_eq!(plan.motion, motion, "{case}");
+        assert_eq!(MotionMode::from(plan.motion), motion, "{case}");
         assert_eq!(
             plan.stage_route.is_some(),
             stage_route != StageRouteKind::Taut && motion == MotionMode::OnTheFly,

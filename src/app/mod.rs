@@ -31,7 +31,8 @@ pub mod toolpaths;
 pub use canvas::{Canvas, CanvasAction, CanvasState, Layers, View};
 
 use crate::document::{
-    Algo, DerivedKey, Document, Layer, MachineProfile, MotionMode, Plan, ScanField, SolverSettings,
+    Algo, DerivedKey, Document, Layer, MachineProfile, Motion, MotionMode, Plan, ScanField,
+    SolverSettings,
 };
 use crate::job::JobCtx;
 use crate::pipeline::{derive_geometries, place_document_fields};
@@ -821,7 +822,11 @@ impl App {
     fn next_plan_name(&self, algo: Algo) -> String {
         let mut settings = self.session.doc.settings.clone();
         settings.algo = algo;
-        let title = settings.plan_title();
+        self.unique_plan_name(settings.plan_title())
+    }
+
+    /// `title`, with " #2", " #3"… when a plan of that name exists.
+    fn unique_plan_name(&self, title: String) -> String {
         let taken = |name: &str| {
             self.session
                 .doc
@@ -868,6 +873,12 @@ impl App {
                 self.set_status(format!("wrote the {what} to {}", path.display()), false);
             }
             JobOutcome::Done(JobResult::Plan { mut plan, lowered }) => {
+                // an automatic motion is named for the motion the solve chose
+                let name = if plan.settings.motion == MotionMode::Auto {
+                    self.unique_plan_name(plan.name.clone())
+                } else {
+                    name
+                };
                 plan.name = if cancelled {
                     format!("{name} (stopped)")
                 } else {
@@ -879,7 +890,7 @@ impl App {
                     format!("job time {t:.2} s")
                 });
                 let stage = match (plan.motion, m.motion) {
-                    (MotionMode::OnTheFly, Some(f)) => {
+                    (Motion::OnTheFly, Some(f)) => {
                         format!("on the fly, stage route {:.1} mm", f.stage_route_mm)
                     }
                     _ => format!("stage travel {:.1} mm, {} scan fields", m.base_mm, m.fields),
@@ -1127,7 +1138,7 @@ pub fn gui_error(e: &crate::pipeline::PipelineError) -> String {
     match e.remedy() {
         Some(Remedy::SplitOversize) => format!(
             "{e}; tick \"Split oversize geometries\" in Solver settings and press \"Re-place \
-             automatically\" to cut them at field borders, or choose \"On the fly\" as the motion"
+             automatically\" to cut them at field borders, or choose \"Automatic\" or \"On the fly\" as the motion"
         ),
         Some(Remedy::Place) => format!(
             "{e}; choose \"Placement: centred\" in the Layers panel to move it within reach"

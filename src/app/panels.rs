@@ -388,6 +388,11 @@ const COST_MODEL_HELP: &str = "What the ordering minimises.\n\
 /// The motion modes offered, in words.
 pub const MOTION_MODES: &[Choice<MotionMode>] = &[
     (
+        MotionMode::Auto,
+        "Automatic (the faster)",
+        "Plans step-and-scan and on the fly and keeps the faster job; command line: --motion auto.",
+    ),
+    (
         MotionMode::Step,
         "Step-and-scan",
         "The stage stops at each scan field; command line: --motion step.",

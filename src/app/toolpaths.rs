@@ -3,7 +3,7 @@
 //! Nothing here is saved; a plan that cannot be lowered keeps the error in words.
 
 use super::motion_plots::{route_points_mm, MotionSamples};
-use crate::document::{Document, MachineProfile, MotionMode, Plan};
+use crate::document::{Document, MachineProfile, Motion, Plan};
 use crate::geom::Pt;
 use crate::motion::{ScanMotion, Toolpath};
 use crate::pipeline::lower_plan;
@@ -76,7 +76,7 @@ struct Key {
     fields: usize,
     geometry_rev: u64,
     profile: MachineProfile,
-    motion: MotionMode,
+    motion: Motion,
 }
 
 impl Key {
@@ -186,7 +186,9 @@ impl ToolpathCache {
 mod tests {
     #![allow(clippy::unwrap_used, clippy::expect_used)]
     use super::*;
-    use crate::document::{Algo, Geometry, Metrics, PlanInputs, ScanField, Source, Step};
+    use crate::document::{
+        Algo, Geometry, Metrics, MotionMode, PlanInputs, ScanField, Source, Step,
+    };
     use crate::geom::Pt;
 
     fn doc_with_plan(bad_geometry: bool) -> Document {
@@ -214,11 +216,12 @@ mod tests {
             }],
             metrics: Metrics::default(),
             history: Vec::new(),
-            motion: MotionMode::Step,
+            motion: Motion::Step,
             stage_route: None,
             layers: Vec::new(),
             ..Plan::new(
                 &PlanInputs::of(&Document::default()),
+                Motion::Step,
                 Vec::new(),
                 Vec::new(),
             )
@@ -253,7 +256,7 @@ mod tests {
         doc.settings.motion = MotionMode::OnTheFly;
         cache.sync(&doc);
         assert!(!cache.get(0).unwrap().unwrap().on_the_fly());
-        doc.plans[0].motion = MotionMode::OnTheFly;
+        doc.plans[0].motion = Motion::OnTheFly;
         doc.settings.motion = MotionMode::Step;
         assert_eq!(cache.sync(&doc), 1);
         let l = cache.get(0).unwrap().unwrap();

@@ -190,7 +190,7 @@ pub fn run_instance(
                 }
                 geometries = doc.geometries.len();
                 marked_mm = m.marked_mm;
-                job_lb = (plan.motion == crate::document::MotionMode::Step).then(|| {
+                job_lb = (plan.motion == crate::document::Motion::Step).then(|| {
                     crate::order::objective::step_job_time_lower_bound_s(
                         &doc.geometries,
                         &plan.fields,

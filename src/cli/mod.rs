@@ -66,6 +66,9 @@ enum AlgoArg {
 /// How the machine moves, as on the command line.
 #[derive(Debug, Clone, Copy, ValueEnum)]
 enum MotionArg {
+    /// The faster of step-and-scan and on the fly on the lowered job time (geometries larger than
+    /// a field: marked whole on the fly or cut at field borders, whichever is faster).
+    Auto,
     /// Step-and-scan: the stage stops at every field.
     Step,
     /// On the fly: the stage moves on a continuous route (taut string) while the scanner marks.
@@ -116,8 +119,9 @@ struct JobOpts {
     /// What the ordering minimises: job time or idle distance.
     #[arg(long, value_enum, default_value = "time")]
     cost: CostArg,
-    /// Step-and-scan, or on the fly (the stage moves while the scanner marks).
-    #[arg(long, value_enum, default_value = "step")]
+    /// Step-and-scan, on the fly (the stage moves while the scanner marks), or whichever runs
+    /// the job faster.
+    #[arg(long, value_enum, default_value = "auto")]
     motion: MotionArg,
     /// The stage route on the fly.
     #[arg(long, value_enum, default_value = "taut")]
@@ -284,6 +288,7 @@ impl JobOpts {
                 AlgoArg::AsIs => Algo::AsIs,
             },
             motion: match self.motion {
+                MotionArg::Auto => MotionMode::Auto,
                 MotionArg::Step => MotionMode::Step,
                 MotionArg::OnTheFly => MotionMode::OnTheFly,
             },
@@ -450,7 +455,7 @@ fn hint(e: &anyhow::Error) -> Option<&'static str> {
         .remedy()?;
     Some(match remedy {
         Remedy::SplitOversize => {
-            "use --split-oversize to cut them at field borders, or --motion on-the-fly"
+            "use --split-oversize to cut them at field borders, or --motion auto or on-the-fly"
         }
         Remedy::Place => "use --place centre or --place corner:X,Y",
     })

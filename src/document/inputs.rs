@@ -28,15 +28,19 @@ impl PlanInputs {
             settings: doc.settings.clone(),
         }
     }
-    /// The inputs a plan was made from.
+    /// The inputs a plan was made from: the motion asked for (automatic, or the plan's own).
     pub fn of_plan(plan: &Plan) -> Self {
+        let motion = match plan.settings.motion {
+            super::MotionMode::Auto => super::MotionMode::Auto,
+            _ => plan.motion.into(),
+        };
         Self {
             geometry_rev: plan.geometry_rev,
             profile: plan.profile.clone(),
             layers: plan.layers.clone(),
             settings: SolverSettings {
                 algo: plan.algo,
-                motion: plan.motion,
+                motion,
                 ..plan.settings.clone()
             },
         }

@@ -35,7 +35,7 @@ pub use project::{
 };
 pub use route::TimedRoute;
 pub use settings::{
-    Algo, CostModel, FieldsMode, GaParams, MotionMode, RouteGaSettings, SolverSettings,
+    Algo, CostModel, FieldsMode, GaParams, Motion, MotionMode, RouteGaSettings, SolverSettings,
     StageRouteKind, VertexMode,
 };
 

@@ -3,7 +3,7 @@
 use crate::geom::{BBox, Pt};
 use serde::{Deserialize, Serialize};
 
-use super::{Algo, CostModel, MotionMode};
+use super::{Algo, CostModel, Motion};
 
 /// A scan field: the base parks at `center` and the scanner reaches `size` around it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -188,11 +188,11 @@ pub enum ObjectiveKind {
 
 impl ObjectiveKind {
     /// The objective of a solve with this cost model and motion.
-    pub fn of(cost: CostModel, motion: MotionMode) -> Self {
+    pub fn of(cost: CostModel, motion: Motion) -> Self {
         match (cost, motion) {
             (CostModel::Distance, _) => ObjectiveKind::IdleMm,
-            (CostModel::Time, MotionMode::Step) => ObjectiveKind::JobTimeS,
-            (CostModel::Time, MotionMode::OnTheFly) => ObjectiveKind::StepJobTimeEstimateS,
+            (CostModel::Time, Motion::Step) => ObjectiveKind::JobTimeS,
+            (CostModel::Time, Motion::OnTheFly) => ObjectiveKind::StepJobTimeEstimateS,
         }
     }
     /// Its unit.
@@ -271,7 +271,7 @@ pub struct Plan {
     /// The motion it was planned for: it is lowered, shown and exported that way whatever the
     /// current setting (projects from before on-the-fly marking are step-and-scan).
     #[serde(default)]
-    pub motion: super::MotionMode,
+    pub motion: Motion,
     /// On the fly with seed 001's routes (`lsa`, `cetsp-ga`): the stage route the lowering
     /// follows (none: the taut string, computed by the lowering itself).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -297,8 +297,14 @@ pub struct Plan {
 }
 
 impl Plan {
-    /// A plan of `order` on `fields` (in visiting order) made from `inputs`, before metrics.
-    pub fn new(inputs: &super::PlanInputs, fields: Vec<ScanField>, order: Vec<Step>) -> Plan {
+    /// A plan of `order` on `fields` (in visiting order) made from `inputs` to run in `motion`,
+    /// before metrics.
+    pub fn new(
+        inputs: &super::PlanInputs,
+        motion: Motion,
+        fields: Vec<ScanField>,
+        order: Vec<Step>,
+    ) -> Plan {
         Plan {
             name: String::new(),
             algo: inputs.settings.algo,
@@ -306,7 +312,7 @@ impl Plan {
             order,
             metrics: Metrics::default(),
             history: Vec::new(),
-            motion: inputs.settings.motion,
+            motion,
             stage_route: None,
             layers: inputs.layers.clone(),
             profile: inputs.profile.clone(),

@@ -49,6 +49,17 @@ impl SolverSettings {
     /// stage route on the fly) and, for the searches that draw random numbers, the seed, e.g.
     /// `HGA · job time · on the fly (taut) · seed 3`. Plans are named after it.
     pub fn plan_title(&self) -> String {
+        self.title_with(None)
+    }
+
+    /// [`plan_title`](Self::plan_title) of a plan made in `motion`: under
+    /// [`MotionMode::Auto`] it says which motion the solve chose, e.g.
+    /// `HHA · job time · auto: on the fly (taut) · seed 1`.
+    pub fn plan_title_as(&self, motion: Motion) -> String {
+        self.title_with(Some(motion))
+    }
+
+    fn title_with(&self, chosen: Option<Motion>) -> String {
         let algo = match self.algo {
             Algo::AsIs => "As-is",
             Algo::Baseline => "Baseline",
@@ -62,19 +73,32 @@ impl SolverSettings {
                 .find(|s| s.key == key)
                 .map_or_else(String::new, |s| (s.show)(self))
         };
-        let (cost, mut motion) = (words("cost_model"), words("motion"));
-        if self.motion == MotionMode::OnTheFly {
-            // the route as the command line spells it, short enough for a plan's name
-            let route = match self.stage_route {
-                StageRouteKind::Taut => "taut",
-                StageRouteKind::Lsa => "lsa",
-                StageRouteKind::CetspGa => "cetsp-ga",
-            };
-            motion = format!("{motion} ({route})");
-        }
+        let cost = words("cost_model");
+        let motion = match (self.motion, chosen) {
+            (MotionMode::Auto, Some(m)) => format!("auto: {}", self.motion_words(m)),
+            (MotionMode::Auto, None) => words("motion"),
+            (MotionMode::Step, _) => self.motion_words(Motion::Step),
+            (MotionMode::OnTheFly, _) => self.motion_words(Motion::OnTheFly),
+        };
         match self.algo {
             Algo::Hha | Algo::Hga => format!("{algo} · {cost} · {motion} · seed {}", self.seed),
             Algo::AsIs | Algo::Baseline => format!("{algo} · {cost} · {motion}"),
+        }
+    }
+
+    /// A motion in words, on the fly with the stage route as the command line spells it
+    /// (short enough for a plan's name).
+    fn motion_words(&self, motion: Motion) -> String {
+        match motion {
+            Motion::Step => motion.words().to_string(),
+            Motion::OnTheFly => {
+                let route = match self.stage_route {
+                    StageRouteKind::Taut => "taut",
+                    StageRouteKind::Lsa => "lsa",
+                    StageRouteKind::CetspGa => "cetsp-ga",
+                };
+                format!("{} ({route})", motion.words())
+            }
         }
     }
 }
@@ -101,9 +125,15 @@ pub enum CostModel {
     Time,
 }
 
-/// How the machine moves while it marks.
+/// How the machine should move while it marks: one motion, or whichever runs the job faster.
+/// The command line's default is [`MotionMode::Auto`]; a document's (and a project file's
+/// without the key) is step-and-scan, as before automatic motion existed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 pub enum MotionMode {
+    /// The faster of step-and-scan and on the fly, judged on the lowered job time (and, where
+    /// geometries are larger than a field, of marking them whole or cut at field borders).
+    #[serde(rename = "auto")]
+    Auto,
     /// Step-and-scan: the stage stops at every field, the scanner marks it.
     #[default]
     #[serde(rename = "step")]
@@ -111,6 +141,52 @@ pub enum MotionMode {
     /// On the fly: the stage moves on a continuous route while the scanner marks.
     #[serde(rename = "on-the-fly")]
     OnTheFly,
+}
+
+impl MotionMode {
+    /// The motions a solve tries: both for [`MotionMode::Auto`], else the one asked for.
+    pub fn candidates(self) -> &'static [Motion] {
+        match self {
+            MotionMode::Auto => &[Motion::Step, Motion::OnTheFly],
+            MotionMode::Step => &[Motion::Step],
+            MotionMode::OnTheFly => &[Motion::OnTheFly],
+        }
+    }
+    /// True when on-the-fly marking is among the motions tried.
+    pub fn may_fly(self) -> bool {
+        self != MotionMode::Step
+    }
+}
+
+/// How a plan's machine moves while it marks (what it is lowered, shown and exported as).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+pub enum Motion {
+    /// Step-and-scan: the stage stops at every field, the scanner marks it.
+    #[default]
+    #[serde(rename = "step")]
+    Step,
+    /// On the fly: the stage moves on a continuous route while the scanner marks.
+    #[serde(rename = "on-the-fly")]
+    OnTheFly,
+}
+
+impl Motion {
+    /// What it is, in words (the settings table's words).
+    pub fn words(self) -> &'static str {
+        match self {
+            Motion::Step => "step-and-scan",
+            Motion::OnTheFly => "on the fly",
+        }
+    }
+}
+
+impl From<Motion> for MotionMode {
+    fn from(m: Motion) -> Self {
+        match m {
+            Motion::Step => MotionMode::Step,
+            Motion::OnTheFly => MotionMode::OnTheFly,
+        }
+    }
 }
 
 /// The stage route of on-the-fly marking.

@@ -4,7 +4,7 @@
 
 use super::validate::{InvalidValue, NON_NEGATIVE, POSITIVE};
 use super::{
-    CostModel, FieldsMode, HatchSettings, MachineProfile, MotionMode, Pen, SolverSettings,
+    CostModel, FieldsMode, HatchSettings, MachineProfile, Motion, MotionMode, Pen, SolverSettings,
     StageRouteKind, MAX_PASSES,
 };
 
@@ -605,8 +605,9 @@ pub fn settings_specs() -> Vec<FieldSpec<SolverSettings>> {
             CostModel::Distance => "idle distance".into(),
         }),
         choice!("Motion", "motion", |t| match t.motion {
-            MotionMode::Step => "step-and-scan".into(),
-            MotionMode::OnTheFly => "on the fly".into(),
+            MotionMode::Auto => "automatic (the faster)".into(),
+            MotionMode::Step => Motion::Step.words().into(),
+            MotionMode::OnTheFly => Motion::OnTheFly.words().into(),
         }),
         choice!(
             "Stage route",
@@ -622,7 +623,10 @@ pub fn settings_specs() -> Vec<FieldSpec<SolverSettings>> {
             "Route GA",
             "route_ga",
             |t| match (t.motion, t.stage_route) {
-                (MotionMode::OnTheFly, StageRouteKind::Lsa | StageRouteKind::CetspGa) => {
+                (
+                    MotionMode::OnTheFly | MotionMode::Auto,
+                    StageRouteKind::Lsa | StageRouteKind::CetspGa,
+                ) => {
                     let g = &t.route_ga;
                     format!(
                         "population {}, generations {}, crossover {}, mutation {}, padding {}",

@@ -15,9 +15,11 @@ pub struct Warning {
 
 impl std::fmt::Display for Warning {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self.line {
-            Some(l) => write!(f, "{} (line {l}): {}", self.element, self.message),
-            None => write!(f, "{}: {}", self.element, self.message),
+        match (self.line, self.element.is_empty()) {
+            (Some(l), _) => write!(f, "{} (line {l}): {}", self.element, self.message),
+            // a note about the whole job names no element
+            (None, true) => write!(f, "{}", self.message),
+            (None, false) => write!(f, "{}: {}", self.element, self.message),
         }
     }
 }

@@ -37,7 +37,7 @@ pub use toolpath::{
     MachineState, ScanMotion, Segment, SegmentKind, StageMotion, Stroke, Toolpath, TIME_EPS_S,
 };
 
-use crate::document::{Geometry, Layer, MotionMode, Plan};
+use crate::document::{Geometry, Layer, Motion, Plan};
 use crate::job::JobCtx;
 
 /// Why a plan cannot be turned into motion, in either mode.
@@ -62,14 +62,14 @@ pub fn lower_motion(
 ) -> Result<Toolpath, MotionError> {
     let profile = &plan.profile;
     let mut path = match plan.motion {
-        MotionMode::Step => {
+        Motion::Step => {
             let path = lower(geometries, plan, profile)?;
             match clock_s {
                 Some(period_s) => path.on_clock(period_s),
                 None => path,
             }
         }
-        MotionMode::OnTheFly => lower_on_the_fly(geometries, plan, profile, clock_s, ctx)?,
+        Motion::OnTheFly => lower_on_the_fly(geometries, plan, profile, clock_s, ctx)?,
     };
     label_layers(&mut path, geometries, &plan.layers);
     Ok(path)

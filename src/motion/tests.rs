@@ -41,7 +41,12 @@ fn plan(fields: Vec<ScanField>, order: Vec<Step>) -> Plan {
         motion: Default::default(),
         stage_route: None,
         layers: vec![],
-        ..Plan::new(&PlanInputs::of(&Default::default()), vec![], vec![])
+        ..Plan::new(
+            &PlanInputs::of(&Default::default()),
+            Motion::Step,
+            vec![],
+            vec![],
+        )
     }
 }
 

@@ -18,8 +18,8 @@ pub use baseline::baseline_order;
 pub use passes::expand_passes;
 
 use crate::document::{
-    Algo, CostModel, GenerationRecord, Geometry, MachineProfile, MotionMode, ObjectiveKind, Plan,
-    PlanInputs, ScanField, SolverSettings, Step,
+    Algo, CostModel, GenerationRecord, Geometry, Motion, ObjectiveKind, Plan, PlanInputs,
+    ScanField, SolverSettings, Step,
 };
 use crate::job::{Cancelled, JobCtx};
 use crate::motion::{lower_motion, MotionError, OtfError, Toolpath};
@@ -52,7 +52,9 @@ pub struct Ordering {
 /// plan with its metrics (stage times other than `order` are left for the caller to fill in)
 /// and the toolpath they were computed on, so that the caller need not lower the plan again.
 /// Every candidate is judged on the inputs' time law, pens and passes included
-/// (`Candidates`).
+/// (`Candidates`). Under [`MotionMode::Auto`](crate::document::MotionMode::Auto) the plan is
+/// made for each motion and the one with the shorter lowered job time is kept (HGA: the motion
+/// of the faster HHA seed, whose GA then runs in that motion alone).
 pub fn order_plan(
     geometries: &[Geometry],
     fields: &[ScanField],
@@ -60,33 +62,104 @@ pub fn order_plan(
     ctx: &JobCtx,
 ) -> Result<(Plan, Toolpath), OrderError> {
     check_allocation(geometries.len(), fields)?;
-    let (profile, settings) = (&inputs.profile, &inputs.settings);
-    let lower = Candidates {
-        geometries,
-        fields,
-        inputs,
-        ctx,
-    };
+    let settings = &inputs.settings;
+    let motions = settings.motion.candidates();
     let t0 = std::time::Instant::now();
     let mut detail = Vec::new();
-    let (ordering, toolpath, history) = match settings.algo {
-        Algo::Hga => hga_plan(&lower, t0, &mut detail)?,
-        Algo::AsIs | Algo::Baseline | Algo::Hha => {
-            let ordering = run_algorithm(geometries, fields, profile, settings, ctx, &mut detail)?;
-            let (ordering, toolpath) =
-                finish(&lower, ordering, hha_until(settings, t0), &mut detail)?;
-            (ordering, toolpath, Vec::new())
+    let mut best: Option<Made> = None;
+    let mut hga_seeds = Vec::new();
+    for &motion in motions {
+        if best.is_some() && ctx.is_cancelled() {
+            // a cancel keeps the plan made so far
+            break;
         }
-    };
+        let lower = Candidates::new(geometries, fields, inputs, motion, ctx);
+        let mut stages = Vec::new();
+        let made = match settings.algo {
+            // HGA under auto: the motion is chosen on HHA plans, the GA then runs in it alone
+            Algo::Hga if motions.len() > 1 => {
+                let seed = hha_finished(&lower, t0, &mut stages)?;
+                hga_seeds.push((motion, seed.clone()));
+                (seed.0, seed.1, Vec::new())
+            }
+            Algo::Hga => hga_plan(&lower, t0, None, &mut stages)?,
+            Algo::AsIs | Algo::Baseline | Algo::Hha => {
+                let ordering = run_algorithm(&lower, &mut stages)?;
+                let (ordering, toolpath) =
+                    finish(&lower, ordering, hha_until(settings, t0), &mut stages)?;
+                (ordering, toolpath, Vec::new())
+            }
+        };
+        note_stages(&mut detail, motion, motions.len() > 1, stages);
+        best = Some(match best {
+            Some(b) if b.toolpath.duration_s() <= made.1.duration_s() => b,
+            _ => Made {
+                motion,
+                ordering: made.0,
+                toolpath: made.1,
+                history: made.2,
+            },
+        });
+    }
+    let mut best = best.ok_or(OrderError::Unallocated(0, 0))?;
+    if let Some((motion, hha)) = hga_seeds.into_iter().find(|(m, _)| *m == best.motion) {
+        // HGA under auto: the GA runs in the motion whose HHA seed was faster
+        let lower = Candidates::new(geometries, fields, inputs, motion, ctx);
+        let mut stages = Vec::new();
+        let (ordering, toolpath, history) = if ctx.is_cancelled() {
+            (hha.0, hha.1, Vec::new())
+        } else {
+            let seed = settings.ga.seed_with_hha.then_some(hha);
+            hga_plan(&lower, t0, seed, &mut stages)?
+        };
+        note_stages(&mut detail, motion, true, stages);
+        best = Made {
+            motion,
+            ordering,
+            toolpath,
+            history,
+        };
+    }
     let order_s = t0.elapsed().as_secs_f64();
-    let mut plan = lower.plan(&ordering);
-    let mut m = metrics::compute(geometries, &plan.fields, &plan.order, profile, &toolpath);
+    let lower = Candidates::new(geometries, fields, inputs, best.motion, ctx);
+    let mut plan = lower.plan(&best.ordering);
+    let mut m = metrics::compute(
+        geometries,
+        &plan.fields,
+        &plan.order,
+        &inputs.profile,
+        &best.toolpath,
+    );
     m.solve_s.order = order_s;
     m.solve_s.order_detail = detail;
-    plan.name = settings.plan_title();
+    plan.name = settings.plan_title_as(best.motion);
     plan.metrics = m;
-    plan.history = history;
-    Ok((plan, toolpath))
+    plan.history = best.history;
+    Ok((plan, best.toolpath))
+}
+
+/// A finished candidate plan: its motion, ordering, toolpath and GA history.
+struct Made {
+    motion: Motion,
+    ordering: Ordering,
+    toolpath: Toolpath,
+    history: Vec<GenerationRecord>,
+}
+
+/// Adds one motion's stage times to the solve's detail (named after the motion when a solve
+/// tries both).
+fn note_stages(
+    detail: &mut Vec<(String, f64)>,
+    motion: Motion,
+    named: bool,
+    stages: Vec<(String, f64)>,
+) {
+    let prefix = match (named, motion) {
+        (false, _) => "",
+        (true, Motion::Step) => "step: ",
+        (true, Motion::OnTheFly) => "on the fly: ",
+    };
+    detail.extend(stages.into_iter().map(|(k, s)| (format!("{prefix}{k}"), s)));
 }
 
 /// When HHA's last search ends under a time limit (none for the other algorithms: HGA spends
@@ -107,13 +180,13 @@ fn finish(
     until: Option<std::time::Instant>,
     detail: &mut Vec<(String, f64)>,
 ) -> Result<(Ordering, Toolpath), OrderError> {
-    let settings = &lower.inputs.settings;
+    let settings = &lower.settings;
     let t = std::time::Instant::now();
     if settings.algo == Algo::AsIs {
         let toolpath = lower.toolpath(&ordering)?;
         return Ok((ordering, toolpath));
     }
-    if settings.motion == MotionMode::OnTheFly {
+    if lower.motion == Motion::OnTheFly {
         let best = faster_on_the_fly(lower, ordering)?;
         detail.push(("bands".into(), t.elapsed().as_secs_f64()));
         return Ok(best);
@@ -127,8 +200,31 @@ fn finish(
     Ok((ordering, toolpath))
 }
 
+/// The HHA plan finished like any plan: HGA's seed.
+fn hha_finished(
+    lower: &Candidates,
+    t0: std::time::Instant,
+    detail: &mut Vec<(String, f64)>,
+) -> Result<(Ordering, Toolpath), OrderError> {
+    let t = std::time::Instant::now();
+    let settings = &lower.settings;
+    let o = hha::hha_order(
+        lower.geometries,
+        lower.fields,
+        &lower.inputs.profile,
+        settings,
+        lower.ctx,
+        detail,
+    )?;
+    let until = hha::deadline(settings, t0, hha::LAST_SEARCH_SHARE);
+    let seed = finish(lower, o, until, detail)?;
+    detail.push(("hha_seed".into(), t.elapsed().as_secs_f64()));
+    Ok(seed)
+}
+
 /// HGA as a race on the plan's objective: the HHA plan, finished like any plan, seeds the GA
-/// (when the settings say so); the GA ranks chromosomes on the same objective
+/// (when the settings say so; `seed` when it is already made); the GA ranks chromosomes on
+/// the same objective
 /// ([`objective`]); its best is finished the same way, and the better of the two finished
 /// plans is returned, so HGA is never worse than its seed, also after a cancel or a time
 /// limit. The history ends with the returned plan's table figure (when the GA's objective is
@@ -136,21 +232,18 @@ fn finish(
 fn hga_plan(
     lower: &Candidates,
     t0: std::time::Instant,
+    seed: Option<(Ordering, Toolpath)>,
     detail: &mut Vec<(String, f64)>,
 ) -> Result<(Ordering, Toolpath, Vec<GenerationRecord>), OrderError> {
     let (geometries, fields, inputs, ctx) =
         (lower.geometries, lower.fields, lower.inputs, lower.ctx);
-    let settings = &inputs.settings;
-    let kind = ObjectiveKind::of(settings.cost_model, settings.motion);
-    let t = std::time::Instant::now();
-    let seed = if settings.ga.seed_with_hha {
-        let o = hha::hha_order(geometries, fields, &inputs.profile, settings, ctx, detail)?;
-        let until = hha::deadline(settings, t0, hha::LAST_SEARCH_SHARE);
-        Some(finish(lower, o, until, detail)?)
-    } else {
-        None
+    let settings = &lower.settings;
+    let kind = ObjectiveKind::of(settings.cost_model, lower.motion);
+    let seed = match seed {
+        Some(seed) => Some(seed),
+        None if settings.ga.seed_with_hha => Some(hha_finished(lower, t0, detail)?),
+        None => None,
     };
-    detail.push(("hha_seed".into(), t.elapsed().as_secs_f64()));
     let step_time = objective::StepTime::new(geometries, fields, &inputs.layers, &inputs.profile);
     let of = |steps: &[Step]| match kind {
         ObjectiveKind::IdleMm => metrics::idle_mm(geometries, steps),
@@ -200,16 +293,42 @@ struct Candidates<'a> {
     geometries: &'a [Geometry],
     fields: &'a [ScanField],
     inputs: &'a PlanInputs,
+    /// The motion the candidates run in.
+    motion: Motion,
+    /// The inputs' settings with that motion (what the ordering reads).
+    settings: SolverSettings,
     ctx: &'a JobCtx,
 }
 
-impl Candidates<'_> {
+impl<'a> Candidates<'a> {
+    fn new(
+        geometries: &'a [Geometry],
+        fields: &'a [ScanField],
+        inputs: &'a PlanInputs,
+        motion: Motion,
+        ctx: &'a JobCtx,
+    ) -> Self {
+        let settings = SolverSettings {
+            motion: motion.into(),
+            ..inputs.settings.clone()
+        };
+        Self {
+            geometries,
+            fields,
+            inputs,
+            motion,
+            settings,
+            ctx,
+        }
+    }
+
     /// The plan of an ordering (unnamed, without metrics): its fields in visiting order, its
     /// strokes repeated for their layers' passes.
     fn plan(&self, ordering: &Ordering) -> Plan {
         let order = expand_passes(&ordering.steps, self.geometries, &self.inputs.layers);
         Plan::new(
             self.inputs,
+            self.motion,
             fields_in_order(self.fields, &ordering.field_order),
             order,
         )
@@ -242,13 +361,11 @@ fn faster(a: (Ordering, Toolpath), b: (Ordering, Toolpath)) -> (Ordering, Toolpa
 
 /// The ordering of the settings' algorithm (HGA goes through [`hga_plan`]).
 fn run_algorithm(
-    geometries: &[Geometry],
-    fields: &[ScanField],
-    profile: &MachineProfile,
-    settings: &SolverSettings,
-    ctx: &JobCtx,
+    lower: &Candidates,
     detail: &mut Vec<(String, f64)>,
 ) -> Result<Ordering, OrderError> {
+    let (geometries, fields, ctx) = (lower.geometries, lower.fields, lower.ctx);
+    let (profile, settings) = (&lower.inputs.profile, &lower.settings);
     Ok(match settings.algo {
         Algo::AsIs => as_is_order(geometries, fields, ctx)?,
         Algo::Baseline => baseline_order(geometries, fields, ctx)?,
@@ -299,7 +416,7 @@ fn time_ordering(
         lower.fields,
         &ordering,
         &lower.inputs.profile,
-        lower.inputs.settings.seed,
+        lower.settings.seed,
         until,
         lower.ctx,
     ) {

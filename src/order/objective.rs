@@ -251,7 +251,12 @@ mod tests {
             layers: Vec::new(),
             settings: SolverSettings::default(),
         };
-        let plan = Plan::new(&inputs, fields.clone(), steps.clone());
+        let plan = Plan::new(
+            &inputs,
+            crate::document::Motion::Step,
+            fields.clone(),
+            steps.clone(),
+        );
         let lowered = lower(&gs, &plan, &profile).unwrap().duration_s();
         let model = StepTime::new(&gs, &fields, &[], &profile).job_time_s(&steps);
         assert!(

@@ -630,7 +630,7 @@ pub fn hha_order(
     // budget, so HHA only gives it a start along a Hilbert curve (BENCHMARKS, issue 16)
     // (on the fly no time search follows: `order_plan` runs it for step-and-scan only)
     let lone_before_time =
-        time_follows && settings.motion == crate::document::MotionMode::Step && live.len() == 1;
+        time_follows && settings.motion != crate::document::MotionMode::OnTheFly && live.len() == 1;
     let cent: Vec<Pt> = geometries.iter().map(Geometry::centroid).collect();
     let (by_centre, by_gap) = field_order_candidates(&live_owned, &cent, profile, ctx)?;
     stage_s.push(("field_order".into(), t.elapsed().as_secs_f64()));
