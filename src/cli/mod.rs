@@ -71,14 +71,15 @@ enum MotionArg {
     Auto,
     /// Step-and-scan: the stage stops at every field.
     Step,
-    /// On the fly: the stage moves on a continuous route (taut string) while the scanner marks.
+    /// On the fly: the stage moves on a continuous route while the scanner marks.
     OnTheFly,
 }
 
 /// The stage route on the fly, as on the command line.
 #[derive(Debug, Clone, Copy, ValueEnum)]
 enum StageRouteArg {
-    /// Per-axis taut string through the scanner's reach, retimed and smoothed to the axis limits.
+    /// galvoplan's own: per axis the stage tracks the laser point within the scanner's reach at
+    /// the axis limits (the taut string, blended, where tracking does not settle).
     Taut,
     /// Seed 001's benchmark: the polyline through the line-simplified pattern points.
     Lsa,

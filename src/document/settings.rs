@@ -192,8 +192,10 @@ impl From<Motion> for MotionMode {
 /// The stage route of on-the-fly marking.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 pub enum StageRouteKind {
-    /// Per-axis taut string through the scanner's reach, retimed and smoothed to the axis
-    /// limits (the shortest route; galvoplan's own).
+    /// galvoplan's own: per axis the stage tracks the laser point within the scanner's reach at
+    /// the axis limits, slowing the marking only where it cannot keep up (the taut string, the
+    /// shortest route, blended, where tracking does not settle). The name is kept for saved
+    /// projects.
     #[default]
     #[serde(rename = "taut")]
     Taut,

@@ -25,6 +25,7 @@ mod route;
 mod seed_routes;
 pub mod taut;
 mod toolpath;
+mod track;
 
 pub use axis::{AxisMove, StageDynamics, StageMove};
 pub use blend::CornerBlends;

@@ -4,18 +4,24 @@
 //!    (marks at mark speed, jumps at jump speed, the laser and jump delays), as *pieces*; a
 //!    long stroke is cut into parts of at least [`PART_MM`] so that it can be slowed locally.
 //! 2. Per axis the stage must keep `|tcp − stage| ≤ h` with `h` = half the field less the
-//!    profile's `otf_margin_mm`, and stay inside its stroke. Through that tube the **taut
-//!    string** is the shortest route and has the least peak speed of any route
-//!    ([`super::taut`]). With a seed 001 route (`lsa`, `cetsp-ga`) each knot's interval is
-//!    narrowed to [`FOLLOW_MM`] around the route's position at that knot's nominal time.
-//! 3. Retiming: where the string is faster than the axis limit, or where one of its corners
-//!    would depart from it by more than [`CORNER_SHARE`] of the reach once blended at the axis
-//!    acceleration (`Δv² / (8 a)`), the pieces under that stretch are slowed (the scanner
-//!    waits, marks run slower), and the string is computed again, until none is.
-//! 4. Every corner is blended at the axis acceleration ([`super::blend`]): the speed stays
-//!    within the string's, the acceleration within the limit. A blend departs from the
-//!    string's corner *outwards* (it cuts the corner the tube pushed the string round), so the
-//!    blended route is checked on a 1 ms grid and at every knot; where it leaves the reach or
+//!    profile's `otf_margin_mm`, and stay inside its stroke. With a seed 001 route (`lsa`,
+//!    `cetsp-ga`) each knot's interval is narrowed to [`FOLLOW_MM`] around the route's position
+//!    at that knot's nominal time.
+//! 3. **Tracked route** (first choice, [`tracking`]): each axis follows that tube through its
+//!    exact reachable sets at the axis' speed and acceleration limits ([`super::track`]); the
+//!    tool is slowed only where no admissible stage motion keeps up with it. Job time is what
+//!    this minimises: nothing is slowed to keep a route short or its corners small.
+//! 4. **Taut route** (where tracking does not settle within its fix budget: a reach too small
+//!    for motion and marking to overlap): through the tube the **taut string** is the shortest
+//!    route and has the least peak speed of any route ([`super::taut`]). Retiming: where the
+//!    string is faster than the axis limit, or where one of its corners would depart from it by
+//!    more than [`CORNER_SHARE`] of the reach once blended at the axis acceleration
+//!    (`Δv² / (8 a)`), the pieces under that stretch are slowed (the scanner waits, marks run
+//!    slower), and the string is computed again, until none is.
+//! 5. The taut route's corners are blended at the axis acceleration ([`super::blend`]): the
+//!    speed stays within the string's, the acceleration within the limit. A blend departs from
+//!    the string's corner *outwards* (it cuts the corner the tube pushed the string round), so
+//!    the blended route is checked on a 1 ms grid and at every knot; where it leaves the reach or
 //!    the stroke, the tube there is narrowed by the excess (the string then bends that much
 //!    further inside and its blend comes back to the edge), or where that would leave less
 //!    than [`MIN_TUBE_SHARE`] of the reach, and where overlapping blends exceed the
@@ -25,9 +31,9 @@
 //!    smoothing and the speed capped so that it stays inside; it has never been needed on the
 //!    benchmarks).
 //!
-//! The trade-off is [`CORNER_SHARE`]: a corner slowed rather than rounded costs time, a corner
-//! rounded costs route length (see docs/BENCHMARKS.md for the measurements that set it). The
-//! job starts with the stage at rest; it waits half the longest blend at the first point.
+//! Either route is checked on a 1 ms grid and at every knot of the tool before it is kept.
+//! The taut route starts with the stage at rest, waiting half the longest blend at the first
+//! point; the tracked route starts at rest inside the first point's reach.
 
 use super::blend::CornerBlends;
 use super::cetsp::{TimedRoute, ToolKnot};
@@ -39,6 +45,8 @@ use crate::document::{AxisLimits, Geometry, MachineProfile, Plan};
 use crate::geom::Pt;
 use crate::job::{Cancelled, JobCtx};
 use thiserror::Error;
+
+mod tracking;
 
 /// Share of the scanner's reach kept for smoothing the route by the guaranteed fallback.
 pub const SMOOTHING_SHARE: f64 = 0.5;
@@ -181,6 +189,18 @@ pub fn lower_on_the_fly(
     let tube_mm = reach_mm * (1.0 - TUBE_SLACK);
     let mut pieces = tool_pieces(geometries, plan, profile, tube_mm, &mut path)?;
     let follow = plan.stage_route.as_ref();
+    let tracked = tracking::lower_tracked(
+        pieces.clone(),
+        &mut path,
+        profile,
+        reach_mm,
+        clock_s,
+        follow,
+        ctx,
+    )?;
+    if tracked.is_some() {
+        return Ok(path);
+    }
     let full_speed = [
         profile.axis_x.max_velocity_mm_s,
         profile.axis_y.max_velocity_mm_s,

@@ -1,5 +1,6 @@
-//! A continuous stage route: per axis a piecewise-linear path (the taut string) smoothed by a
-//! moving average, so that speed and acceleration stay within the axis limits.
+//! A continuous stage route, per axis: tracked through its reachable sets ([`super::track`]),
+//! or a piecewise-linear path (the taut string) with blended corners or smoothed by a moving
+//! average, so that speed and acceleration stay within the axis limits.
 //!
 //! Smoothing: `y(t) = (1/W) ∫_{t−W/2}^{t+W/2} x(s) ds`, with `x` held constant before its first
 //! and after its last vertex. Then `y'(t) = (x(t+W/2) − x(t−W/2)) / W`, so `|y'| ≤ max |x'|`, and
@@ -9,6 +10,7 @@
 //! window, `≤ v · W / 4 = v² / (2 a_max)`, which is the part of the scanner's reach kept for it.
 
 use super::blend::CornerBlends;
+use super::track::TrackedAxis;
 use crate::geom::Pt;
 
 /// One smoothed axis.
@@ -88,6 +90,9 @@ pub enum AxisRoute {
     Blends(CornerBlends),
     /// A moving average ([`SmoothedAxis`]).
     Window(SmoothedAxis),
+    /// Tracked through the reachable sets ([`super::track`]): the acceleration constant
+    /// between samples.
+    Tracked(TrackedAxis),
 }
 
 impl AxisRoute {
@@ -106,6 +111,7 @@ impl AxisRoute {
         match self {
             AxisRoute::Blends(b) => b.position_mm(t_s),
             AxisRoute::Window(w) => w.position_mm(t_s),
+            AxisRoute::Tracked(a) => a.position_mm(t_s),
         }
     }
     /// The stretch of the path (route time, s) whose corners move the route at `t_s`.
@@ -113,6 +119,7 @@ impl AxisRoute {
         match self {
             AxisRoute::Blends(b) => b.active_span(t_s),
             AxisRoute::Window(w) => Some((t_s - w.window_s() / 2.0, t_s + w.window_s() / 2.0)),
+            AxisRoute::Tracked(_) => None,
         }
     }
     /// How long before or after a vertex the route may depart from the path, s (the longest
@@ -121,6 +128,7 @@ impl AxisRoute {
         match self {
             AxisRoute::Blends(b) => b.longest_s(),
             AxisRoute::Window(w) => w.window_s(),
+            AxisRoute::Tracked(_) => 0.0,
         }
     }
 }
