@@ -1300,7 +1300,7 @@ fn stage_routes_and_settings_are_offered_in_an_operators_words() {
     h.get_by_label("Stage route").click();
     h.run();
     for option in [
-        "Shortest route (taut, default)",
+        "Tracked route (default)",
         "Follow a simplified path of the marks",
         "Genetic algorithm route (slow)",
     ] {

@@ -410,7 +410,9 @@ const MOTION_HELP: &str = "How the machine moves while it marks.\n\
     the field, then the stage drives to the next one.\n\
     On the fly: the stage never stops; it follows a smooth route while the scanner marks, \
     keeping the laser point inside the field (less the profile's on-the-fly margin). Shapes \
-    larger than the field need no splitting.\n\
+    larger than the field are marked whole or cut at field borders, whichever is faster.\n\
+    Automatic: plans both and keeps the shorter job time (the plan is named for the motion \
+    it chose); planning takes about twice as long.\n\
     Used by the next solve; a plan made already keeps the motion it was planned for (its \
     path, playback and motion plots), marked stale.";
 
@@ -418,9 +420,9 @@ const MOTION_HELP: &str = "How the machine moves while it marks.\n\
 pub const STAGE_ROUTES: &[Choice<StageRouteKind>] = &[
     (
         StageRouteKind::Taut,
-        "Shortest route (taut, default)",
-        "Per axis the shortest route that keeps the laser point within the scanner's reach; \
-         command line: --stage-route taut.",
+        "Tracked route (default)",
+        "The stage follows the laser point as closely as its speed and acceleration allow, \
+         and the marking waits only where it cannot keep up; command line: --stage-route taut.",
     ),
     (
         StageRouteKind::Lsa,
@@ -438,9 +440,10 @@ pub const STAGE_ROUTES: &[Choice<StageRouteKind>] = &[
 
 /// What the stage routes mean for the operator.
 const STAGE_ROUTE_HELP: &str = "How the stage's route is planned on the fly.\n\
-    Shortest route: per axis, the shortest route that keeps the laser point within the \
-    scanner's reach, smoothed to the axes' speed and acceleration limits; the marking slows \
-    where the stage cannot follow (command line: --stage-route taut).\n\
+    Tracked route: the stage follows the laser point within the scanner's reach as its \
+    speed and acceleration limits allow; the scanner waits between marks only where the \
+    stage cannot keep up, and where it falls behind too often (a very small field) the \
+    shortest (taut) route takes over (command line: --stage-route taut).\n\
     Follow a simplified path of the marks: the stage follows the pattern's points, thinned \
     out by line simplification (seed 001's benchmark; --stage-route lsa).\n\
     Genetic algorithm route: a route through circles around the marks searched by a \

@@ -47,14 +47,14 @@ impl Algo {
 impl SolverSettings {
     /// What a plan made with these settings is, in words: algorithm, cost, motion (with the
     /// stage route on the fly) and, for the searches that draw random numbers, the seed, e.g.
-    /// `HGA · job time · on the fly (taut) · seed 3`. Plans are named after it.
+    /// `HGA · job time · on the fly (lsa) · seed 3`. Plans are named after it.
     pub fn plan_title(&self) -> String {
         self.title_with(None)
     }
 
     /// [`plan_title`](Self::plan_title) of a plan made in `motion`: under
     /// [`MotionMode::Auto`] it says which motion the solve chose, e.g.
-    /// `HHA · job time · auto: on the fly (taut) · seed 1`.
+    /// `HHA · job time · auto: on the fly · seed 1`.
     pub fn plan_title_as(&self, motion: Motion) -> String {
         self.title_with(Some(motion))
     }
@@ -86,19 +86,16 @@ impl SolverSettings {
         }
     }
 
-    /// A motion in words, on the fly with the stage route as the command line spells it
-    /// (short enough for a plan's name).
+    /// A motion in words, on the fly with seed 001's stage route as the command line spells it
+    /// (galvoplan's own route goes without a word; short enough for a plan's name).
     fn motion_words(&self, motion: Motion) -> String {
         match motion {
             Motion::Step => motion.words().to_string(),
-            Motion::OnTheFly => {
-                let route = match self.stage_route {
-                    StageRouteKind::Taut => "taut",
-                    StageRouteKind::Lsa => "lsa",
-                    StageRouteKind::CetspGa => "cetsp-ga",
-                };
-                format!("{} ({route})", motion.words())
-            }
+            Motion::OnTheFly => match self.stage_route {
+                StageRouteKind::Taut => motion.words().to_string(),
+                StageRouteKind::Lsa => format!("{} (lsa)", motion.words()),
+                StageRouteKind::CetspGa => format!("{} (cetsp-ga)", motion.words()),
+            },
         }
     }
 }

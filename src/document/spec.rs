@@ -614,7 +614,7 @@ pub fn settings_specs() -> Vec<FieldSpec<SolverSettings>> {
             "stage_route",
             |t| match (t.motion, t.stage_route) {
                 (MotionMode::Step, _) => "none (step-and-scan)".into(),
-                (_, StageRouteKind::Taut) => "shortest (taut)".into(),
+                (_, StageRouteKind::Taut) => "tracked (galvoplan's own)".into(),
                 (_, StageRouteKind::Lsa) => "simplified pattern (lsa)".into(),
                 (_, StageRouteKind::CetspGa) => "genetic algorithm (cetsp-ga)".into(),
             }

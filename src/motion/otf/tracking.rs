@@ -3,9 +3,11 @@
 //!
 //! The tube is sampled at every knot of the tool (piece ends, stroke vertices) and at least
 //! every [`MAX_STEP_S`] of nominal time; between samples the tool moves straight. Where the
-//! stage cannot follow (an empty set at sample `j`, time `t_j`), the pieces running in the
-//! window `[t_j − W, t_j]` are slowed by [`FIX_FACTOR`] and the sets are propagated again from
-//! the first of them (the sets before are unchanged: they depend only on earlier pieces). `W`
+//! stage cannot follow (an empty set at sample `j`, time `t_j`), the window `[t_j − W, t_j]` is
+//! made [`FIX_FACTOR`] times longer, the time added to its laser-off waits (the scanner waits
+//! for the stage between marks) where it has any, else to all its pieces (marks run slower),
+//! and the sets are propagated again from the first of them (the sets before are unchanged:
+//! they depend only on earlier pieces). `W`
 //! starts at the longest time an axis takes to reach full speed and grows by half each time the
 //! same spot fails again. Job time is what this spends, and only near spots where the stage
 //! cannot keep up, in steps of [`FIX_FACTOR`]; route length and corners cost nothing.
@@ -17,7 +19,7 @@ use crate::job::JobCtx;
 use crate::motion::cetsp::TimedRoute;
 use crate::motion::route::AxisRoute;
 use crate::motion::track::{Limits, Reachable, TrackedAxis};
-use crate::motion::Toolpath;
+use crate::motion::{SegmentKind, Toolpath};
 
 use super::OtfError;
 
@@ -227,12 +229,35 @@ impl Fixes {
         self.last_fail_s = fail_s;
         let from = t_s[..=k].partition_point(|&t| t < fail_s - self.window_s);
         let first_piece = samples.samples[from.min(k)].piece;
-        for p in &mut pieces[first_piece..=samples.samples[k].piece] {
-            self.added_s += p.duration_s * (FIX_FACTOR - 1.0);
-            p.duration_s *= FIX_FACTOR;
-        }
+        self.added_s += add_time(&mut pieces[first_piece..=samples.samples[k].piece]);
         Some(samples.first[first_piece])
     }
+}
+
+/// Makes `window` last [`FIX_FACTOR`] times longer, the added time given to what it does
+/// between marks, laser off (jumps and delays: the scanner waits for the stage, as
+/// step-and-scan does) where it has any, else spread over all its pieces (marks run slower).
+/// Returns the time added, s.
+fn add_time(window: &mut [Piece]) -> f64 {
+    let is_wait = |p: &Piece| p.kind != SegmentKind::Mark;
+    let total_s: f64 = window.iter().map(|p| p.duration_s).sum();
+    let waits_s: f64 = window
+        .iter()
+        .filter(|p| is_wait(p))
+        .map(|p| p.duration_s)
+        .sum();
+    let added_s = total_s * (FIX_FACTOR - 1.0);
+    if waits_s > 0.0 {
+        let stretch = 1.0 + added_s / waits_s;
+        for p in window.iter_mut().filter(|p| is_wait(p)) {
+            p.duration_s *= stretch;
+        }
+    } else {
+        for p in window.iter_mut() {
+            p.duration_s *= FIX_FACTOR;
+        }
+    }
+    added_s
 }
 
 /// Propagates both axes' sets to sample `k` (`t_s[k]` set on the way); false where one runs
