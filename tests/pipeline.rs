@@ -230,3 +230,48 @@ fn a_version_2_project_gives_its_plans_the_documents_inputs() {
     assert_eq!(back.plans[0].profile, back.profile);
     assert!(galvoplan::document::staleness(&back.plans[0], &back).is_empty());
 }
+
+/// Cancels the job when the second ordering (the second motion, under auto) starts.
+struct CancelOnSecondOrdering {
+    token: galvoplan::job::CancelToken,
+    starts: std::sync::atomic::AtomicUsize,
+}
+
+impl galvoplan::job::ProgressSink for CancelOnSecondOrdering {
+    fn report(&self, p: &galvoplan::job::Progress) {
+        if p.message == "HHA: field order"
+            && self
+                .starts
+                .fetch_add(1, std::sync::atomic::Ordering::SeqCst)
+                == 1
+        {
+            self.token.cancel();
+        }
+    }
+}
+
+#[test]
+fn a_cancel_under_auto_keeps_the_motion_planned_so_far() {
+    let path = common::root().join("assets/examples/demo.svg");
+    let settings = SolverSettings {
+        motion: galvoplan::document::MotionMode::Auto,
+        ..SolverSettings::default()
+    };
+    let (mut doc, _) = load_svg(
+        &path,
+        MachineProfile::default(),
+        settings,
+        &ImportOptions::default(),
+    )
+    .unwrap();
+    let token = galvoplan::job::CancelToken::new();
+    let sink = std::sync::Arc::new(CancelOnSecondOrdering {
+        token: token.clone(),
+        starts: Default::default(),
+    });
+    let ctx = JobCtx::new(token, sink.clone());
+    let plan = plan_document(&mut doc, &ctx).unwrap();
+    assert!(ctx.is_cancelled(), "the second motion was never started");
+    assert_eq!(plan.motion, galvoplan::document::Motion::Step);
+    common::check_plan(&doc, &plan);
+}

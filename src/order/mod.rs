@@ -77,18 +77,20 @@ pub fn order_plan(
         let mut stages = Vec::new();
         let made = match settings.algo {
             // HGA under auto: the motion is chosen on HHA plans, the GA then runs in it alone
-            Algo::Hga if motions.len() > 1 => {
-                let seed = hha_finished(&lower, t0, &mut stages)?;
+            Algo::Hga if motions.len() > 1 => hha_finished(&lower, t0, &mut stages).map(|seed| {
                 hga_seeds.push((motion, seed.clone()));
                 (seed.0, seed.1, Vec::new())
-            }
-            Algo::Hga => hga_plan(&lower, t0, None, &mut stages)?,
-            Algo::AsIs | Algo::Baseline | Algo::Hha => {
-                let ordering = run_algorithm(&lower, &mut stages)?;
-                let (ordering, toolpath) =
-                    finish(&lower, ordering, hha_until(settings, t0), &mut stages)?;
-                (ordering, toolpath, Vec::new())
-            }
+            }),
+            Algo::Hga => hga_plan(&lower, t0, None, &mut stages),
+            Algo::AsIs | Algo::Baseline | Algo::Hha => run_algorithm(&lower, &mut stages)
+                .and_then(|ordering| finish(&lower, ordering, hha_until(settings, t0), &mut stages))
+                .map(|(ordering, toolpath)| (ordering, toolpath, Vec::new())),
+        };
+        let made = match made {
+            Ok(made) => made,
+            // a cancel while the next motion is planned keeps the plan made so far
+            Err(OrderError::Cancelled(_)) if best.is_some() => break,
+            Err(e) => return Err(e),
         };
         note_stages(&mut detail, motion, motions.len() > 1, stages);
         best = Some(match best {
