@@ -5,7 +5,9 @@ use crate::document::{
     MotionMode, Pen, PenLibrary, Plan, PlanInputs, ScanField, SolverSettings, StageRouteKind,
     Warning,
 };
-use crate::fields::{check_artwork, place_fields, split_oversize, FieldError, Placement};
+use crate::fields::{
+    check_artwork, place_fields, split_oversize, FieldError, Placement, SPLIT_WORDS,
+};
 use crate::hatch::{layer_geometries, HatchError};
 use crate::import::{import_file, ImportError, ImportOptions, SkippedLayer};
 use crate::job::JobCtx;
@@ -226,6 +228,8 @@ pub fn derive_geometries(doc: &mut Document, ctx: &JobCtx) -> Result<f64, Pipeli
     if doc.derived_with.as_ref() == Some(&key) {
         return Ok(0.0);
     }
+    doc.uncut_geometries = None;
+    drop_cut_warnings(&mut doc.warnings);
     let made = layer_geometries(&doc.artwork, &doc.layers, doc.profile.field_mm, ctx).map_err(
         |source| PipelineError::Hatch {
             file: doc.source.clone().unwrap_or_else(|| "document".into()),
@@ -344,6 +348,13 @@ type Made = Option<(Plan, Toolpath)>;
 /// HHA plans).
 fn place_and_choose(doc: &mut Document, ctx: &JobCtx) -> Result<(usize, Made), PipelineError> {
     derive_geometries(doc, ctx)?;
+    if !doc.settings.split_oversize && !doc.settings.motion.may_fly() {
+        // a placement that may not cut starts again from the whole geometries
+        if let Some(whole) = doc.uncut_geometries.take() {
+            doc.set_geometries(whole);
+            drop_cut_warnings(&mut doc.warnings);
+        }
+    }
     if doc.geometries.is_empty() && !doc.artwork.is_empty() {
         return Err(PipelineError::AllDisabled {
             file: doc.source.clone().unwrap_or_else(|| "document".into()),
@@ -359,10 +370,8 @@ fn place_and_choose(doc: &mut Document, ctx: &JobCtx) -> Result<(usize, Made), P
         let mut geometries = doc.geometries.clone();
         let warnings = split_oversize(&mut geometries, doc.profile.field_mm);
         if !warnings.is_empty() {
-            // indices changed: the plans keep the geometries they were planned on
-            doc.set_geometries(geometries);
+            cut_geometries(doc, geometries, warnings);
         }
-        doc.warnings.extend(warnings);
     }
     let locked: Vec<ScanField> = doc.fields.iter().filter(|f| f.locked).cloned().collect();
     let placed = place_fields(&doc.geometries, &doc.profile, &doc.settings, &locked, ctx);
@@ -428,12 +437,14 @@ fn whole_or_cut(
         ("whole".to_string(), whole.0.metrics.solve_s.order),
         ("cut".to_string(), cut.0.metrics.solve_s.order),
     ];
+    // this choice replaces the last one's words
+    doc.warnings
+        .retain(|w| !w.message.starts_with(CHOICE_PREFIX));
     let (mut made, lower_bound) = if cut_s < whole_s {
-        doc.set_geometries(pieces);
+        cut_geometries(doc, pieces, cuts);
         doc.fields = cut_placement.fields;
-        doc.warnings.extend(cuts);
         doc.warnings.push(choice_warning(format!(
-            "geometries larger than a scan field are cut at field borders: the job takes {} s cut against {} s marked whole on the fly",
+            "{CHOICE_PREFIX}cut at field borders: the job takes {} s cut against {} s marked whole on the fly",
             format_s(cut_s),
             format_s(whole_s)
         )));
@@ -441,7 +452,7 @@ fn whole_or_cut(
     } else {
         doc.fields = whole_region.fields;
         doc.warnings.push(choice_warning(format!(
-            "geometries larger than a scan field are marked whole on the fly: the job takes {} s against {} s cut at field borders",
+            "{CHOICE_PREFIX}marked whole on the fly: the job takes {} s against {} s cut at field borders",
             format_s(whole_s),
             format_s(cut_s)
         )));
@@ -455,6 +466,34 @@ fn whole_or_cut(
     solve.order = order_s;
     solve.order_detail = detail;
     Ok((lower_bound, reusable.then_some(made)))
+}
+
+/// How the warning about the whole-or-cut choice begins (a placement replaces the last one's).
+const CHOICE_PREFIX: &str = "geometries larger than a scan field are ";
+
+/// Installs `pieces`, the document's geometries cut at field borders, with the cut `warnings`
+/// (each once), keeping the whole geometries for a placement that may not cut
+/// ([`Document::uncut_geometries`]).
+fn cut_geometries(
+    doc: &mut Document,
+    pieces: Vec<crate::document::Geometry>,
+    warnings: Vec<Warning>,
+) {
+    let whole = doc.geometries.clone();
+    // indices changed: the plans keep the geometries they were planned on
+    if doc.set_geometries(pieces) && doc.uncut_geometries.is_none() {
+        doc.uncut_geometries = Some(whole);
+    }
+    for w in warnings {
+        if !doc.warnings.contains(&w) {
+            doc.warnings.push(w);
+        }
+    }
+}
+
+/// Drops the warnings of a cut and of the whole-or-cut choice (the geometries are whole again).
+fn drop_cut_warnings(warnings: &mut Vec<Warning>) {
+    warnings.retain(|w| !w.message.starts_with(CHOICE_PREFIX) && !w.message.contains(SPLIT_WORDS));
 }
 
 /// A warning about a choice the solve made (no element of the drawing).

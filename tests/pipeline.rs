@@ -275,3 +275,37 @@ fn a_cancel_under_auto_keeps_the_motion_planned_so_far() {
     assert_eq!(plan.motion, galvoplan::document::Motion::Step);
     common::check_plan(&doc, &plan);
 }
+
+#[test]
+fn a_cut_is_the_placements_choice_and_a_step_placement_starts_again_from_whole_geometries() {
+    let path = common::root().join("assets/examples/oversize.svg");
+    let settings = SolverSettings {
+        motion: galvoplan::document::MotionMode::Auto,
+        ..SolverSettings::default()
+    };
+    let (mut doc, _) = load_svg(
+        &path,
+        MachineProfile::default(),
+        settings,
+        &ImportOptions::default(),
+    )
+    .unwrap();
+    let whole = doc.geometries.len();
+    let ctx = JobCtx::default();
+    let choices = |doc: &galvoplan::document::Document| {
+        doc.warnings
+            .iter()
+            .filter(|w| w.message.contains("cut at field borders"))
+            .count()
+    };
+    galvoplan::pipeline::place_document_fields(&mut doc, &ctx).unwrap();
+    assert!(doc.geometries.len() > whole, "auto cuts oversize.svg");
+    galvoplan::pipeline::place_document_fields(&mut doc, &ctx).unwrap();
+    assert_eq!(choices(&doc), 1, "{:?}", doc.warnings);
+    // step-and-scan without the split setting: the whole geometries again, which it cannot mark
+    doc.settings.motion = galvoplan::document::MotionMode::Step;
+    let err = galvoplan::pipeline::place_document_fields(&mut doc, &ctx).unwrap_err();
+    assert!(err.to_string().contains("larger than"), "{err}");
+    assert_eq!(doc.geometries.len(), whole);
+    assert_eq!(choices(&doc), 0);
+}

@@ -902,6 +902,9 @@ impl App {
                     elapsed.as_secs_f64()
                 );
                 let k = self.session.add_plan(*plan, lowered);
+                // a new plan is shown from its start
+                self.view.playback.t_s = 0.0;
+                self.view.playback.playing = false;
                 self.view.compare.push(k, &self.session.doc.plans);
                 match self.session.toolpaths.get(k) {
                     Some(Err(why)) => {

@@ -196,7 +196,7 @@ fn speed_plot(
     );
     ui.add(
         egui::Label::new(format!(
-            "Stage speed, mm/s: peak {:.0}, limit {:.0} an axis, {:.0} both",
+            "Stage speed, mm/s: peak {:.0}, limit {:.0} per axis, {:.0} both",
             s.peak_speed_mm_s(),
             vx.max(vy),
             vx.hypot(vy)

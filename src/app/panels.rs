@@ -292,7 +292,7 @@ impl Editors {
         combo(ui, "Start points", &mut s.vertex, START_POINTS).on_hover_text(VERTEX_HELP);
         combo(ui, "Cost model", &mut s.cost_model, COST_MODELS).on_hover_text(COST_MODEL_HELP);
         combo(ui, "Motion", &mut s.motion, MOTION_MODES).on_hover_text(MOTION_HELP);
-        ui.add_enabled_ui(s.motion == MotionMode::OnTheFly, |ui| {
+        ui.add_enabled_ui(s.motion.may_fly(), |ui| {
             combo(ui, "Stage route", &mut s.stage_route, STAGE_ROUTES)
                 .on_hover_text(STAGE_ROUTE_HELP)
                 .on_disabled_hover_text("Only used on the fly: step-and-scan has no route.");
@@ -427,14 +427,14 @@ pub const STAGE_ROUTES: &[Choice<StageRouteKind>] = &[
     (
         StageRouteKind::Lsa,
         "Follow a simplified path of the marks",
-        "The stage follows the marks' points, thinned out (seed 001's line-simplified \
-         route, LSA); command line: --stage-route lsa.",
+        "The stage follows the marks' points, thinned out by line simplification (a \
+         published benchmark route); command line: --stage-route lsa.",
     ),
     (
         StageRouteKind::CetspGa,
         "Genetic algorithm route (slow)",
-        "A route searched by a genetic algorithm (seed 001's close-enough TSP); command \
-         line: --stage-route cetsp-ga.",
+        "A route through circles around the marks, searched by a genetic algorithm (a \
+         published benchmark route); command line: --stage-route cetsp-ga.",
     ),
 ];
 
@@ -442,13 +442,13 @@ pub const STAGE_ROUTES: &[Choice<StageRouteKind>] = &[
 const STAGE_ROUTE_HELP: &str = "How the stage's route is planned on the fly.\n\
     Tracked route: the stage follows the laser point within the scanner's reach as its \
     speed and acceleration limits allow; the scanner waits between marks only where the \
-    stage cannot keep up, and where it falls behind too often (a very small field) the \
-    shortest (taut) route takes over (command line: --stage-route taut).\n\
+    stage cannot keep up, and where it would fall behind at almost every mark (a very small \
+    field) the shortest route through the reach takes over.\n\
     Follow a simplified path of the marks: the stage follows the pattern's points, thinned \
-    out by line simplification (seed 001's benchmark; --stage-route lsa).\n\
-    Genetic algorithm route: a route through circles around the marks searched by a \
-    genetic algorithm (seed 001's close-enough TSP; --stage-route cetsp-ga); slow to plan: \
-    500 generations, with progress and Cancel as for the solves.\n\
+    out by line simplification (a published benchmark route).\n\
+    Genetic algorithm route: a route through circles around the marks, searched by a \
+    genetic algorithm (a published benchmark route); slow to plan: 500 generations, with \
+    a progress bar and Cancel.\n\
     Used by the next solve.";
 
 /// A labelled combo box, each option with its hover text; returns the combo's response.

@@ -88,6 +88,11 @@ pub struct Document {
     /// The geometries to mark: the enabled layers' artwork with their hatch; a geometry's
     /// index is its id (fields and plans refer to it).
     pub geometries: Vec<Geometry>,
+    /// The geometries before a placement cut them at field borders (the split setting, or the
+    /// whole-or-cut choice on the fly): a placement that may not cut (step-and-scan without
+    /// the split setting) starts again from these. Not saved: a project reopens as it was cut.
+    #[serde(skip)]
+    pub uncut_geometries: Option<Vec<Geometry>>,
     /// Warnings from the import (skipped elements, degenerate paths).
     pub warnings: Vec<Warning>,
     /// The machine the job is planned for.

@@ -21,7 +21,7 @@ pub use edit::{
 };
 pub use greedy::greedy_fields;
 pub use reach::{center_range, check_artwork, check_reach, Span};
-pub use split::{is_oversize, split_geometry, split_oversize};
+pub use split::{is_oversize, split_geometry, split_oversize, SPLIT_WORDS};
 
 use crate::document::{FieldsMode, Geometry, MachineProfile, ScanField, SolverSettings};
 use crate::job::{Cancelled, JobCtx};

@@ -14,6 +14,10 @@ use crate::geom::Pt;
 /// Pieces shorter than this (mm) are dropped: below the resolution of the exported G-code.
 pub const MIN_PIECE_MM: f64 = 1e-3;
 
+/// The words of a cut's warning ("geometry 3 (… mm) is larger than the scan field: split into
+/// 4 strokes at field borders"), by which the cut's warnings are found again.
+pub const SPLIT_WORDS: &str = "is larger than the scan field: split into";
+
 /// True when the geometry does not fit a field of `field_mm`.
 pub fn is_oversize(g: &Geometry, field_mm: [f64; 2]) -> bool {
     let b = g.bbox();
@@ -122,7 +126,7 @@ pub fn split_oversize(geometries: &mut Vec<Geometry>, field_mm: [f64; 2]) -> Vec
                 element: g.source.element.clone(),
                 line: None,
                 message: format!(
-                    "geometry {i} ({:.2} × {:.2} mm) is larger than the scan field: split into {} strokes at field borders",
+                    "geometry {i} ({:.2} × {:.2} mm) {SPLIT_WORDS} {} strokes at field borders",
                     g.bbox().width(),
                     g.bbox().height(),
                     pieces.len()

@@ -12,11 +12,10 @@
 //! same spot fails again. Job time is what this spends, and only near spots where the stage
 //! cannot keep up, in steps of [`FIX_FACTOR`]; route length and corners cost nothing.
 
+use super::TUBE_SLACK;
 use super::{clocked, install, overshoots, piece_knots, Piece};
-use super::{FOLLOW_MM, TUBE_SLACK};
 use crate::document::MachineProfile;
 use crate::job::JobCtx;
-use crate::motion::cetsp::TimedRoute;
 use crate::motion::route::AxisRoute;
 use crate::motion::track::{Limits, Reachable, TrackedAxis};
 use crate::motion::{SegmentKind, Toolpath};
@@ -79,14 +78,12 @@ fn limits(profile: &MachineProfile, reach_mm: f64) -> [Limits; 2] {
 }
 
 impl Samples {
-    /// Samples the tube of half-width `tube_mm` around `pieces` (clipped to the stroke; with a
-    /// seed 001 route, narrowed to [`FOLLOW_MM`] around it where they meet).
+    /// Samples the tube of half-width `tube_mm` around `pieces` (clipped to the stroke).
     fn new(
         pieces: &[Piece],
         path: &Toolpath,
         profile: &MachineProfile,
         tube_mm: f64,
-        follow: Option<&TimedRoute>,
     ) -> Result<Self, OtfError> {
         let mut samples: Vec<Sample> = Vec::new();
         let mut first = Vec::with_capacity(pieces.len());
@@ -106,7 +103,6 @@ impl Samples {
                 for m in 1..=fill {
                     let s = m as f64 / fill as f64;
                     let (us, ps) = (u0 + s * (u - u0), p0.plus(p.minus(p0).scale(s)));
-                    let nominal_s = piece.nominal_start_s + us * piece.nominal_s;
                     // the first knot of a piece is the last of the one before
                     let joins = us == 0.0 && j > 0;
                     let repeats = samples.last().is_some_and(|l: &Sample| {
@@ -115,7 +111,7 @@ impl Samples {
                     if joins || repeats {
                         continue;
                     }
-                    let (lower, upper) = bounds(piece, ps, nominal_s, tube_mm, profile, follow)?;
+                    let (lower, upper) = bounds(piece, ps, tube_mm, profile)?;
                     samples.push(Sample {
                         piece: j,
                         u: us,
@@ -142,39 +138,25 @@ impl Samples {
     }
 }
 
-/// The interval `(lower, upper)` each axis must keep at the tool's point `p` of `piece` (at
-/// nominal time `nominal_s`).
+/// The interval `(lower, upper)` each axis must keep at the tool's point `p` of `piece`.
 fn bounds(
     piece: &Piece,
     p: crate::geom::Pt,
-    nominal_s: f64,
     tube_mm: f64,
     profile: &MachineProfile,
-    follow: Option<&TimedRoute>,
 ) -> Result<([f64; 2], [f64; 2]), OtfError> {
-    let target = follow.map(|route| route.position(nominal_s));
     let mut lower = [0.0; 2];
     let mut upper = [0.0; 2];
     for (k, axis) in ['x', 'y'].into_iter().enumerate() {
-        let coord = |q: crate::geom::Pt| if k == 0 { q.x } else { q.y };
-        let (mut lo, mut hi) = (
-            (coord(p) - tube_mm).max(0.0),
-            (coord(p) + tube_mm).min(profile.stroke_mm[k]),
-        );
-        if lo > hi {
+        let coord = if k == 0 { p.x } else { p.y };
+        lower[k] = (coord - tube_mm).max(0.0);
+        upper[k] = (coord + tube_mm).min(profile.stroke_mm[k]);
+        if lower[k] > upper[k] {
             return Err(OtfError::OutOfStroke {
                 geometry: piece.geometry,
                 axis,
             });
         }
-        if let Some(t) = target.map(coord) {
-            let (band_lo, band_hi) = (lo.max(t - FOLLOW_MM), hi.min(t + FOLLOW_MM));
-            if band_lo <= band_hi {
-                (lo, hi) = (band_lo, band_hi);
-            }
-        }
-        lower[k] = lo;
-        upper[k] = hi;
     }
     Ok((lower, upper))
 }
@@ -348,7 +330,6 @@ pub(super) fn lower_tracked(
     profile: &MachineProfile,
     reach_mm: f64,
     clock_s: Option<f64>,
-    follow: Option<&TimedRoute>,
     ctx: &JobCtx,
 ) -> Result<Option<()>, OtfError> {
     let tube_mm = reach_mm * (1.0 - TUBE_SLACK);
@@ -357,7 +338,7 @@ pub(super) fn lower_tracked(
         ctx.check()?;
         let mut run = clocked(&pieces, path, clock_s);
         let before: Vec<f64> = run.iter().map(|p| p.duration_s).collect();
-        let samples = Samples::new(&run, path, profile, tube_mm, follow)?;
+        let samples = Samples::new(&run, path, profile, tube_mm)?;
         let Some((fixes, [x, y])) = track(&mut run, &samples, limits, ctx)? else {
             return Ok(None);
         };
