@@ -231,6 +231,18 @@ fn a_version_2_project_gives_its_plans_the_documents_inputs() {
     assert!(galvoplan::document::staleness(&back.plans[0], &back).is_empty());
 }
 
+/// An example opened with the motion on automatic.
+fn load_auto(name: &str) -> galvoplan::document::Document {
+    let path = common::root().join("assets/examples").join(name);
+    let settings = SolverSettings {
+        motion: galvoplan::document::MotionMode::Auto,
+        ..SolverSettings::default()
+    };
+    let options = ImportOptions::default();
+    let (doc, _) = load_svg(&path, MachineProfile::default(), settings, &options).unwrap();
+    doc
+}
+
 /// Cancels the job when the second ordering (the second motion, under auto) starts.
 struct CancelOnSecondOrdering {
     token: galvoplan::job::CancelToken,
@@ -252,18 +264,7 @@ impl galvoplan::job::ProgressSink for CancelOnSecondOrdering {
 
 #[test]
 fn a_cancel_under_auto_keeps_the_motion_planned_so_far() {
-    let path = common::root().join("assets/examples/demo.svg");
-    let settings = SolverSettings {
-        motion: galvoplan::document::MotionMode::Auto,
-        ..SolverSettings::default()
-    };
-    let (mut doc, _) = load_svg(
-        &path,
-        MachineProfile::default(),
-        settings,
-        &ImportOptions::default(),
-    )
-    .unwrap();
+    let mut doc = load_auto("demo.svg");
     let token = galvoplan::job::CancelToken::new();
     let sink = std::sync::Arc::new(CancelOnSecondOrdering {
         token: token.clone(),
@@ -278,18 +279,7 @@ fn a_cancel_under_auto_keeps_the_motion_planned_so_far() {
 
 #[test]
 fn a_cut_is_the_placements_choice_and_a_step_placement_starts_again_from_whole_geometries() {
-    let path = common::root().join("assets/examples/oversize.svg");
-    let settings = SolverSettings {
-        motion: galvoplan::document::MotionMode::Auto,
-        ..SolverSettings::default()
-    };
-    let (mut doc, _) = load_svg(
-        &path,
-        MachineProfile::default(),
-        settings,
-        &ImportOptions::default(),
-    )
-    .unwrap();
+    let mut doc = load_auto("oversize.svg");
     let whole = doc.geometries.len();
     let ctx = JobCtx::default();
     let choices = |doc: &galvoplan::document::Document| {
