@@ -420,6 +420,21 @@ fn whole_or_cut(
     inputs.settings.motion = MotionMode::OnTheFly;
     let whole = order_plan(&judge.geometries, &whole_region.fields, &inputs, ctx)
         .map_err(as_order_error)?;
+    if judge.settings.stage_route != crate::document::StageRouteKind::Taut {
+        // seed 001's routes are made for the whole pattern (cut, lissajous on lsa took 75.6 s
+        // against 11.3 s whole)
+        doc.fields = whole_region.fields;
+        doc.warnings
+            .retain(|w| !w.message.starts_with(CHOICE_PREFIX));
+        doc.warnings.push(choice_warning(format!(
+            "{CHOICE_PREFIX}marked whole on the fly: the lsa and cetsp-ga stage routes follow the whole pattern"
+        )));
+        let mut made = whole;
+        made.0.geometry_rev = doc.geometry_rev;
+        made.0.settings.motion = doc.settings.motion;
+        made.0.name = doc.settings.plan_title_as(made.0.motion);
+        return Ok((whole_region.lower_bound, reusable.then_some(made)));
+    }
     // cut: fields on the pieces, every motion allowed
     let mut pieces = judge.geometries.clone();
     let cuts = split_oversize(&mut pieces, judge.profile.field_mm);

@@ -190,9 +190,8 @@ pub fn lower_on_the_fly(
     let tube_mm = reach_mm * (1.0 - TUBE_SLACK);
     let mut pieces = tool_pieces(geometries, plan, profile, tube_mm, &mut path)?;
     let follow = plan.stage_route.as_ref();
-    // seed 001's routes are followed on the taut route, as the paper's benchmark: a hard band
-    // around their polylines' corners makes the tracked stage crawl (lissajous, lsa: 75.6 s
-    // tracked against 11.3 s taut)
+    // seed 001's routes are followed on the taut route, as measured for the paper's benchmark
+    // (docs/BENCHMARKS.md); tracking inside their ±1 mm band is not measured
     if follow.is_none() {
         let tracked =
             tracking::lower_tracked(pieces.clone(), &mut path, profile, reach_mm, clock_s, ctx)?;
