@@ -143,7 +143,7 @@ pub fn check_reach(geometries: &[Geometry], profile: &MachineProfile) -> Result<
             let b = g.bbox();
             b.width() > fw + super::INSIDE_EPS_MM || b.height() > fh + super::INSIDE_EPS_MM
         })
-        .map(|(i, g)| format!("geometry {i} {}", g.describe()))
+        .map(|(i, g)| format!("geometry {} {}", i + 1, g.describe()))
         .collect();
     if !oversize.is_empty() {
         return Err(FieldError::Oversize {
@@ -158,7 +158,7 @@ pub fn check_reach(geometries: &[Geometry], profile: &MachineProfile) -> Result<
             let (x, y) = center_range(&g.bbox(), profile);
             x.lo > x.hi + super::INSIDE_EPS_MM || y.lo > y.hi + super::INSIDE_EPS_MM
         })
-        .map(|(i, g)| format!("geometry {i} {}", g.describe()))
+        .map(|(i, g)| format!("geometry {} {}", i + 1, g.describe()))
         .collect();
     if !out.is_empty() {
         return Err(FieldError::OutOfReach {

@@ -126,7 +126,8 @@ pub fn split_oversize(geometries: &mut Vec<Geometry>, field_mm: [f64; 2]) -> Vec
                 element: g.source.element.clone(),
                 line: None,
                 message: format!(
-                    "geometry {i} ({:.2} × {:.2} mm) {SPLIT_WORDS} {} strokes at field borders",
+                    "geometry {} ({:.2} × {:.2} mm) {SPLIT_WORDS} {} strokes at field borders",
+                    i + 1,
                     g.bbox().width(),
                     g.bbox().height(),
                     pieces.len()

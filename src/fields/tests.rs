@@ -59,7 +59,7 @@ fn oversize_and_out_of_reach_are_listed() {
     let msg = e.to_string();
     assert!(msg.starts_with("2 geometries are larger"), "{msg}");
     assert!(
-        msg.contains("geometry 0") && msg.contains("geometry 2") && msg.contains("80.00 × 10.00"),
+        msg.contains("geometry 1 ") && msg.contains("geometry 3 ") && msg.contains("80.00 × 10.00"),
         "{msg}"
     );
     let gs = vec![rect(340.0, 10.0, 5.0, 5.0)];
@@ -83,7 +83,7 @@ fn lists_stop_at_five_and_huge_artwork_asks_for_a_unit_check() {
     let msg = place(&gs, &p).unwrap_err().to_string();
     assert!(msg.starts_with("12 geometries are larger"), "{msg}");
     assert!(
-        msg.contains("geometry 4 ") && !msg.contains("geometry 5 "),
+        msg.contains("geometry 5 ") && !msg.contains("geometry 6 "),
         "{msg}"
     );
     assert!(msg.ends_with("; … and 7 more"), "{msg}");
