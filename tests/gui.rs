@@ -524,7 +524,7 @@ fn oversize_geometries_are_shown_uncovered_until_split() {
     // the split pieces are reported as warnings in the panel
     let w = h.state().session.doc.warnings.len();
     assert!(w > 0);
-    h.get_by_label(&format!("Import warnings ({w})"));
+    h.get_by_label(&format!("Warnings ({w})"));
     // undo restores the unsplit geometries
     h.get_by_label("Undo").click();
     h.run();
@@ -573,7 +573,7 @@ fn import_warnings_are_listed() {
     .unwrap();
     let h = opened(&svg);
     assert_eq!(h.state().session.doc.warnings.len(), 1);
-    h.get_by_label("Import warnings (1)");
+    h.get_by_label("Warnings (1)");
     h.get_by_label_contains("photo");
 }
 

@@ -522,11 +522,12 @@ impl App {
         ui.separator();
         let n = self.session.doc.warnings.len();
         let title = if n > 0 {
-            RichText::new(format!("Import warnings ({n})"))
+            // import, cut and whole-or-cut warnings alike: what the drawing and the placement say
+            RichText::new(format!("Warnings ({n})"))
                 .strong()
                 .color(Color32::from_rgb(180, 83, 9))
         } else {
-            RichText::new("Import warnings (0)")
+            RichText::new("Warnings (0)")
         };
         // a new id per import: the list opens on each import that has warnings
         egui::CollapsingHeader::new(title)
