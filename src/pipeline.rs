@@ -409,77 +409,69 @@ fn whole_or_cut(
         source,
     };
     // the choice is made on HHA plans when the solve is HGA (its GA runs once, afterwards)
-    let mut judge = doc.clone();
+    let mut judge = PlanInputs::of(doc);
     if judge.settings.algo == crate::document::Algo::Hga {
         judge.settings.algo = crate::document::Algo::Hha;
     }
     let reusable = judge.settings.algo == doc.settings.algo;
     // whole: one region, on the fly only
-    let whole_region = whole_work_region(&judge.geometries);
-    let mut inputs = PlanInputs::of(&judge);
-    inputs.settings.motion = MotionMode::OnTheFly;
-    let whole = order_plan(&judge.geometries, &whole_region.fields, &inputs, ctx)
+    let whole_region = whole_work_region(&doc.geometries);
+    let mut on_the_fly = judge.clone();
+    on_the_fly.settings.motion = MotionMode::OnTheFly;
+    let whole = order_plan(&doc.geometries, &whole_region.fields, &on_the_fly, ctx)
         .map_err(as_order_error)?;
-    if judge.settings.stage_route != crate::document::StageRouteKind::Taut {
+    let (mut made, lower_bound, note) = if judge.settings.stage_route != StageRouteKind::Taut {
         // seed 001's routes are made for the whole pattern (cut, lissajous on lsa took 75.6 s
-        // against 11.3 s whole)
+        // against 11.09 s whole)
         doc.fields = whole_region.fields;
-        doc.warnings
-            .retain(|w| !w.message.starts_with(CHOICE_PREFIX));
-        doc.warnings.push(choice_warning(format!(
-            "{CHOICE_PREFIX}marked whole on the fly: the lsa and cetsp-ga stage routes follow the whole pattern"
-        )));
-        let mut made = whole;
-        made.0.geometry_rev = doc.geometry_rev;
-        made.0.settings.motion = doc.settings.motion;
-        made.0.name = doc.settings.plan_title_as(made.0.motion);
-        return Ok((whole_region.lower_bound, reusable.then_some(made)));
-    }
-    // cut: fields on the pieces, every motion allowed
-    let mut pieces = judge.geometries.clone();
-    let cuts = split_oversize(&mut pieces, judge.profile.field_mm);
-    let cut_placement = place_fields(&pieces, &judge.profile, &judge.settings, locked, ctx)
-        .map_err(|source| PipelineError::Fields {
-            file: file.clone(),
-            source,
-        })?;
-    let cut = order_plan(&pieces, &cut_placement.fields, &PlanInputs::of(&judge), ctx)
-        .map_err(as_order_error)?;
-    let (whole_s, cut_s) = (whole.1.duration_s(), cut.1.duration_s());
-    // the chosen plan's order stage: both candidates' orderings
-    let order_s = whole.0.metrics.solve_s.order + cut.0.metrics.solve_s.order;
-    let mut detail = vec![
-        ("whole".to_string(), whole.0.metrics.solve_s.order),
-        ("cut".to_string(), cut.0.metrics.solve_s.order),
-    ];
+        let note =
+            "marked whole on the fly: the lsa and cetsp-ga stage routes follow the whole pattern"
+                .to_string();
+        (whole, whole_region.lower_bound, note)
+    } else {
+        // cut: fields on the pieces, every motion allowed
+        let mut pieces = doc.geometries.clone();
+        let cuts = split_oversize(&mut pieces, doc.profile.field_mm);
+        let cut_placement = place_fields(&pieces, &doc.profile, &judge.settings, locked, ctx)
+            .map_err(|source| PipelineError::Fields {
+                file: file.clone(),
+                source,
+            })?;
+        let cut =
+            order_plan(&pieces, &cut_placement.fields, &judge, ctx).map_err(as_order_error)?;
+        let (whole_s, cut_s) = (format_s(whole.1.duration_s()), format_s(cut.1.duration_s()));
+        // the chosen plan's order stage: both candidates' orderings
+        let order_s = whole.0.metrics.solve_s.order + cut.0.metrics.solve_s.order;
+        let detail = vec![
+            ("whole".to_string(), whole.0.metrics.solve_s.order),
+            ("cut".to_string(), cut.0.metrics.solve_s.order),
+        ];
+        let (mut made, lower_bound, note) = if cut.1.duration_s() < whole.1.duration_s() {
+            cut_geometries(doc, pieces, cuts);
+            doc.fields = cut_placement.fields;
+            let note = format!("cut at field borders: the job takes {cut_s} s cut against {whole_s} s marked whole on the fly");
+            (cut, cut_placement.lower_bound, note)
+        } else {
+            doc.fields = whole_region.fields;
+            let note = format!("marked whole on the fly: the job takes {whole_s} s against {cut_s} s cut at field borders");
+            (whole, whole_region.lower_bound, note)
+        };
+        let solve = &mut made.0.metrics.solve_s;
+        solve.order_detail = detail
+            .into_iter()
+            .chain(solve.order_detail.drain(..))
+            .collect();
+        solve.order = order_s;
+        (made, lower_bound, note)
+    };
     // this choice replaces the last one's words
     doc.warnings
         .retain(|w| !w.message.starts_with(CHOICE_PREFIX));
-    let (mut made, lower_bound) = if cut_s < whole_s {
-        cut_geometries(doc, pieces, cuts);
-        doc.fields = cut_placement.fields;
-        doc.warnings.push(choice_warning(format!(
-            "{CHOICE_PREFIX}cut at field borders: the job takes {} s cut against {} s marked whole on the fly",
-            format_s(cut_s),
-            format_s(whole_s)
-        )));
-        (cut, cut_placement.lower_bound)
-    } else {
-        doc.fields = whole_region.fields;
-        doc.warnings.push(choice_warning(format!(
-            "{CHOICE_PREFIX}marked whole on the fly: the job takes {} s against {} s cut at field borders",
-            format_s(whole_s),
-            format_s(cut_s)
-        )));
-        (whole, whole_region.lower_bound)
-    };
+    doc.warnings
+        .push(choice_warning(format!("{CHOICE_PREFIX}{note}")));
     made.0.geometry_rev = doc.geometry_rev;
     made.0.settings.motion = doc.settings.motion;
     made.0.name = doc.settings.plan_title_as(made.0.motion);
-    let solve = &mut made.0.metrics.solve_s;
-    detail.append(&mut solve.order_detail);
-    solve.order = order_s;
-    solve.order_detail = detail;
     Ok((lower_bound, reusable.then_some(made)))
 }
 

@@ -123,11 +123,6 @@ impl TrackedAxis {
         let tau = tau.min(stop_s);
         x + v * tau - 0.5 * v.signum() * self.a_max_mm_s2 * tau * tau
     }
-
-    /// The sample times, s.
-    pub fn times_s(&self) -> &[f64] {
-        &self.t_s
-    }
 }
 
 /// The reachable sets of one axis, propagated sample by sample (see the module documentation).

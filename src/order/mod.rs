@@ -67,7 +67,8 @@ pub fn order_plan(
     let t0 = std::time::Instant::now();
     let mut detail = Vec::new();
     let mut best: Option<Made> = None;
-    let mut hga_seeds = Vec::new();
+    // HGA under auto: the motion is chosen on finished HHA plans, the GA then runs in it alone
+    let hga_after = settings.algo == Algo::Hga && motions.len() > 1;
     for &motion in motions {
         if best.is_some() && ctx.is_cancelled() {
             // a cancel keeps the plan made so far
@@ -76,11 +77,8 @@ pub fn order_plan(
         let lower = Candidates::new(geometries, fields, inputs, motion, ctx);
         let mut stages = Vec::new();
         let made = match settings.algo {
-            // HGA under auto: the motion is chosen on HHA plans, the GA then runs in it alone
-            Algo::Hga if motions.len() > 1 => hha_finished(&lower, t0, &mut stages).map(|seed| {
-                hga_seeds.push((motion, seed.clone()));
-                (seed.0, seed.1, Vec::new())
-            }),
+            Algo::Hga if hga_after => hha_finished(&lower, t0, &mut stages)
+                .map(|(ordering, toolpath)| (ordering, toolpath, Vec::new())),
             Algo::Hga => hga_plan(&lower, t0, None, &mut stages),
             Algo::AsIs | Algo::Baseline | Algo::Hha => run_algorithm(&lower, &mut stages)
                 .and_then(|ordering| finish(&lower, ordering, hha_until(settings, t0), &mut stages))
@@ -104,19 +102,16 @@ pub fn order_plan(
         });
     }
     let mut best = best.ok_or(OrderError::Unallocated(0, 0))?;
-    if let Some((motion, hha)) = hga_seeds.into_iter().find(|(m, _)| *m == best.motion) {
-        // HGA under auto: the GA runs in the motion whose HHA seed was faster
-        let lower = Candidates::new(geometries, fields, inputs, motion, ctx);
+    if hga_after && !ctx.is_cancelled() {
+        // the GA runs in the motion whose HHA plan was faster, seeded with that plan
+        let lower = Candidates::new(geometries, fields, inputs, best.motion, ctx);
         let mut stages = Vec::new();
-        let (ordering, toolpath, history) = if ctx.is_cancelled() {
-            (hha.0, hha.1, Vec::new())
-        } else {
-            let seed = settings.ga.seed_with_hha.then_some(hha);
-            hga_plan(&lower, t0, seed, &mut stages)?
-        };
-        note_stages(&mut detail, motion, true, stages);
+        let hha = (best.ordering, best.toolpath);
+        let seed = settings.ga.seed_with_hha.then_some(hha);
+        let (ordering, toolpath, history) = hga_plan(&lower, t0, seed, &mut stages)?;
+        note_stages(&mut detail, best.motion, true, stages);
         best = Made {
-            motion,
+            motion: best.motion,
             ordering,
             toolpath,
             history,
