@@ -2,6 +2,7 @@
 
 mod bench;
 mod hatch_bench;
+mod linuxcnc;
 mod plan;
 mod progress;
 mod tsp;
@@ -37,6 +38,8 @@ enum Command {
     /// Order plain point sets (TSPLIB or SVG) with the ordering engine, for comparison with
     /// LKH or Concorde; or write the random point sets the benchmarks use.
     Tsp(tsp::TspArgs),
+    /// Write a LinuxCNC machine configuration (INI, HAL, a headless runner) for a profile.
+    LinuxcncConfig(linuxcnc::LinuxcncConfigArgs),
 }
 
 /// Field placement, as on the command line.
@@ -108,7 +111,7 @@ enum VertexArg {
 /// Options shared by `plan` and `bench`.
 #[derive(Args, Debug, Clone)]
 struct JobOpts {
-    /// Machine profile: a TOML file or a built-in name (seed000, small-field).
+    /// Machine profile: a TOML file or a built-in name (seed000, small-field, linuxcnc).
     #[arg(long, default_value = "seed000")]
     profile: String,
     /// Scan-field placement.
@@ -239,6 +242,7 @@ impl PlanArgs {
             ("rerun recording", &self.rerun),
             ("geometry SVG", &self.export_geometry),
             ("trajectory", &self.trajectory),
+            ("waypoints", &self.waypoints),
         ];
         v.extend(
             optional
@@ -400,6 +404,11 @@ struct PlanArgs {
         requires = "trajectory"
     )]
     trajectory_period_ms: f64,
+    /// Write the toolpath's exact states at every segment end and mark vertex (on the fly: and
+    /// every millisecond of planned time, the on-the-fly program's samples) as CSV, in the
+    /// trajectory's columns: what a controller's canonical moves are checked against.
+    #[arg(long, value_name = "OUT.csv")]
+    waypoints: Option<PathBuf>,
     #[command(flatten)]
     job: JobOpts,
 }
@@ -430,6 +439,7 @@ pub fn main() -> std::process::ExitCode {
         Some(Command::Bench(a)) => bench::run(&a),
         Some(Command::HatchBench(a)) => hatch_bench::run(&a),
         Some(Command::Tsp(a)) => tsp::run(&a),
+        Some(Command::LinuxcncConfig(a)) => linuxcnc::run(&a),
         None => open_gui(cli.file),
     };
     match result {

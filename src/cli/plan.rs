@@ -6,7 +6,7 @@ use anyhow::{Context, Result};
 use galvoplan::document::write_atomic;
 use galvoplan::export::{
     check_outputs, geometry_svg, preview_svg, report_json, trajectory_csv, trajectory_period_s,
-    write_gcode,
+    waypoints_csv, write_gcode,
 };
 use galvoplan::import::Place;
 use galvoplan::job::Progress;
@@ -100,6 +100,7 @@ pub fn run(a: &PlanArgs) -> Result<()> {
         plan.metrics.motion = Some(toolpath.motion_figures(p));
         trajectory_csv(&toolpath, p)
     });
+    let waypoints = a.waypoints.as_ref().map(|_| waypoints_csv(&toolpath));
     let gcode = write_gcode(&toolpath, &plan, doc.page_mm[1], &source)
         .with_context(|| format!("{}: cannot write G-code", a.output.display()))?;
     let preview = a
@@ -131,6 +132,9 @@ pub fn run(a: &PlanArgs) -> Result<()> {
         write(p, s)?;
     }
     if let (Some(p), Some(s)) = (&a.trajectory, &trajectory) {
+        write(p, s)?;
+    }
+    if let (Some(p), Some(s)) = (&a.waypoints, &waypoints) {
         write(p, s)?;
     }
     let m = &plan.metrics;

@@ -27,8 +27,8 @@ pub use plan::{
     TimeBreakdown,
 };
 pub use profile::{
-    AxisLimits, GcodeDialect, GcodeMode, LaserTiming, MachineProfile, ProfileError, ScannerSpeeds,
-    BUILTIN, PROFILE_VERSION,
+    AxisLimits, Controller, ControllerKind, GcodeDialect, GcodeMode, LaserTiming, MachineProfile,
+    ProfileError, ScannerSpeeds, BUILTIN, PROFILE_VERSION,
 };
 pub use project::{
     load_project, parse_project, save_project, write_atomic, ProjectError, PROJECT_VERSION,

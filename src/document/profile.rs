@@ -11,7 +11,10 @@ use thiserror::Error;
 ///   `max_accel_mm_s2`, and a `settle_s` after each move; `[gcode] mode` (`tcp` or
 ///   `stage-scanner`) and `scanner_axes`; `otf_margin_mm` for on-the-fly marking. Every
 ///   version-1 file is a valid version-2 file.
-pub const PROFILE_VERSION: u32 = 2;
+/// * 3: `[gcode] mode = "linuxcnc"` with `laser_output`, `power_output`, `path_tol_mm`; a
+///   `[controller]` table (the controller's time law). Every version-2 file is a valid
+///   version-3 file.
+pub const PROFILE_VERSION: u32 = 3;
 
 /// Limits of one base-stage axis (seed 002, Table 2 style).
 ///
@@ -129,6 +132,10 @@ pub enum GcodeMode {
     /// The stage on X/Y once per field; scanner jumps and marks in field-local coordinates on
     /// the two [`GcodeDialect::scanner_axes`] words.
     StageScanner,
+    /// LinuxCNC (docs/GCODE.md, *LinuxCNC*): stage X/Y and scanner axes as coordinated axes of
+    /// one machine, the laser gated by a digital output (`M62`/`M63 P..`), delays as dwells;
+    /// on the fly the whole job as timed X/Y/U/V segments in inverse time (`G93`).
+    Linuxcnc,
 }
 
 /// G-code dialect options. The defaults produce the contract in DESIGN.md.
@@ -152,8 +159,17 @@ pub struct GcodeDialect {
     pub flip_y: bool,
     /// Tool-centre path or stage + scanner axes.
     pub mode: GcodeMode,
-    /// Axis words of the scanner in `stage-scanner` mode (x, y).
+    /// Axis words of the scanner in `stage-scanner` and `linuxcnc` mode (x, y).
     pub scanner_axes: [String; 2],
+    /// LinuxCNC: the digital output that gates the laser (`M62`/`M63 P<n>`).
+    pub laser_output: u32,
+    /// LinuxCNC: the analog output that carries the power (`M67 E<n> Q<power>`, synchronised
+    /// with the next move); none: the power word, as in the other dialects.
+    pub power_output: Option<u32>,
+    /// LinuxCNC: how far the controller's path may leave the toolpath, mm: the blending
+    /// tolerance (`G64 P..`) and, on the fly, the tolerance within which samples are merged
+    /// into one segment.
+    pub path_tol_mm: f64,
 }
 
 impl Default for GcodeDialect {
@@ -168,6 +184,45 @@ impl Default for GcodeDialect {
             flip_y: false,
             mode: GcodeMode::Tcp,
             scanner_axes: ["U".into(), "V".into()],
+            laser_output: 0,
+            power_output: None,
+            path_tol_mm: 0.005,
+        }
+    }
+}
+
+/// Which controller runs the job, and so how galvoplan times it.
+#[derive(Debug, Clone, Copy, Serialize, Deserialize, PartialEq, Eq, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum ControllerKind {
+    /// A scan-head controller (seed 002's model): the scanner marks at constant speed through
+    /// corners, jumps at jump speed, delays as given.
+    #[default]
+    Ideal,
+    /// LinuxCNC's trajectory planner (motion/controller.rs): every move accelerates and
+    /// brakes at the axes' limits, blends corners within the path tolerance, and takes whole
+    /// servo periods.
+    Linuxcnc,
+}
+
+/// The controller and its time law.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(default, deny_unknown_fields)]
+pub struct Controller {
+    /// Which controller.
+    pub kind: ControllerKind,
+    /// Servo period (the controller's clock), s.
+    pub servo_period_s: f64,
+    /// Scanner axes' acceleration as the controller drives them, mm/s².
+    pub scanner_accel_mm_s2: f64,
+}
+
+impl Default for Controller {
+    fn default() -> Self {
+        Self {
+            kind: ControllerKind::Ideal,
+            servo_period_s: 1e-3,
+            scanner_accel_mm_s2: 1e6,
         }
     }
 }
@@ -194,6 +249,8 @@ pub struct MachineProfile {
     pub laser: LaserTiming,
     /// G-code output options.
     pub gcode: GcodeDialect,
+    /// The controller that runs the job and its time law.
+    pub controller: Controller,
     /// On-the-fly marking: following-error headroom kept inside the field, mm (the scanner
     /// offset stays within half the field less this).
     pub otf_margin_mm: f64,
@@ -211,6 +268,7 @@ impl Default for MachineProfile {
             scanner: ScannerSpeeds::default(),
             laser: LaserTiming::default(),
             gcode: GcodeDialect::default(),
+            controller: Controller::default(),
             otf_margin_mm: 0.0,
         }
     }
@@ -258,6 +316,10 @@ pub const BUILTIN: &[(&str, &str)] = &[
         "small-field",
         include_str!("../../assets/profiles/small-field.toml"),
     ),
+    (
+        "linuxcnc",
+        include_str!("../../assets/profiles/linuxcnc.toml"),
+    ),
 ];
 
 /// Brings a profile table of an earlier format version to [`PROFILE_VERSION`], one step per
@@ -267,10 +329,10 @@ fn upgrade(table: &mut toml::Table) {
     let Some(version) = table.get("version").and_then(toml::Value::as_integer) else {
         return;
     };
-    if version == 1 {
-        // 1 → 2 only added fields, each with a default that keeps version-1 behaviour
-        // (acceleration as given, no settling, tool-centre G-code)
-        table.insert("version".into(), toml::Value::Integer(2));
+    if version == 1 || version == 2 {
+        // 1 → 2 and 2 → 3 only added fields, each with a default that keeps the earlier
+        // behaviour (acceleration as given, no settling, tool-centre G-code, ideal controller)
+        table.insert("version".into(), toml::Value::Integer(3));
     }
 }
 
@@ -334,7 +396,7 @@ impl MachineProfile {
             ));
         }
         let [u, v] = &self.gcode.scanner_axes;
-        if self.gcode.mode == GcodeMode::StageScanner
+        if self.gcode.mode != GcodeMode::Tcp
             && (u == v || [u, v].iter().any(|w| ["X", "Y"].contains(&w.trim())))
         {
             return Err(InvalidValue::new(

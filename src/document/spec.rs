@@ -485,8 +485,79 @@ pub fn profile_specs() -> Vec<FieldSpec<MachineProfile>> {
             Rule::Text,
             |p| p.gcode.scanner_axes[1]
         ),
+        whole!(
+            "Laser output",
+            "gcode.laser_output",
+            "LinuxCNC digital output that gates the laser (M62/M63 P)",
+            0,
+            MAX_LINUXCNC_IO,
+            u32,
+            |p| p.gcode.laser_output
+        ),
+        FieldSpec {
+            label: "Power output",
+            unit: "",
+            key: "gcode.power_output",
+            help: "LinuxCNC analog output for the power (M67 E); empty: the power word",
+            rule: Rule::Whole(0, MAX_LINUXCNC_IO as u64),
+            optional: true,
+            shapes_plan: false,
+            show: |p| {
+                p.gcode
+                    .power_output
+                    .map(|e| e.to_string())
+                    .unwrap_or_default()
+            },
+            number: |p| p.gcode.power_output.map(f64::from),
+            parse: |p, s| {
+                p.gcode.power_output = if s.trim().is_empty() {
+                    None
+                } else {
+                    let v = parse_whole(s)?;
+                    Some(u32::try_from(v).map_err(|_| format!("must be smaller, not {v}"))?)
+                };
+                Ok(())
+            },
+        },
+        number!(
+            "Path tolerance",
+            "mm",
+            "gcode.path_tol_mm",
+            "LinuxCNC blending (G64 P) and on-the-fly sample merging",
+            Positive,
+            |p| p.gcode.path_tol_mm
+        ),
+    ]
+    .into_iter()
+    .chain(controller_specs())
+    .collect()
+}
+
+/// The controller's values (a profile's `[controller]` table).
+fn controller_specs() -> Vec<FieldSpec<MachineProfile>> {
+    use Rule::{Positive, Range};
+    vec![
+        number!(
+            "Servo period",
+            "s",
+            "controller.servo_period_s",
+            "the controller's clock",
+            Range(1e-5, 0.01),
+            |p| p.controller.servo_period_s
+        ),
+        number!(
+            "Scanner accel",
+            "mm/s²",
+            "controller.scanner_accel_mm_s2",
+            "as the controller drives the scanner axes",
+            Positive,
+            |p| p.controller.scanner_accel_mm_s2
+        ),
     ]
 }
+
+/// The highest digital or analog output number a LinuxCNC program may name (motmod allows 64).
+pub const MAX_LINUXCNC_IO: u32 = 63;
 
 /// The solver settings' values: the typed ones (the settings editor's rows), then the ones
 /// chosen from lists.

@@ -24,6 +24,12 @@ pub enum GcodeError {
         /// Stroke index in marking order.
         stroke: usize,
     },
+    /// A segment the dialect has no words for (lowering never makes one).
+    #[error("the LinuxCNC program cannot express a {kind:?} segment of this kind of motion")]
+    Unwritable {
+        /// The segment's kind.
+        kind: crate::motion::SegmentKind,
+    },
     /// A stroke names a layer the plan does not have (lowering never does).
     #[error("stroke {stroke} of the toolpath names layer {layer}, which the plan does not have")]
     NoLayer {
@@ -34,15 +40,16 @@ pub enum GcodeError {
     },
 }
 
-/// The laser-on line, feed and layer comment of one pen.
-struct PenWords {
-    on: String,
-    feed: String,
-    comment: Option<String>,
+/// The laser-on line, power, feed and layer comment of one pen.
+pub(super) struct PenWords {
+    pub(super) on: String,
+    pub(super) power: Option<f64>,
+    pub(super) feed: String,
+    pub(super) comment: Option<String>,
 }
 
 impl PenWords {
-    fn of(w: &Words<'_>, layer: Option<&Layer>) -> Self {
+    pub(super) fn of(w: &Words<'_>, layer: Option<&Layer>) -> Self {
         let profile = w.profile;
         let d = &profile.gcode;
         let pen = layer.map(|l| &l.pen);
@@ -66,6 +73,7 @@ impl PenWords {
         });
         Self {
             on,
+            power,
             feed: w.num(feed),
             comment,
         }
@@ -73,18 +81,18 @@ impl PenWords {
 }
 
 /// Number formatting and the Y mirror of a dialect.
-struct Words<'a> {
-    profile: &'a MachineProfile,
-    page_height_mm: f64,
+pub(super) struct Words<'a> {
+    pub(super) profile: &'a MachineProfile,
+    pub(super) page_height_mm: f64,
 }
 
 impl Words<'_> {
     /// A number with the dialect's decimals, trailing zeros trimmed, no negative zero.
-    fn num(&self, v: f64) -> String {
+    pub(super) fn num(&self, v: f64) -> String {
         crate::geom::format_mm(v, self.profile.gcode.decimals)
     }
     /// A machine position (mirrored about the page height when the dialect flips Y).
-    fn position(&self, p: Pt) -> Pt {
+    pub(super) fn position(&self, p: Pt) -> Pt {
         if self.profile.gcode.flip_y {
             Pt::new(p.x, self.page_height_mm - p.y)
         } else {
@@ -92,7 +100,7 @@ impl Words<'_> {
         }
     }
     /// A scanner offset (mirrored with the positions).
-    fn offset(&self, o: Pt) -> Pt {
+    pub(super) fn offset(&self, o: Pt) -> Pt {
         if self.profile.gcode.flip_y {
             Pt::new(o.x, -o.y)
         } else {
@@ -100,7 +108,7 @@ impl Words<'_> {
         }
     }
     /// `X.. Y..`, or the scanner words for an offset in stage-scanner mode.
-    fn xy(&self, axes: [&str; 2], p: Pt) -> String {
+    pub(super) fn xy(&self, axes: [&str; 2], p: Pt) -> String {
         format!("{}{} {}{}", axes[0], self.num(p.x), axes[1], self.num(p.y))
     }
 }
@@ -135,8 +143,13 @@ pub fn write_gcode(
         return Err(GcodeError::StageScannerOnTheFly);
     }
     let scan_axes = [d.scanner_axes[0].as_str(), d.scanner_axes[1].as_str()];
+    if d.mode == GcodeMode::Linuxcnc {
+        let mut head = String::new();
+        header(&mut head, toolpath, plan, title, true);
+        return super::linuxcnc::write_program(toolpath, plan, &w, &head);
+    }
     let mut out = String::with_capacity(toolpath.strokes.len() * 64);
-    header(&mut out, toolpath, plan, title);
+    header(&mut out, toolpath, plan, title, false);
     let _ = writeln!(out, "{}", d.laser_off);
     let number: std::collections::HashMap<usize, usize> = plan
         .fields
@@ -197,26 +210,34 @@ pub fn write_gcode(
     Ok(out)
 }
 
-fn header(out: &mut String, toolpath: &Toolpath, plan: &Plan, title: &str) {
+/// The comment lines at the top: `; ..` lines, or `(..)` for LinuxCNC (`parens`).
+fn header(out: &mut String, toolpath: &Toolpath, plan: &Plan, title: &str, parens: bool) {
     let m = &plan.metrics;
-    let _ = writeln!(
-        out,
-        "; galvoplan {} — {}",
+    let mut lines = vec![format!(
+        "galvoplan {} — {}",
         env!("CARGO_PKG_VERSION"),
         title.replace('\n', " ")
-    );
+    )];
     if !plan.name.is_empty() {
-        let _ = writeln!(out, "; plan {}", plan.name.replace('\n', " "));
+        lines.push(format!("plan {}", plan.name.replace('\n', " ")));
     }
-    let _ = writeln!(
-        out,
-        "; {} strokes in {} fields, marked {:.3} mm, idle {:.3} mm, base {:.3} mm, job time {:.3} s",
+    lines.push(format!(
+        "{} strokes in {} fields, marked {:.3} mm, idle {:.3} mm, base {:.3} mm, job time {:.3} s",
         toolpath.strokes.len(),
         plan.fields.len(),
         m.marked_mm,
         m.idle_mm,
         m.base_mm,
         toolpath.duration_s()
-    );
-    out.push_str("G21\nG90\n");
+    ));
+    for l in lines {
+        if parens {
+            let _ = writeln!(out, "({})", l.replace(['(', ')'], ""));
+        } else {
+            let _ = writeln!(out, "; {l}");
+        }
+    }
+    if !parens {
+        out.push_str("G21\nG90\n");
+    }
 }

@@ -3,14 +3,18 @@
 
 mod gcode;
 mod guard;
+mod linuxcnc;
+mod linuxcnc_config;
 mod report;
 mod svg_preview;
 mod trajectory;
 
 pub use gcode::{write_gcode, GcodeError};
 pub use guard::{check_outputs, OutputClash};
+pub use linuxcnc_config::{linuxcnc_config, ConfigFile, LIMIT_MARGIN_MM};
 pub use report::{report_json, Report};
 pub use svg_preview::{geometry_svg, preview_svg};
 pub use trajectory::{
-    trajectory_csv, trajectory_period_s, PeriodError, MAX_PERIOD_S, MIN_PERIOD_S, TRAJECTORY_HEADER,
+    trajectory_csv, trajectory_period_s, waypoints_csv, PeriodError, MAX_PERIOD_S, MIN_PERIOD_S,
+    TRAJECTORY_HEADER,
 };

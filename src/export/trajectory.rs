@@ -59,3 +59,28 @@ pub fn trajectory_csv(toolpath: &Toolpath, period_s: f64) -> String {
     }
     out
 }
+
+/// The toolpath's exact states, one CSV row each (the trajectory's columns): the start, every
+/// segment's end, every mark vertex, and on the fly the on-the-fly program's samples
+/// ([`crate::motion::controller::otf_sample_states`]). Positions are the toolpath's own, so a
+/// controller's canonical moves can be checked against them; they are not flipped as the
+/// G-code's Y may be.
+pub fn waypoints_csv(toolpath: &Toolpath) -> String {
+    let states = crate::motion::controller::waypoint_states(toolpath);
+    let mut out = String::with_capacity(states.len() * 64 + 64);
+    out.push_str(TRAJECTORY_HEADER);
+    out.push('\n');
+    for (t_s, m) in states {
+        let _ = writeln!(
+            out,
+            "{:.9},{:.7},{:.7},{:.7},{:.7},{}",
+            t_s,
+            m.stage.x,
+            m.stage.y,
+            m.scan.x,
+            m.scan.y,
+            u8::from(m.laser)
+        );
+    }
+    out
+}

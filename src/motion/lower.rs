@@ -1,6 +1,7 @@
 //! [`lower`]: the one place where a plan becomes machine motion.
 
 use super::axis::StageDynamics;
+use super::controller::LinuxcncClock;
 use super::toolpath::{ScanMotion, Segment, SegmentKind, StageMotion, Toolpath};
 use crate::document::{Geometry, MachineProfile, Plan};
 use crate::geom::Pt;
@@ -126,6 +127,11 @@ struct Builder<'a> {
     t_s: f64,
     stage_at: Pt,
     scan_at: Pt,
+    /// The controller's clock (LinuxCNC), which times moves and dwells; none: the scan head's
+    /// own timing.
+    clock: Option<LinuxcncClock>,
+    /// The last segment was a pause: a pause next to it is the same dwell on the controller.
+    pausing: bool,
 }
 
 impl<'a> Builder<'a> {
@@ -137,10 +143,13 @@ impl<'a> Builder<'a> {
             t_s: 0.0,
             stage_at: Pt::default(),
             scan_at: Pt::default(),
+            clock: LinuxcncClock::of(profile),
+            pausing: false,
         }
     }
 
     fn push(&mut self, kind: SegmentKind, duration_s: f64, stage: StageMotion, scan: ScanMotion) {
+        self.pausing = matches!(stage, StageMotion::Hold(_)) && matches!(scan, ScanMotion::Hold(_));
         self.path.segments.push(Segment {
             kind,
             start_s: self.t_s,
@@ -151,8 +160,13 @@ impl<'a> Builder<'a> {
         self.t_s += duration_s;
     }
 
-    /// A pause with stage and scanner at rest (skipped when zero).
+    /// A pause with stage and scanner at rest (skipped when zero); on a controller clock, pauses
+    /// next to each other are one dwell.
     fn hold(&mut self, kind: SegmentKind, duration_s: f64) {
+        let duration_s = match &self.clock {
+            Some(c) if !self.pausing => c.dwell_s(duration_s),
+            _ => duration_s,
+        };
         if duration_s > 0.0 {
             let (stage, scan) = (self.stage_at, self.scan_at);
             self.push(
@@ -166,7 +180,11 @@ impl<'a> Builder<'a> {
 
     /// A scanner jump to `offset` and its delay, the stage at rest.
     fn jump(&mut self, offset: Pt) {
-        let move_s = offset.dist(self.scan_at) / self.profile.scanner.jump_speed_mm_s;
+        let d = offset.minus(self.scan_at);
+        let move_s = match &self.clock {
+            Some(c) => c.move_s([0.0, 0.0, d.x, d.y], None),
+            None => d.norm() / self.profile.scanner.jump_speed_mm_s,
+        };
         if move_s > 0.0 {
             let from = self.scan_at;
             let stage = StageMotion::Hold(self.stage_at);
@@ -194,8 +212,18 @@ impl<'a> Builder<'a> {
         }
         let mv = self.stage.plan_move(self.stage_at, center);
         let jump_s = offset.dist(self.scan_at) / self.profile.scanner.jump_speed_mm_s;
-        let hidden =
-            jump_s <= mv.move_s && jump_s + self.profile.laser.jump_delay_s <= mv.total_s();
+        // on a controller clock the jump is part of the stage's move (one coordinated G0),
+        // which comes to rest on both
+        let hidden = self.clock.is_some()
+            || (jump_s <= mv.move_s && jump_s + self.profile.laser.jump_delay_s <= mv.total_s());
+        let move_s = match &self.clock {
+            Some(c) => {
+                let (d, j) = (center.minus(self.stage_at), offset.minus(self.scan_at));
+                // never shorter than the axes' own trapezoids (the stage's position is timed by them)
+                c.move_s([d.x, d.y, j.x, j.y], None).max(mv.move_s)
+            }
+            None => mv.move_s,
+        };
         let scan = if hidden {
             ScanMotion::Line {
                 from: self.scan_at,
@@ -205,12 +233,7 @@ impl<'a> Builder<'a> {
         } else {
             ScanMotion::Hold(self.scan_at)
         };
-        self.push(
-            SegmentKind::StageMove,
-            mv.move_s,
-            StageMotion::Move(mv),
-            scan,
-        );
+        self.push(SegmentKind::StageMove, move_s, StageMotion::Move(mv), scan);
         self.stage_at = center;
         if hidden {
             self.scan_at = offset;
@@ -228,7 +251,10 @@ impl<'a> Builder<'a> {
         let (on_s, off_s) = (laser.on_delay_s, laser.off_delay_s);
         self.hold(SegmentKind::LaserOnDelay, on_s);
         let length_mm = self.path.strokes[stroke].length_mm;
-        let duration_s = length_mm / speed_mm_s;
+        let duration_s = match &self.clock {
+            Some(c) => c.polyline_s(self.path.stroke_points(stroke), speed_mm_s),
+            None => length_mm / speed_mm_s,
+        };
         let stage = StageMotion::Hold(self.stage_at);
         self.push(
             SegmentKind::Mark,

@@ -19,6 +19,7 @@ mod axis;
 mod blend;
 pub mod cetsp;
 mod clock;
+pub mod controller;
 mod lower;
 mod otf;
 mod route;
@@ -70,7 +71,23 @@ pub fn lower_motion(
                 None => path,
             }
         }
-        Motion::OnTheFly => lower_on_the_fly(geometries, plan, profile, clock_s, ctx)?,
+        Motion::OnTheFly => {
+            let path = lower_on_the_fly(geometries, plan, profile, clock_s, ctx)?;
+            match controller::LinuxcncClock::of(profile) {
+                // the controller's planner cannot keep the planned pace: the job at its pace
+                Some(clock) => {
+                    let (start, lines) = controller::otf_lines(&path, profile.gcode.path_tol_mm);
+                    let controller_s = clock.otf_program_s(&start, &lines);
+                    let planned_s = path.duration_s();
+                    if planned_s > 0.0 {
+                        path.stretched(controller_s / planned_s)
+                    } else {
+                        path
+                    }
+                }
+                None => path,
+            }
+        }
     };
     label_layers(&mut path, geometries, &plan.layers);
     Ok(path)

@@ -150,6 +150,9 @@ pub struct Toolpath {
     pub strokes: Vec<Stroke>,
     /// The stage's continuous route (on the fly), which [`StageMotion::Route`] segments follow.
     pub route: Option<StageRoute>,
+    /// The controller runs this on-the-fly job this many times slower than it was planned
+    /// ([`Toolpath::stretched`]); none: as planned.
+    pub stretch: Option<f64>,
     /// Tool-centre points of all strokes, concatenated.
     points: Vec<Pt>,
     /// Arc length from each stroke's first point to each point, mm (parallel to `points`).
@@ -202,6 +205,7 @@ impl Toolpath {
             segments: Vec::with_capacity(self.segments.len() + self.strokes.len()),
             strokes: self.strokes.clone(),
             route: None,
+            stretch: None,
             points: self.points.clone(),
             arc_mm: self.arc_mm.clone(),
         };
@@ -237,6 +241,33 @@ impl Toolpath {
         out
     }
 
+    /// The same job run `k` (≥ 1) times slower, everywhere alike: every segment lasts `k` times
+    /// as long and the route is read at the planned instant `t / k`. Positions along the job are
+    /// the same; speeds divide by `k`, accelerations by `k²`. What a controller that cannot
+    /// keep the planned pace does on the whole (motion/controller.rs).
+    pub fn stretched(mut self, k: f64) -> Toolpath {
+        if !(k.is_finite() && k > 1.0) {
+            return self;
+        }
+        for seg in &mut self.segments {
+            seg.start_s *= k;
+            seg.duration_s *= k;
+            match &mut seg.scan {
+                ScanMotion::Line { move_s, .. } | ScanMotion::TcpLine { move_s, .. } => {
+                    *move_s *= k;
+                }
+                _ => {}
+            }
+        }
+        self.stretch = Some(self.stretch.unwrap_or(1.0) * k);
+        self
+    }
+
+    /// The factor by which the job runs slower than planned (1: as planned).
+    pub fn stretch(&self) -> f64 {
+        self.stretch.unwrap_or(1.0)
+    }
+
     /// The tool-centre points of stroke `k` in marking order.
     pub fn stroke_points(&self, k: usize) -> &[Pt] {
         self.strokes
@@ -245,7 +276,7 @@ impl Toolpath {
     }
 
     /// The arc length (mm) from stroke `k`'s start to each of its points.
-    pub(crate) fn stroke_arc_mm(&self, k: usize) -> &[f64] {
+    pub fn stroke_arc_mm(&self, k: usize) -> &[f64] {
         self.strokes
             .get(k)
             .map_or(&[][..], |s| &self.arc_mm[s.points.clone()])
@@ -339,12 +370,12 @@ impl Toolpath {
         let local_s = (t_s - seg.start_s).clamp(0.0, seg.duration_s);
         let stage = match &seg.stage {
             StageMotion::Hold(p) => *p,
-            StageMotion::Move(m) => m.position(local_s),
+            StageMotion::Move(m) => m.position(local_s / self.stretch()),
             // the route goes on past the job's end (the stage comes to rest on it)
             StageMotion::Route => self
                 .route
                 .as_ref()
-                .map_or(Pt::default(), |r| r.position(t_s.max(0.0))),
+                .map_or(Pt::default(), |r| r.position(t_s.max(0.0) / self.stretch())),
         };
         let (scan, laser) = match seg.scan {
             ScanMotion::Hold(o) => (o, false),

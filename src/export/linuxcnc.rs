@@ -1,0 +1,325 @@
+//! The LinuxCNC dialect (docs/GCODE.md, *LinuxCNC*): one program for a machine whose stage
+//! axes (X, Y) and scanner axes (the profile's words, default U, V) are coordinated axes of one
+//! LinuxCNC machine (trivkins XYUV; [`super::linuxcnc_config`] writes its configuration).
+//!
+//! Written from the toolpath's segments, one after another, so that the program runs the
+//! toolpath's motion and nothing else:
+//!
+//! * **step-and-scan**: a stage move is `G0 X.. Y..` (with the scanner words when the scanner
+//!   jumps during it), a scanner jump `G0 U.. V..`, a mark `G1 U.. V..` through the stroke's
+//!   points at its pen's feed; settling, jump and laser delays are dwells (`G4 P<s>`);
+//! * **on the fly**: the whole job in inverse time (`G93`), `G1 X.. Y.. U.. V.. F<1/min>`, each
+//!   line lasting what the toolpath takes between its two ends; the toolpath is sampled every
+//!   millisecond (and at every segment end and mark vertex) and consecutive samples are merged
+//!   while the path between them stays within `path_tol_mm` of the straight line
+//!   ([`otf_lines`]).
+//!
+//! The laser is a digital output: `M62 P<n>` before the first move of a mark (it switches at
+//! that move's start), `M63 P<n>` before the first move after it; `M65 P<n>` (at once) at the
+//! start and the end, then `M2`. Power goes to an analog output (`M67 E<n> Q<power>`,
+//! synchronised) or, without one, on the profile's power word.
+
+use super::gcode::{GcodeError, PenWords, Words};
+use crate::document::{MachineProfile, Plan};
+use crate::geom::Pt;
+use crate::motion::controller::otf_lines;
+use crate::motion::{ScanMotion, SegmentKind, StageMotion, Toolpath};
+use std::fmt::Write;
+
+/// Dwells shorter than this are not written, s (LinuxCNC's `G4` takes at least a servo period).
+const MIN_DWELL_S: f64 = 1e-7;
+
+/// Writes `toolpath` as a LinuxCNC program (see the module documentation).
+pub(super) fn write_program(
+    toolpath: &Toolpath,
+    plan: &Plan,
+    w: &Words<'_>,
+    header: &str,
+) -> Result<String, GcodeError> {
+    let profile = &plan.profile;
+    let mut p = Program::new(profile, w, toolpath.segments.len() * 48 + 1024);
+    p.out.push_str(header);
+    p.start(toolpath.route.is_some());
+    if toolpath.route.is_some() {
+        p.on_the_fly(toolpath, plan)?;
+    } else {
+        p.step_and_scan(toolpath, plan)?;
+    }
+    p.end();
+    Ok(p.out)
+}
+
+/// A program being written, and the machine state its lines leave.
+struct Program<'a, 'w> {
+    profile: &'a MachineProfile,
+    w: &'a Words<'w>,
+    out: String,
+    /// The laser output is (or will be, at the next move) on.
+    lit: bool,
+    /// Dwell not yet written, s.
+    dwell_s: f64,
+    /// The pen whose power and feed were last written (layer index; none: the profile's).
+    pen: Option<Option<usize>>,
+    /// Layer comments are written (the plan's layers have pens of their own).
+    comment_layers: bool,
+}
+
+impl<'a, 'w> Program<'a, 'w> {
+    fn new(profile: &'a MachineProfile, w: &'a Words<'w>, capacity: usize) -> Self {
+        Self {
+            profile,
+            w,
+            out: String::with_capacity(capacity),
+            lit: false,
+            dwell_s: 0.0,
+            pen: None,
+            comment_layers: false,
+        }
+    }
+
+    /// Units, absolute positions, the path mode, the laser off. Step-and-scan runs in exact
+    /// path mode (`G61`): LinuxCNC blends moves of the U/V axes only parabolically, without
+    /// the `G64 P` bound, so blended marks would cut their corners. On the fly the moves blend
+    /// (`G64 P`), or the stage would stop at every line.
+    fn start(&mut self, blend: bool) {
+        let d = &self.profile.gcode;
+        let path_mode = if blend {
+            format!("G64 P{}", self.w.num(d.path_tol_mm))
+        } else {
+            "G61".to_string()
+        };
+        let _ = writeln!(
+            self.out,
+            "G21 G90 G94 G17 G40 G49\n{path_mode}\nM65 P{}",
+            d.laser_output
+        );
+    }
+
+    fn end(&mut self) {
+        self.flush_dwell();
+        let d = &self.profile.gcode;
+        let _ = writeln!(self.out, "M65 P{}", d.laser_output);
+        if let Some(e) = d.power_output {
+            let _ = writeln!(self.out, "M68 E{e} Q0");
+        }
+        self.out.push_str("G94\n(end)\nM2\n");
+    }
+
+    /// A pause at rest, written as one dwell with the pauses next to it.
+    fn dwell(&mut self, duration_s: f64) {
+        self.dwell_s += duration_s;
+    }
+
+    fn flush_dwell(&mut self) {
+        if self.dwell_s >= MIN_DWELL_S {
+            let _ = writeln!(self.out, "G4 P{}", fmt_s(self.dwell_s));
+        }
+        self.dwell_s = 0.0;
+    }
+
+    /// Before a move: the dwell before it, and the laser switched for it.
+    fn before_move(&mut self, lit: bool) {
+        self.flush_dwell();
+        if lit != self.lit {
+            let n = self.profile.gcode.laser_output;
+            let _ = writeln!(self.out, "{} P{n}", if lit { "M62" } else { "M63" });
+            self.lit = lit;
+        }
+    }
+
+    /// Power, feed and layer comment of a stroke's pen, where it changes.
+    fn pen_for(
+        &mut self,
+        plan: &Plan,
+        layer: Option<usize>,
+        stroke: usize,
+    ) -> Result<String, GcodeError> {
+        let words = match layer {
+            None => PenWords::of(self.w, None),
+            Some(l) => PenWords::of(
+                self.w,
+                Some(
+                    plan.layers
+                        .get(l)
+                        .ok_or(GcodeError::NoLayer { stroke, layer: l })?,
+                ),
+            ),
+        };
+        if self.pen != Some(layer) {
+            self.pen = Some(layer);
+            if self.comment_layers {
+                if let Some(c) = &words.comment {
+                    let _ = writeln!(self.out, "({})", comment_text(c.trim_start_matches("; ")));
+                }
+            }
+            if let Some(power) = words.power {
+                match self.profile.gcode.power_output {
+                    Some(e) => {
+                        let _ = writeln!(self.out, "M67 E{e} Q{}", self.w.num(power));
+                    }
+                    None => {
+                        let _ = writeln!(
+                            self.out,
+                            "{}{}",
+                            self.profile.gcode.power_word,
+                            self.w.num(power)
+                        );
+                    }
+                }
+            }
+        }
+        // the feed the toolpath was timed with: the pen's mark speed (the dialects' feed word
+        // may differ from it in a profile; this program runs what was planned)
+        let speed = layer
+            .and_then(|l| plan.layers.get(l))
+            .map_or(self.profile.scanner.mark_speed_mm_s, |l| {
+                l.pen.mark_speed_mm_s(self.profile)
+            });
+        let _ = words.feed;
+        Ok(self.w.num(speed * 60.0))
+    }
+
+    fn scan_words(&self, offset: Pt) -> String {
+        let a = &self.profile.gcode.scanner_axes;
+        self.w
+            .xy([a[0].as_str(), a[1].as_str()], self.w.offset(offset))
+    }
+
+    fn stage_words(&self, p: Pt) -> String {
+        self.w.xy(["X", "Y"], self.w.position(p))
+    }
+
+    fn field_comment(&mut self, plan: &Plan, field: usize, centre: Pt) {
+        let number = plan
+            .fields
+            .iter()
+            .position(|f| f.id == field)
+            .map_or(format!("[id {field}]"), |k| (k + 1).to_string());
+        let c = self.w.position(centre);
+        let _ = writeln!(
+            self.out,
+            "(field {number} centre {} {})",
+            self.w.num(c.x),
+            self.w.num(c.y)
+        );
+    }
+
+    /// Step-and-scan: the segments as moves and dwells.
+    fn step_and_scan(&mut self, toolpath: &Toolpath, plan: &Plan) -> Result<(), GcodeError> {
+        self.comment_layers = plan.layers.iter().any(|l| !l.pen.marks_as_profile());
+        let mut field = None;
+        // the lowering places stage and scanner at the first stroke's start: move there
+        if let (Some(first), Some(&start)) =
+            (toolpath.strokes.first(), toolpath.stroke_points(0).first())
+        {
+            self.field_comment(plan, first.field, first.stage);
+            field = Some(first.field);
+            let _ = writeln!(
+                self.out,
+                "G0 {} {}",
+                self.stage_words(first.stage),
+                self.scan_words(start.minus(first.stage))
+            );
+        }
+        for seg in &toolpath.segments {
+            match (seg.kind, seg.stage, seg.scan) {
+                (SegmentKind::StageMove, StageMotion::Move(mv), scan) => {
+                    self.before_move(false);
+                    let to = mv.position(seg.duration_s);
+                    if let Some(s) = toolpath.strokes.iter().find(|s| s.stage == to) {
+                        if field != Some(s.field) {
+                            field = Some(s.field);
+                            self.field_comment(plan, s.field, to);
+                        }
+                    }
+                    let jump = match scan {
+                        ScanMotion::Line { to, .. } => format!(" {}", self.scan_words(to)),
+                        _ => String::new(),
+                    };
+                    let _ = writeln!(self.out, "G0 {}{jump}", self.stage_words(to));
+                }
+                (SegmentKind::Jump, _, ScanMotion::Line { to, .. }) => {
+                    self.before_move(false);
+                    let _ = writeln!(self.out, "G0 {}", self.scan_words(to));
+                }
+                (SegmentKind::Mark, StageMotion::Hold(stage), ScanMotion::Mark { stroke, .. }) => {
+                    let layer = toolpath.strokes.get(stroke).and_then(|s| s.layer);
+                    let feed = self.pen_for(plan, layer, stroke)?;
+                    self.before_move(true);
+                    let points = toolpath.stroke_points(stroke);
+                    if points.is_empty() {
+                        return Err(GcodeError::EmptyStroke { stroke });
+                    }
+                    for (j, &p) in points.iter().enumerate().skip(1) {
+                        let words = self.scan_words(p.minus(stage));
+                        if j == 1 {
+                            let _ = writeln!(self.out, "G1 {words} F{feed}");
+                        } else {
+                            let _ = writeln!(self.out, "G1 {words}");
+                        }
+                    }
+                }
+                (
+                    SegmentKind::Settle
+                    | SegmentKind::JumpDelay
+                    | SegmentKind::LaserOnDelay
+                    | SegmentKind::LaserOffDelay,
+                    _,
+                    _,
+                ) => self.dwell(seg.duration_s),
+                _ => return Err(GcodeError::Unwritable { kind: seg.kind }),
+            }
+        }
+        Ok(())
+    }
+
+    /// On the fly: the job as timed lines in inverse time, each lasting its planned time
+    /// ([`otf_lines`]; a toolpath stretched to the controller's pace is written as planned:
+    /// LinuxCNC itself runs it at that pace).
+    fn on_the_fly(&mut self, toolpath: &Toolpath, plan: &Plan) -> Result<(), GcodeError> {
+        self.comment_layers = plan.layers.iter().any(|l| !l.pen.marks_as_profile());
+        let (start, lines) = otf_lines(toolpath, self.profile.gcode.path_tol_mm);
+        if lines.is_empty() {
+            return Ok(());
+        }
+        let _ = writeln!(
+            self.out,
+            "G0 {} {}",
+            self.stage_words(start.stage),
+            self.scan_words(start.scan)
+        );
+        self.out.push_str("G93\n");
+        for line in &lines {
+            if let Some(stroke) = line.stroke {
+                let layer = toolpath.strokes.get(stroke).and_then(|s| s.layer);
+                let _ = self.pen_for(plan, layer, stroke)?;
+            }
+            self.before_move(line.lit);
+            let duration_min = line.duration_s / 60.0;
+            let _ = writeln!(
+                self.out,
+                "G1 {} {} F{}",
+                self.stage_words(line.stage),
+                self.scan_words(line.scan),
+                fmt_inverse_time(1.0 / duration_min)
+            );
+        }
+        Ok(())
+    }
+}
+
+/// Seconds for `G4 P`: microseconds resolved, trailing zeros trimmed.
+fn fmt_s(v: f64) -> String {
+    crate::geom::format_mm(v, 7)
+}
+
+/// An inverse-time feed (1/min) with nine significant digits.
+fn fmt_inverse_time(f: f64) -> String {
+    let digits = f.abs().log10().floor().max(0.0) as usize + 1;
+    crate::geom::format_mm(f, 9usize.saturating_sub(digits).max(1))
+}
+
+/// Text that fits inside a LinuxCNC comment (no parentheses).
+fn comment_text(s: &str) -> String {
+    s.replace(['(', ')'], "").replace('\n', " ")
+}
