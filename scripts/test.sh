@@ -27,6 +27,10 @@ cargo clippy --all-targets -- -D warnings
 cargo test --no-default-features --lib --bins
 # Everything: library, CLI, integration and GUI (egui_kittest) tests.
 cargo test --all-targets
+# LinuxCNC itself reads and runs galvoplan's programs on a headless simulated machine (installs
+# linuxcnc-uspace without recommends when missing: 123 packages, 80 MB; about 2 min of runs).
+cargo build --bin galvoplan
+bash scripts/check-linuxcnc.sh "$CARGO_TARGET_DIR/debug/galvoplan"
 # The rerun recording (feature-gated: the rerun SDK is a third of the full build).
 cargo test --no-default-features --features rerun --test rerun
 echo "test.sh: done in $(( $(date +%s) - start )) s"

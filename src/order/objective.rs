@@ -18,6 +18,7 @@
 
 use crate::document::{pen_of, Geometry, Layer, MachineProfile, ScanField, Step};
 use crate::geom::Pt;
+use crate::motion::controller::LinuxcncClock;
 use crate::motion::StageDynamics;
 use std::collections::HashMap;
 
@@ -29,8 +30,13 @@ pub struct StepTime<'a> {
     stage: StageDynamics,
     jump_speed_mm_s: f64,
     jump_delay_s: f64,
-    /// Per geometry: laser-on delay + mark + laser-off delay, s.
+    /// Per geometry: laser-on delay + mark + laser-off delay, s (on a controller clock: the
+    /// mark alone; [`StepTime::sum_clocked`] adds the delays as dwells).
     mark_s: Vec<f64>,
+    /// The controller's clock (LinuxCNC), which times moves and dwells as `motion::lower` does
+    /// on it.
+    clock: Option<LinuxcncClock>,
+    laser: crate::document::LaserTiming,
 }
 
 impl<'a> StepTime<'a> {
@@ -42,13 +48,18 @@ impl<'a> StepTime<'a> {
         profile: &MachineProfile,
     ) -> Self {
         let laser = &profile.laser;
+        let clock = LinuxcncClock::of(profile);
         let mark_s = geometries
             .iter()
             .map(|g| {
                 let speed = pen_of(layers, g).map_or(profile.scanner.mark_speed_mm_s, |p| {
                     p.mark_speed_mm_s(profile)
                 });
-                laser.on_delay_s + g.length_mm() / speed + laser.off_delay_s
+                match &clock {
+                    // every start vertex and direction marks the same edges
+                    Some(c) => c.polyline_s(&g.marking_path(0, false), speed),
+                    None => laser.on_delay_s + g.length_mm() / speed + laser.off_delay_s,
+                }
             })
             .collect();
         Self {
@@ -59,6 +70,8 @@ impl<'a> StepTime<'a> {
             jump_speed_mm_s: profile.scanner.jump_speed_mm_s,
             jump_delay_s: laser.jump_delay_s,
             mark_s,
+            clock,
+            laser: laser.clone(),
         }
     }
 
@@ -74,6 +87,9 @@ impl<'a> StepTime<'a> {
     }
 
     fn sum(&self, steps: &[Step]) -> f64 {
+        if let Some(clock) = &self.clock {
+            return self.sum_clocked(steps, clock);
+        }
         let mut t = 0.0;
         let (mut stage_at, mut scan_at) = (Pt::default(), Pt::default());
         for (k, s) in steps.iter().enumerate() {
@@ -99,6 +115,59 @@ impl<'a> StepTime<'a> {
                 stage_at = centre;
             }
             t += self.mark_s[s.geometry];
+            scan_at = end.minus(stage_at);
+        }
+        t
+    }
+}
+
+impl StepTime<'_> {
+    /// [`StepTime::sum`] on a controller clock, by `motion::lower`'s rules there: a field
+    /// change is one coordinated move of stage and scanner (never shorter than the stage's own
+    /// trapezoids), a jump is an exact-stop move, and pauses next to each other (settling, jump
+    /// delay, laser-on delay) are one dwell.
+    fn sum_clocked(&self, steps: &[Step], clock: &LinuxcncClock) -> f64 {
+        let mut t = 0.0;
+        let (mut stage_at, mut scan_at) = (Pt::default(), Pt::default());
+        // the last thing done was a pause: the next pause joins its dwell
+        let mut pausing = false;
+        let hold = |t: &mut f64, pausing: &mut bool, d: f64| {
+            let d = if *pausing { d } else { clock.dwell_s(d) };
+            if d > 0.0 {
+                *t += d;
+                *pausing = true;
+            }
+        };
+        for (k, s) in steps.iter().enumerate() {
+            let (Some(g), Some(&centre)) =
+                (self.geometries.get(s.geometry), self.centre.get(&s.field))
+            else {
+                return f64::INFINITY;
+            };
+            let (start, end) = g.ends(s.choice(g));
+            let offset = start.minus(centre);
+            if k == 0 {
+                stage_at = centre;
+            } else if centre == stage_at {
+                let j = offset.minus(scan_at);
+                let jump_s = clock.move_s([0.0, 0.0, j.x, j.y], None);
+                if jump_s > 0.0 {
+                    t += jump_s;
+                    pausing = false;
+                }
+                hold(&mut t, &mut pausing, self.jump_delay_s);
+            } else {
+                let mv = self.stage.plan_move(stage_at, centre);
+                let (d, j) = (centre.minus(stage_at), offset.minus(scan_at));
+                t += clock.move_s([d.x, d.y, j.x, j.y], None).max(mv.move_s);
+                pausing = false;
+                hold(&mut t, &mut pausing, mv.settle_s);
+                stage_at = centre;
+            }
+            hold(&mut t, &mut pausing, self.laser.on_delay_s);
+            t += self.mark_s[s.geometry];
+            pausing = false;
+            hold(&mut t, &mut pausing, self.laser.off_delay_s);
             scan_at = end.minus(stage_at);
         }
         t
@@ -212,7 +281,24 @@ mod tests {
 
     #[test]
     fn the_step_time_equals_the_lowered_job_time() {
-        let profile = MachineProfile::default();
+        step_time_equals_lowered(&MachineProfile::default());
+    }
+
+    #[test]
+    fn the_step_time_on_a_controller_clock_equals_the_lowered_job_time() {
+        // LinuxCNC's exact-stop moves, with delays and settling as dwells (merged where
+        // adjacent), as the lowering times them
+        let mut profile = MachineProfile::builtin("linuxcnc").unwrap();
+        profile.laser.on_delay_s = 1e-4;
+        profile.laser.off_delay_s = 2e-4;
+        profile.laser.jump_delay_s = 3e-4;
+        profile.axis_x.settle_s = 5e-3;
+        step_time_equals_lowered(&profile);
+        step_time_equals_lowered(&MachineProfile::builtin("linuxcnc").unwrap());
+    }
+
+    fn step_time_equals_lowered(profile: &MachineProfile) {
+        let profile = profile.clone();
         let centre = |j: usize| Pt::new(50.0 + 45.0 * j as f64, 40.0 + 37.0 * (j % 3) as f64);
         let gs: Vec<Geometry> = (0..12)
             .map(|k| {

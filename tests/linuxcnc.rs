@@ -1,0 +1,203 @@
+//! The LinuxCNC dialect, its machine configuration and its time law, without LinuxCNC
+//! (scripts/check-linuxcnc.sh runs the programs on LinuxCNC itself).
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+mod common;
+
+use galvoplan::document::{Document, MachineProfile, MotionMode, Plan, SolverSettings};
+use galvoplan::export::{linuxcnc_config, waypoints_csv, write_gcode};
+use galvoplan::import::ImportOptions;
+use galvoplan::job::JobCtx;
+use galvoplan::motion::controller::{otf_lines, LinuxcncClock};
+use galvoplan::motion::Toolpath;
+use galvoplan::pipeline::{load_svg, plan_document_lowered};
+
+fn planned(name: &str, motion: MotionMode, profile: MachineProfile) -> (Document, Plan, Toolpath) {
+    let settings = SolverSettings {
+        motion,
+        ..SolverSettings::default()
+    };
+    let path = common::root().join("assets/examples").join(name);
+    let (mut doc, _) = load_svg(&path, profile, settings, &ImportOptions::default()).unwrap();
+    let (plan, toolpath) = plan_document_lowered(&mut doc, &JobCtx::default()).unwrap();
+    (doc, plan, toolpath)
+}
+
+/// The numbers after each of `words` on a G-code line (`G1 U1.5 V-2` → [1.5, -2]).
+fn words(line: &str, letters: &[char]) -> Vec<Option<f64>> {
+    letters
+        .iter()
+        .map(|&l| {
+            line.split_whitespace()
+                .find(|w| w.starts_with(l))
+                .and_then(|w| w[1..].parse().ok())
+        })
+        .collect()
+}
+
+#[test]
+fn step_and_scan_marks_between_m62_and_m63_in_exact_path_mode() {
+    let profile = MachineProfile::builtin("linuxcnc").unwrap();
+    let (doc, plan, toolpath) = planned("demo.svg", MotionMode::Step, profile.clone());
+    let g = write_gcode(&toolpath, &plan, doc.page_mm[1], "demo").unwrap();
+    let lines: Vec<&str> = g.lines().collect();
+    assert!(lines[0].starts_with("(galvoplan"), "{}", lines[0]);
+    assert!(g.contains("G21 G90 G94") && g.contains("\nG61\n") && g.contains("\nM65 P0\n"));
+    assert!(!g.contains("M3") && !g.contains("M5\n") && !g.contains(';'));
+    assert!(g.trim_end().ends_with("M2"));
+    // the last laser word is the immediate off, after every move
+    let last_move = lines
+        .iter()
+        .rposition(|l| l.starts_with('G') && l.contains('U'));
+    let last_off = lines.iter().rposition(|l| *l == "M65 P0");
+    assert!(last_off > last_move);
+    // no dwells: the profile has no delays
+    assert!(!lines.iter().any(|l| l.starts_with("G4 ")));
+    // feeds only while lit, rapids only while dark; one G1 per edge of every stroke
+    let mut lit = false;
+    let mut feeds = 0;
+    let half = profile.field_mm[0] / 2.0 + 1e-4;
+    for l in &lines {
+        match *l {
+            "M62 P0" => lit = true,
+            "M63 P0" => lit = false,
+            _ if l.starts_with("G1 ") => {
+                assert!(lit, "feed with the laser off: {l}");
+                feeds += 1;
+                for v in words(l, &['U', 'V']).into_iter().flatten() {
+                    assert!(v.abs() <= half, "{l} outside the field");
+                }
+            }
+            _ if l.starts_with("G0 ") => assert!(!lit, "rapid with the laser on: {l}"),
+            _ => {}
+        }
+    }
+    let edges: usize = (0..toolpath.strokes.len())
+        .map(|k| toolpath.stroke_points(k).len() - 1)
+        .sum();
+    assert_eq!(feeds, edges);
+    // the job time is the controller's: slower than the scan head's own
+    let ideal = planned("demo.svg", MotionMode::Step, MachineProfile::default()).2;
+    assert!(toolpath.duration_s() > ideal.duration_s() * 1.1);
+}
+
+#[test]
+fn on_the_fly_lines_last_the_planned_time_and_stay_within_the_tolerance() {
+    let profile = MachineProfile::builtin("linuxcnc").unwrap();
+    let tol = profile.gcode.path_tol_mm;
+    let (doc, plan, toolpath) = planned("oversize.svg", MotionMode::OnTheFly, profile.clone());
+    assert!(toolpath.route.is_some());
+    let g = write_gcode(&toolpath, &plan, doc.page_mm[1], "oversize").unwrap();
+    assert!(g.contains("\nG93\n") && g.contains(&format!("G64 P{tol}")));
+    // inverse-time feeds add up to the planned time; the toolpath runs at the controller's pace
+    let minutes: f64 = g
+        .lines()
+        .filter(|l| l.starts_with("G1 "))
+        .map(|l| 1.0 / words(l, &['F'])[0].unwrap())
+        .sum();
+    let planned_s = toolpath.duration_s() / toolpath.stretch();
+    assert!(
+        (minutes * 60.0 - planned_s).abs() <= 1e-6 * planned_s,
+        "{} vs {planned_s}",
+        minutes * 60.0
+    );
+    assert!(toolpath.stretch() >= 1.0);
+    let clock = LinuxcncClock::of(&profile).unwrap();
+    let (start, lines) = otf_lines(&toolpath, tol);
+    let controller_s = clock.otf_program_s(&start, &lines);
+    assert!((controller_s - toolpath.duration_s()).abs() <= 1e-6 * controller_s);
+    // every waypoint lies within the tolerance of the line through it (in planned time)
+    let waypoints: Vec<Vec<f64>> = waypoints_csv(&toolpath)
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    let k = toolpath.stretch();
+    let mut t_end = 0.0;
+    let mut from = [start.stage.x, start.stage.y, start.scan.x, start.scan.y];
+    let mut w = 0;
+    for line in &lines {
+        let t0 = t_end;
+        t_end += line.duration_s * k;
+        let to = [line.stage.x, line.stage.y, line.scan.x, line.scan.y];
+        while w < waypoints.len() && waypoints[w][0] <= t_end + 1e-9 {
+            let r = &waypoints[w];
+            let u = if t_end > t0 {
+                ((r[0] - t0) / (t_end - t0)).clamp(0.0, 1.0)
+            } else {
+                1.0
+            };
+            let p: Vec<f64> = (0..4).map(|i| from[i] + (to[i] - from[i]) * u).collect();
+            let stage = (p[0] - r[1]).hypot(p[1] - r[2]);
+            let tcp = (p[0] + p[2] - r[1] - r[3]).hypot(p[1] + p[3] - r[2] - r[4]);
+            assert!(
+                stage <= tol + 1e-6 && tcp <= tol + 1e-6, // the CSV holds positions to 0.1 µm
+                "at {}: {stage} {tcp}",
+                r[0]
+            );
+            w += 1;
+        }
+        from = to;
+    }
+    assert_eq!(w, waypoints.len());
+}
+
+#[test]
+fn the_configuration_is_the_profiles_machine() {
+    let mut profile = MachineProfile::builtin("linuxcnc").unwrap();
+    profile.gcode.power_output = Some(2);
+    profile.controller.servo_period_s = 5e-4;
+    let files = linuxcnc_config(&profile);
+    let text = |name: &str| {
+        files
+            .iter()
+            .find(|f| f.name == name)
+            .map(|f| f.text.clone())
+            .unwrap()
+    };
+    let ini = text("galvoplan.ini");
+    assert!(ini.contains("KINEMATICS = trivkins coordinates=XYUV"));
+    assert!(ini.contains("COORDINATES = XYUV") && ini.contains("JOINTS = 4"));
+    assert!(ini.contains("SERVO_PERIOD = 500000"));
+    assert!(ini.contains("[AXIS_U]\nMIN_LIMIT = -35.001\nMAX_LIMIT = 35.001\nMAX_VELOCITY = 5000"));
+    assert!(ini.contains("[JOINT_0]") && ini.contains("[JOINT_3]"));
+    assert!(ini.contains("MAX_ACCELERATION = 1000000"));
+    let hal = text("galvoplan.hal");
+    assert!(hal.contains("net laser-gate motion.digital-out-00"));
+    assert!(hal.contains("motion.analog-out-02") && hal.contains("num_aio=4"));
+    assert!(hal.contains("joint.3.motor-pos-cmd => joint.3.motor-pos-fb"));
+    assert!(files
+        .iter()
+        .any(|f| f.name == "galvoplan-run.py" && f.executable));
+    assert!(text("README.txt").contains("xy2mod"));
+}
+
+#[test]
+fn linuxcnc_profile_values_are_checked_by_name() {
+    let bad = "version = 3\n[gcode]\nmode = \"linuxcnc\"\nlaser_output = 99\n";
+    let e = MachineProfile::from_toml(bad, "p.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("Laser output") && e.contains("99"), "{e}");
+    let bad = "version = 3\n[controller]\nkind = \"linuxcnc\"\nservo_period_s = 0.5\n";
+    let e = MachineProfile::from_toml(bad, "p.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("Servo period"), "{e}");
+    // version-2 files stay valid, on the scan head's timing
+    let p = MachineProfile::from_toml("version = 2\n", "p.toml").unwrap();
+    assert!(LinuxcncClock::of(&p).is_none());
+}
+
+#[test]
+fn power_goes_to_the_analog_output_with_the_pen() {
+    let mut profile = MachineProfile::builtin("linuxcnc").unwrap();
+    profile.gcode.power_output = Some(1);
+    profile.gcode.power = Some(40.0);
+    let (doc, plan, toolpath) = planned("demo.svg", MotionMode::Step, profile);
+    let g = write_gcode(&toolpath, &plan, doc.page_mm[1], "demo").unwrap();
+    let first_power = g.find("M67 E1 Q40").expect("power word");
+    let first_mark = g.find("M62 P0").unwrap();
+    assert!(first_power < first_mark);
+    assert!(g.contains("M68 E1 Q0\n"), "power off at the end");
+}
