@@ -1,7 +1,10 @@
 #!/usr/bin/env bash
 # Runs galvoplan's LinuxCNC programs on LinuxCNC itself (part of the test command).
 #
-# usage: scripts/check-linuxcnc.sh [BINARY]
+# usage: scripts/check-linuxcnc.sh [BINARY] [--shared BENCH_DIR]
+#
+# With --shared (e.g. ../shared/bench), also the 14 shared instances step-and-scan and the three
+# on-the-fly patterns on the fly (docs/BENCHMARKS.md's LinuxCNC table; about 10 min more).
 #
 # For each job: plans it with the built-in `linuxcnc` profile, reads the program with LinuxCNC's
 # interpreter and compares its canonical moves with the toolpath (scripts/linuxcnc_check.py),
@@ -17,6 +20,8 @@ set -uo pipefail
 cd "$(dirname "$0")/.."
 ROOT="$PWD"
 B="${1:-${CARGO_TARGET_DIR:-$HOME/.cache/galvoplan-target}/debug/galvoplan}"
+SHARED=""
+if [ "${2:-}" = "--shared" ]; then SHARED="${3:?--shared needs a folder}"; fi
 if [ ! -x "$B" ]; then
   echo "check-linuxcnc: no galvoplan binary at $B" >&2
   exit 1
@@ -27,7 +32,8 @@ if ! command -v linuxcnc >/dev/null || ! /usr/bin/python3 -c 'import linuxcnc, g
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -q --no-install-recommends linuxcnc-uspace >/dev/null
 fi
 OUT="${OUT:-$(mktemp -d /tmp/galvoplan-linuxcnc.XXXXXX)}"
-mkdir -p "$OUT/rtapi" && chmod 1777 "$OUT/rtapi"
+# rtapi_app runs as another user (below) and must reach its socket folder
+mkdir -p "$OUT/rtapi" && chmod 755 "$OUT" && chmod 1777 "$OUT/rtapi"
 OUT="$(realpath "$OUT")"
 CFG="$OUT/machine"
 "$B" linuxcnc-config --profile linuxcnc --out "$CFG" >/dev/null || exit 1
@@ -98,4 +104,11 @@ job ISW-1017 tests/data/linuxcnc/ISW-1017.svg step
 job two-layers assets/examples/two-layers.svg step --pens assets/examples/two-layers.pens.toml
 job oversize assets/examples/oversize.svg on-the-fly
 job lissajous tests/data/linuxcnc/lissajous.svg on-the-fly
+if [ -n "$SHARED" ]; then
+  for f in "$SHARED"/instances/*.svg; do
+    n=$(basename "$f" .svg)
+    [ "$n" = ISW-1017 ] || job "$n" "$f" step
+  done
+  for n in spiral tree; do job "$n" "$SHARED/otf/$n.svg" on-the-fly; done
+fi
 exit $status
