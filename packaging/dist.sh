@@ -25,7 +25,7 @@ install -Dm644 packaging/linux/io.github.galvoplan.galvoplan.metainfo.xml \
   "$root/share/metainfo/io.github.galvoplan.galvoplan.metainfo.xml"
 install -Dm644 packaging/linux/galvoplan-mime.xml "$root/share/mime/packages/galvoplan.xml"
 for f in assets/profiles/*.toml; do install -Dm644 "$f" "$root/share/galvoplan/profiles/$(basename "$f")"; done
-for f in assets/examples/*.svg; do install -Dm644 "$f" "$root/share/galvoplan/examples/$(basename "$f")"; done
+for f in assets/examples/*.svg assets/examples/*.toml; do install -Dm644 "$f" "$root/share/galvoplan/examples/$(basename "$f")"; done
 for f in README.md LICENSE-MIT LICENSE-APACHE docs/ARCHITECTURE.md docs/BENCHMARKS.md \
   assets/fonts/DejaVuSans-LICENSE.txt; do
   install -Dm644 "$f" "$root/share/doc/galvoplan/$(basename "$f")"

@@ -405,11 +405,8 @@ impl App {
             count(self.session.doc.geometries.len(), "geometry", "geometries"),
             count(self.session.doc.layers.len(), "layer", "layers"),
             count(self.session.doc.fields.len(), "scan field", "scan fields"),
-            count(
-                self.session.doc.warnings.len(),
-                "import warning",
-                "import warnings"
-            )
+            // the Warnings panel's word
+            count(self.session.doc.warnings.len(), "warning", "warnings")
         );
         match o.problem {
             Some(p) => {

@@ -8,8 +8,8 @@
 use super::commands::Command;
 use crate::document::spec::{self, FieldSpec, Rule};
 use crate::document::{
-    CostModel, FieldsMode, MachineProfile, MotionMode, SolverSettings, StageRouteKind, VertexMode,
-    BUILTIN,
+    ControllerKind, CostModel, FieldsMode, GcodeMode, MachineProfile, MotionMode, SolverSettings,
+    StageRouteKind, VertexMode, BUILTIN,
 };
 use egui::{Color32, RichText};
 
@@ -53,6 +53,8 @@ struct Form<T> {
     synced: Option<T>,
     text: Vec<String>,
     error: Vec<Option<String>>,
+    /// Whether a row's value is used by the value as it stands (a row that is not is greyed).
+    applies: fn(&FieldSpec<T>, &T) -> bool,
 }
 
 impl<T: Clone + PartialEq> Form<T> {
@@ -62,6 +64,7 @@ impl<T: Clone + PartialEq> Form<T> {
             synced: None,
             text: Vec::new(),
             error: Vec::new(),
+            applies: |_, _| true,
         }
     }
 
@@ -91,7 +94,7 @@ impl<T: Clone + PartialEq> Form<T> {
                 .desired_rows(1)
                 .desired_width(f32::INFINITY)
                 .return_key(None);
-            let r = add_edit(ui, edit, bad, help, label.id);
+            let r = add_edit(ui, edit, bad, help, label.id, true);
             if r.has_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter)) {
                 // Enter commits, as in the one-line fields
                 r.surrender_focus();
@@ -107,7 +110,8 @@ impl<T: Clone + PartialEq> Form<T> {
                     let (bad, help) = (self.error[k].is_some(), self.specs[k].help);
                     let edit =
                         egui::TextEdit::singleline(&mut self.text[k]).desired_width(NARROW_EDIT_PX);
-                    let r = add_edit(ui, edit, bad, help, label.id);
+                    let used = (self.applies)(&self.specs[k], value);
+                    let r = add_edit(ui, edit, bad, help, label.id, used);
                     ui.end_row();
                     self.commit(k, &r, value, validate, &mut out, &mut valid_commit);
                 }
@@ -177,21 +181,82 @@ pub(super) fn reserved_message(ui: &mut egui::Ui, text: RichText, height_px: f32
     });
 }
 
-/// Adds a row's edit (red while its value is rejected), labelled, with its help.
+/// Adds a row's edit (red while its value is rejected), labelled, with its help; greyed when
+/// the value is not `used`.
 fn add_edit(
     ui: &mut egui::Ui,
     edit: egui::TextEdit<'_>,
     bad: bool,
     help: &str,
     label: egui::Id,
+    used: bool,
 ) -> egui::Response {
     let edit = if bad { edit.text_color(ERROR) } else { edit };
-    let r = ui.add(edit).labelled_by(label);
+    let r = ui
+        .add_enabled(used, edit)
+        .labelled_by(label)
+        .on_disabled_hover_text(format!(
+            "Not used with this profile's G-code dialect and controller. {help}"
+        ));
     match help {
         "" => r,
         help => r.on_hover_text(help),
     }
 }
+
+/// Whether a profile row is used with the profile's G-code dialect and controller.
+fn profile_row_applies(spec: &FieldSpec<MachineProfile>, p: &MachineProfile) -> bool {
+    let linuxcnc = p.gcode.mode == GcodeMode::Linuxcnc;
+    match spec.key {
+        "gcode.laser_on" | "gcode.laser_off" | "gcode.feed_mm_min" => !linuxcnc,
+        "gcode.scanner_axes[0]" | "gcode.scanner_axes[1]" => p.gcode.mode != GcodeMode::Tcp,
+        "gcode.laser_output" | "gcode.power_output" | "gcode.path_tol_mm" => linuxcnc,
+        "gcode.power_word" => !(linuxcnc && p.gcode.power_output.is_some()),
+        "controller.servo_period_s" => p.controller.kind == ControllerKind::Linuxcnc,
+        // also the scanner's acceleration in linuxcnc-config's machine
+        "controller.scanner_accel_mm_s2" => {
+            linuxcnc || p.controller.kind == ControllerKind::Linuxcnc
+        }
+        _ => true,
+    }
+}
+
+/// The G-code dialects offered, in words.
+pub const GCODE_DIALECTS: &[Choice<GcodeMode>] = &[
+    (
+        GcodeMode::Tcp,
+        "Tool-centre point (X/Y)",
+        "The laser point's path on X/Y; the controller splits it between stage and scanner.",
+    ),
+    (
+        GcodeMode::StageScanner,
+        "Stage and scanner axes",
+        "G0 X/Y to each scan field, the scanner on its own two axis words (step-and-scan).",
+    ),
+    (
+        GcodeMode::Linuxcnc,
+        "LinuxCNC (X/Y stage, U/V scanner)",
+        "One LinuxCNC machine: the laser on a digital output (M62/M63), exact stops in \
+         step-and-scan, timed G93 lines on the fly; `galvoplan linuxcnc-config` writes the \
+         machine's configuration.",
+    ),
+];
+
+/// The controllers offered, in words.
+pub const CONTROLLERS: &[Choice<ControllerKind>] = &[
+    (
+        ControllerKind::Ideal,
+        "Scan-head controller",
+        "Job time as a scan head runs it: marks at constant speed through corners, jumps at \
+         jump speed, delays as given.",
+    ),
+    (
+        ControllerKind::Linuxcnc,
+        "LinuxCNC",
+        "Job time as LinuxCNC's planner runs the program: every move to rest in whole servo \
+         periods; on the fly its blends, slower than planned.",
+    ),
+];
 
 /// True for a free-text row (a name): it gets the panel's width, wrapped.
 fn is_wide<T>(spec: &FieldSpec<T>) -> bool {
@@ -211,7 +276,10 @@ pub struct Editors {
 impl Default for Editors {
     fn default() -> Self {
         Self {
-            profile: Form::new(profile_specs()),
+            profile: Form {
+                applies: profile_row_applies,
+                ..Form::new(profile_specs())
+            },
             settings: Form::new(settings_specs()),
             file_error: None,
             file_request: None,
@@ -256,6 +324,18 @@ impl Editors {
                 .response
                 .labelled_by(label.id);
         });
+        let mut p = profile.clone();
+        combo(ui, "G-code dialect", &mut p.gcode.mode, GCODE_DIALECTS);
+        combo(ui, "Controller", &mut p.controller.kind, CONTROLLERS);
+        if p != *profile {
+            match validate_profile(&p) {
+                Ok(()) => {
+                    self.file_error = None;
+                    out = Some(p);
+                }
+                Err(e) => self.file_error = Some(e),
+            }
+        }
         ui.horizontal(|ui| {
             if ui.button("Load TOML…").clicked() {
                 self.file_request = Some(super::prompts::PathAction::LoadProfile);
@@ -492,5 +572,38 @@ pub fn builtin_words(profile: &MachineProfile) -> String {
     match builtins.iter().find(|(_, b)| b.name == profile.name) {
         Some((name, _)) => format!("{name}, edited"),
         None => "custom (edited or loaded)".to_string(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+
+    #[test]
+    fn rows_the_dialect_or_controller_does_not_use_are_greyed() {
+        let specs = spec::profile_specs();
+        let row = |key: &str| specs.iter().find(|s| s.key == key).unwrap();
+        let seed = MachineProfile::default();
+        let lcnc = MachineProfile::builtin("linuxcnc").unwrap();
+        for key in [
+            "gcode.laser_output",
+            "gcode.path_tol_mm",
+            "controller.servo_period_s",
+        ] {
+            assert!(!profile_row_applies(row(key), &seed), "{key}");
+            assert!(profile_row_applies(row(key), &lcnc), "{key}");
+        }
+        for key in ["gcode.laser_on", "gcode.laser_off", "gcode.feed_mm_min"] {
+            assert!(profile_row_applies(row(key), &seed), "{key}");
+            assert!(!profile_row_applies(row(key), &lcnc), "{key}");
+        }
+        assert!(profile_row_applies(row("scanner.mark_speed_mm_s"), &lcnc));
+        // the dialect and the controller are chosen from lists, with words for every value
+        for (_, words, help) in GCODE_DIALECTS {
+            assert!(!words.is_empty() && !help.is_empty());
+        }
+        assert_eq!(GCODE_DIALECTS.len(), 3);
+        assert_eq!(CONTROLLERS.len(), 2);
     }
 }

@@ -176,9 +176,19 @@ impl App {
     /// Asks for a path: the native dialog when one can be shown, else a path field.
     pub fn choose_path(&mut self, action: PathAction, ctx: &egui::Context) {
         let (title, _, ext, filter) = action.words();
+        // LinuxCNC reads programs named .ngc
+        let linuxcnc = self.session.doc.profile.gcode.mode == crate::document::GcodeMode::Linuxcnc;
+        let gcode = matches!(
+            action,
+            PathAction::Export(ExportKind::Gcode) | PathAction::ResolveExport(ExportKind::Gcode)
+        );
+        let ext = if gcode && linuxcnc { "ngc" } else { ext };
         let default_name = match action {
             PathAction::SavePens => "pens.toml".to_string(),
             PathAction::SaveProfile => "profile.toml".to_string(),
+            PathAction::Export(_) | PathAction::ResolveExport(_) if gcode && linuxcnc => {
+                files::default_name(&self.session.doc, "ngc")
+            }
             PathAction::Export(kind) | PathAction::ResolveExport(kind) => {
                 files::default_name(&self.session.doc, kind.suffix())
             }

@@ -4,8 +4,8 @@
 
 use super::validate::{InvalidValue, NON_NEGATIVE, POSITIVE};
 use super::{
-    CostModel, FieldsMode, HatchSettings, MachineProfile, Motion, MotionMode, Pen, SolverSettings,
-    StageRouteKind, MAX_PASSES,
+    ControllerKind, CostModel, FieldsMode, GcodeMode, HatchSettings, MachineProfile, Motion,
+    MotionMode, Pen, SolverSettings, StageRouteKind, MAX_PASSES,
 };
 
 /// What a value must be.
@@ -428,14 +428,14 @@ pub fn profile_specs() -> Vec<FieldSpec<MachineProfile>> {
         text!(
             "Laser on word",
             "gcode.laser_on",
-            "M3 or M4",
+            "M3 or M4 (LinuxCNC: M62 on the laser output)",
             Rule::Text,
             |p| p.gcode.laser_on
         ),
         text!(
             "Laser off word",
             "gcode.laser_off",
-            "usually M5",
+            "usually M5 (LinuxCNC: M63 on the laser output)",
             Rule::Text,
             |p| p.gcode.laser_off
         ),
@@ -458,7 +458,7 @@ pub fn profile_specs() -> Vec<FieldSpec<MachineProfile>> {
             "Feed",
             "mm/min",
             "gcode.feed_mm_min",
-            "on G1 moves",
+            "on G1 moves (LinuxCNC: the mark speed × 60, as the job is timed)",
             Positive,
             |p| p.gcode.feed_mm_min
         ),
@@ -533,7 +533,8 @@ pub fn profile_specs() -> Vec<FieldSpec<MachineProfile>> {
     .collect()
 }
 
-/// The controller's values (a profile's `[controller]` table).
+/// The controller's values (a profile's `[controller]` table), and the two choices of
+/// dialect and controller.
 fn controller_specs() -> Vec<FieldSpec<MachineProfile>> {
     use Rule::{Positive, Range};
     vec![
@@ -541,7 +542,7 @@ fn controller_specs() -> Vec<FieldSpec<MachineProfile>> {
             "Servo period",
             "s",
             "controller.servo_period_s",
-            "the controller's clock",
+            "LinuxCNC controller: its servo period (the clock its moves are timed on)",
             Range(1e-5, 0.01),
             |p| p.controller.servo_period_s
         ),
@@ -549,9 +550,22 @@ fn controller_specs() -> Vec<FieldSpec<MachineProfile>> {
             "Scanner accel",
             "mm/s²",
             "controller.scanner_accel_mm_s2",
-            "as the controller drives the scanner axes",
+            "LinuxCNC: the scanner axes' acceleration (its configuration and time law)",
             Positive,
             |p| p.controller.scanner_accel_mm_s2
+        ),
+        choice!("G-code dialect", "gcode.mode", |p| match p.gcode.mode {
+            GcodeMode::Tcp => "tool-centre point".into(),
+            GcodeMode::StageScanner => "stage and scanner axes".into(),
+            GcodeMode::Linuxcnc => "LinuxCNC".into(),
+        }),
+        choice!(
+            "Controller",
+            "controller.kind",
+            |p| match p.controller.kind {
+                ControllerKind::Ideal => "scan-head controller".into(),
+                ControllerKind::Linuxcnc => "LinuxCNC".into(),
+            }
         ),
     ]
 }
