@@ -29,7 +29,8 @@ cargo test --no-default-features --lib --bins
 cargo test --all-targets
 # LinuxCNC itself reads and runs galvoplan's programs on a headless simulated machine (installs
 # linuxcnc-uspace without recommends when missing: 123 packages, 80 MB; about 2 min of runs).
-cargo build --bin galvoplan
+# The binary is the one the integration tests just built (a plain `cargo build` would unify
+# features without the dev-dependencies and rebuild for 4 min).
 bash scripts/check-linuxcnc.sh "$CARGO_TARGET_DIR/debug/galvoplan"
 # The rerun recording (feature-gated: the rerun SDK is a third of the full build).
 cargo test --no-default-features --features rerun --test rerun

@@ -201,3 +201,55 @@ fn power_goes_to_the_analog_output_with_the_pen() {
     assert!(first_power < first_mark);
     assert!(g.contains("M68 E1 Q0\n"), "power off at the end");
 }
+
+#[test]
+fn linuxcnc_config_writes_the_machine_and_refuses_a_file_for_a_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("machine");
+    let run = |args: &[&std::ffi::OsStr]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_galvoplan"))
+            .args(args)
+            .output()
+            .unwrap()
+    };
+    let r = run(&[
+        "linuxcnc-config".as_ref(),
+        "--out".as_ref(),
+        out.as_os_str(),
+    ]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    for name in [
+        "galvoplan.ini",
+        "galvoplan.hal",
+        "galvoplan-timers.hal",
+        "galvoplan-run.py",
+    ] {
+        assert!(out.join(name).is_file(), "{name}");
+    }
+    let ini = std::fs::read_to_string(out.join("galvoplan.ini")).unwrap();
+    assert!(ini.contains("DISPLAY = ./galvoplan-run.py"));
+    // a file where the folder should be: an error naming it, nothing written
+    let file = dir.path().join("a-file");
+    std::fs::write(&file, "keep me").unwrap();
+    let r = run(&[
+        "linuxcnc-config".as_ref(),
+        "--out".as_ref(),
+        file.as_os_str(),
+    ]);
+    assert!(!r.status.success());
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(
+        err.contains("a-file") && err.contains("not a folder"),
+        "{err}"
+    );
+    assert_eq!(std::fs::read_to_string(&file).unwrap(), "keep me");
+    // an unknown profile is named
+    let r = run(&[
+        "linuxcnc-config".as_ref(),
+        "--profile".as_ref(),
+        "nope".as_ref(),
+        "--out".as_ref(),
+        out.as_os_str(),
+    ]);
+    assert!(String::from_utf8_lossy(&r.stderr).contains("nope"));
+}

@@ -622,13 +622,14 @@ impl App {
         match &r {
             Ok(o) => {
                 if group.is_none() {
-                    self.set_status(
-                        format!(
-                            "{what}: {} uncovered",
-                            count(o.uncovered.len(), "geometry", "geometries")
+                    let cover = match o.uncovered.len() {
+                        0 => "every geometry lies in a scan field".to_string(),
+                        n => format!(
+                            "{} outside every scan field",
+                            count(n, "geometry", "geometries")
                         ),
-                        false,
-                    );
+                    };
+                    self.set_status(format!("{what}: {cover}"), false);
                 }
                 if o.uncovered.is_empty() && self.session.problem.is_some() {
                     self.session.problem = None;
