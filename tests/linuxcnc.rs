@@ -184,6 +184,12 @@ fn linuxcnc_profile_values_are_checked_by_name() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("Servo period"), "{e}");
+    // LinuxCNC's time law times only the LinuxCNC program
+    let bad = "version = 3\n[controller]\nkind = \"linuxcnc\"\n";
+    let e = MachineProfile::from_toml(bad, "p.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("Controller") && e.contains("dialect"), "{e}");
     // version-2 files stay valid, on the scan head's timing
     let p = MachineProfile::from_toml("version = 2\n", "p.toml").unwrap();
     assert!(LinuxcncClock::of(&p).is_none());

@@ -327,6 +327,10 @@ impl Editors {
         let mut p = profile.clone();
         combo(ui, "G-code dialect", &mut p.gcode.mode, GCODE_DIALECTS);
         combo(ui, "Controller", &mut p.controller.kind, CONTROLLERS);
+        if p.gcode.mode != profile.gcode.mode && p.gcode.mode != GcodeMode::Linuxcnc {
+            // LinuxCNC's time law times only LinuxCNC's program
+            p.controller.kind = ControllerKind::Ideal;
+        }
         if p != *profile {
             match validate_profile(&p) {
                 Ok(()) => {

@@ -395,6 +395,18 @@ impl MachineProfile {
                 format!("less than half the field ({half_field_mm} mm)"),
             ));
         }
+        if self.controller.kind == ControllerKind::Linuxcnc
+            && self.gcode.mode != GcodeMode::Linuxcnc
+        {
+            // the time law is that of the program the LinuxCNC dialect writes (G61 exact
+            // stops, G93 lines): any other program would run at another pace than the one shown
+            return Err(InvalidValue::new(
+                "Controller",
+                "controller.kind",
+                "LinuxCNC",
+                "the scan-head controller unless the G-code dialect is LinuxCNC",
+            ));
+        }
         let [u, v] = &self.gcode.scanner_axes;
         if self.gcode.mode != GcodeMode::Tcp
             && (u == v || [u, v].iter().any(|w| ["X", "Y"].contains(&w.trim())))

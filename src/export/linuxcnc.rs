@@ -60,6 +60,8 @@ struct Program<'a, 'w> {
     dwell_s: f64,
     /// The pen whose power and feed were last written (layer index; none: the profile's).
     pen: Option<Option<usize>>,
+    /// That pen's feed (F), mm/min.
+    feed: String,
     /// Layer comments are written (the plan's layers have pens of their own).
     comment_layers: bool,
 }
@@ -73,6 +75,7 @@ impl<'a, 'w> Program<'a, 'w> {
             lit: false,
             dwell_s: 0.0,
             pen: None,
+            feed: String::new(),
             comment_layers: false,
         }
     }
@@ -127,56 +130,46 @@ impl<'a, 'w> Program<'a, 'w> {
         }
     }
 
-    /// Power, feed and layer comment of a stroke's pen, where it changes.
+    /// The feed (F) of a stroke's pen; where the pen changes, its layer comment and power
+    /// first.
     fn pen_for(
         &mut self,
         plan: &Plan,
         layer: Option<usize>,
         stroke: usize,
     ) -> Result<String, GcodeError> {
-        let words = match layer {
-            None => PenWords::of(self.w, None),
-            Some(l) => PenWords::of(
-                self.w,
-                Some(
-                    plan.layers
-                        .get(l)
-                        .ok_or(GcodeError::NoLayer { stroke, layer: l })?,
-                ),
+        if self.pen == Some(layer) {
+            return Ok(self.feed.clone());
+        }
+        let pen_layer = match layer {
+            None => None,
+            Some(l) => Some(
+                plan.layers
+                    .get(l)
+                    .ok_or(GcodeError::NoLayer { stroke, layer: l })?,
             ),
         };
-        if self.pen != Some(layer) {
-            self.pen = Some(layer);
-            if self.comment_layers {
-                if let Some(c) = &words.comment {
-                    let _ = writeln!(self.out, "({})", comment_text(c.trim_start_matches("; ")));
-                }
-            }
-            if let Some(power) = words.power {
-                match self.profile.gcode.power_output {
-                    Some(e) => {
-                        let _ = writeln!(self.out, "M67 E{e} Q{}", self.w.num(power));
-                    }
-                    None => {
-                        let _ = writeln!(
-                            self.out,
-                            "{}{}",
-                            self.profile.gcode.power_word,
-                            self.w.num(power)
-                        );
-                    }
-                }
+        let words = PenWords::of(self.w, pen_layer);
+        self.pen = Some(layer);
+        if self.comment_layers {
+            if let Some(c) = &words.comment {
+                let _ = writeln!(self.out, "({})", comment_text(c.trim_start_matches("; ")));
             }
         }
-        // the feed the toolpath was timed with: the pen's mark speed (the dialects' feed word
-        // may differ from it in a profile; this program runs what was planned)
-        let speed = layer
-            .and_then(|l| plan.layers.get(l))
-            .map_or(self.profile.scanner.mark_speed_mm_s, |l| {
-                l.pen.mark_speed_mm_s(self.profile)
-            });
-        let _ = words.feed;
-        Ok(self.w.num(speed * 60.0))
+        if let Some(power) = words.power {
+            let d = &self.profile.gcode;
+            let _ = match d.power_output {
+                Some(e) => writeln!(self.out, "M67 E{e} Q{}", self.w.num(power)),
+                None => writeln!(self.out, "{}{}", d.power_word, self.w.num(power)),
+            };
+        }
+        // the feed the toolpath was timed with: the pen's mark speed (the other dialects' feed
+        // word may differ from it in a profile; this program runs what was planned)
+        let speed = pen_layer.map_or(self.profile.scanner.mark_speed_mm_s, |l| {
+            l.pen.mark_speed_mm_s(self.profile)
+        });
+        self.feed = self.w.num(speed * 60.0);
+        Ok(self.feed.clone())
     }
 
     fn scan_words(&self, offset: Pt) -> String {
@@ -308,7 +301,7 @@ impl<'a, 'w> Program<'a, 'w> {
     }
 }
 
-/// Seconds for `G4 P`: microseconds resolved, trailing zeros trimmed.
+/// Seconds for `G4 P`: to 0.1 µs, trailing zeros trimmed.
 fn fmt_s(v: f64) -> String {
     crate::geom::format_mm(v, 7)
 }

@@ -61,7 +61,7 @@ pub fn linuxcnc_config(profile: &MachineProfile) -> Vec<ConfigFile> {
         },
         ConfigFile {
             name: "galvoplan-timers.hal",
-            text: timers_hal(profile),
+            text: TIMERS_HAL.to_string(),
             executable: false,
         },
         ConfigFile {
@@ -89,35 +89,25 @@ fn axes(profile: &MachineProfile) -> Vec<Axis> {
         .jump_speed_mm_s
         .max(profile.scanner.mark_speed_mm_s);
     let words = &profile.gcode.scanner_axes;
+    let stage = |letter: &str, k: usize, limits: &crate::document::AxisLimits| Axis {
+        letter: letter.into(),
+        min_mm: -LIMIT_MARGIN_MM,
+        max_mm: profile.stroke_mm[k] + LIMIT_MARGIN_MM,
+        velocity_mm_s: limits.max_velocity_mm_s,
+        accel_mm_s2: limits.max_accel_mm_s2,
+    };
+    let scanner = |k: usize| Axis {
+        letter: words[k].trim().to_uppercase(),
+        min_mm: -half(k),
+        max_mm: half(k),
+        velocity_mm_s: scanner_velocity,
+        accel_mm_s2: profile.controller.scanner_accel_mm_s2,
+    };
     vec![
-        Axis {
-            letter: "X".into(),
-            min_mm: -LIMIT_MARGIN_MM,
-            max_mm: profile.stroke_mm[0] + LIMIT_MARGIN_MM,
-            velocity_mm_s: profile.axis_x.max_velocity_mm_s,
-            accel_mm_s2: profile.axis_x.max_accel_mm_s2,
-        },
-        Axis {
-            letter: "Y".into(),
-            min_mm: -LIMIT_MARGIN_MM,
-            max_mm: profile.stroke_mm[1] + LIMIT_MARGIN_MM,
-            velocity_mm_s: profile.axis_y.max_velocity_mm_s,
-            accel_mm_s2: profile.axis_y.max_accel_mm_s2,
-        },
-        Axis {
-            letter: words[0].trim().to_uppercase(),
-            min_mm: -half(0),
-            max_mm: half(0),
-            velocity_mm_s: scanner_velocity,
-            accel_mm_s2: profile.controller.scanner_accel_mm_s2,
-        },
-        Axis {
-            letter: words[1].trim().to_uppercase(),
-            min_mm: -half(1),
-            max_mm: half(1),
-            velocity_mm_s: scanner_velocity,
-            accel_mm_s2: profile.controller.scanner_accel_mm_s2,
-        },
+        stage("X", 0, &profile.axis_x),
+        stage("Y", 1, &profile.axis_y),
+        scanner(0),
+        scanner(1),
     ]
 }
 
@@ -249,8 +239,8 @@ net laser-gate motion.digital-out-{n:02}
     s
 }
 
-fn timers_hal(profile: &MachineProfile) -> String {
-    let _ = profile;
+/// The timers' HAL file (the same for every profile).
+const TIMERS_HAL: &str =
     "# Timers of the running program, read by galvoplan-run.py (servo periods added up):
 #   t-run: the program runs; t-laser: the laser output is on; t-move: the machine moves;
 #   t-laser-move: the laser is on while the machine moves; t-job: from the laser's first
@@ -287,9 +277,7 @@ net tm-laser-move-v tm-laser-move-f.out => t-laser-move.in
 net tm-job-v tm-job-f.out => t-job.in
 # halui's pins exist only once halui runs: galvoplan-run.py nets
 # halui.program.is-running to tm-run-f.in and tm-job.in1.
-"
-    .to_string()
-}
+";
 
 fn readme(profile: &MachineProfile, axes: &[Axis]) -> String {
     let d = &profile.gcode;

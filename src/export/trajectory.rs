@@ -45,19 +45,30 @@ pub fn trajectory_csv(toolpath: &Toolpath, period_s: f64) -> String {
     out.push('\n');
     for k in 0..samples {
         let t_s = k as f64 * period_s;
-        let m = toolpath.state_at(t_s);
-        let _ = writeln!(
-            out,
-            "{:.7},{:.6},{:.6},{:.6},{:.6},{}",
-            t_s,
-            m.stage.x,
-            m.stage.y,
-            m.scan.x,
-            m.scan.y,
-            u8::from(m.laser)
-        );
+        push_row(&mut out, t_s, &toolpath.state_at(t_s), 7, 6);
     }
     out
+}
+
+/// One CSV row in [`TRAJECTORY_HEADER`]'s columns: time with `t_decimals`, positions (mm) with
+/// `mm_decimals`.
+fn push_row(
+    out: &mut String,
+    t_s: f64,
+    m: &crate::motion::MachineState,
+    t_decimals: usize,
+    mm_decimals: usize,
+) {
+    let (t, p) = (t_decimals, mm_decimals);
+    let _ = writeln!(
+        out,
+        "{t_s:.t$},{:.p$},{:.p$},{:.p$},{:.p$},{}",
+        m.stage.x,
+        m.stage.y,
+        m.scan.x,
+        m.scan.y,
+        u8::from(m.laser)
+    );
 }
 
 /// The toolpath's exact states, one CSV row each (the trajectory's columns): the start, every
@@ -71,16 +82,8 @@ pub fn waypoints_csv(toolpath: &Toolpath) -> String {
     out.push_str(TRAJECTORY_HEADER);
     out.push('\n');
     for (t_s, m) in states {
-        let _ = writeln!(
-            out,
-            "{:.9},{:.7},{:.7},{:.7},{:.7},{}",
-            t_s,
-            m.stage.x,
-            m.stage.y,
-            m.scan.x,
-            m.scan.y,
-            u8::from(m.laser)
-        );
+        // exact states: time to the nanosecond, positions to 0.1 µm
+        push_row(&mut out, t_s, &m, 9, 7);
     }
     out
 }

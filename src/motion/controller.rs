@@ -99,8 +99,8 @@ impl LinuxcncClock {
         })
     }
 
-    /// Time of a polyline marked at `feed_mm_s` through `points` (offsets of one axis pair:
-    /// `stage` false for the scanner's), one exact-stop move per edge.
+    /// Time of a polyline marked by the scanner at `feed_mm_s` through `points` (the stage at
+    /// rest), one exact-stop move per edge.
     pub fn polyline_s(&self, points: &[crate::geom::Pt], feed_mm_s: f64) -> f64 {
         points
             .windows(2)

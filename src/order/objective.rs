@@ -86,6 +86,15 @@ impl<'a> StepTime<'a> {
         }
     }
 
+    /// A step's field centre and its stroke's start and end; none when the step names a field
+    /// or geometry that does not exist.
+    fn place(&self, s: &Step) -> Option<(Pt, Pt, Pt)> {
+        let g = self.geometries.get(s.geometry)?;
+        let centre = *self.centre.get(&s.field)?;
+        let (start, end) = g.ends(s.choice(g));
+        Some((centre, start, end))
+    }
+
     fn sum(&self, steps: &[Step]) -> f64 {
         if let Some(clock) = &self.clock {
             return self.sum_clocked(steps, clock);
@@ -93,12 +102,9 @@ impl<'a> StepTime<'a> {
         let mut t = 0.0;
         let (mut stage_at, mut scan_at) = (Pt::default(), Pt::default());
         for (k, s) in steps.iter().enumerate() {
-            let (Some(g), Some(&centre)) =
-                (self.geometries.get(s.geometry), self.centre.get(&s.field))
-            else {
+            let Some((centre, start, end)) = self.place(s) else {
                 return f64::INFINITY;
             };
-            let (start, end) = g.ends(s.choice(g));
             let offset = start.minus(centre);
             if k == 0 {
                 stage_at = centre;
@@ -139,12 +145,9 @@ impl StepTime<'_> {
             }
         };
         for (k, s) in steps.iter().enumerate() {
-            let (Some(g), Some(&centre)) =
-                (self.geometries.get(s.geometry), self.centre.get(&s.field))
-            else {
+            let Some((centre, start, end)) = self.place(s) else {
                 return f64::INFINITY;
             };
-            let (start, end) = g.ends(s.choice(g));
             let offset = start.minus(centre);
             if k == 0 {
                 stage_at = centre;
