@@ -6,8 +6,11 @@ use crate::document::{
     Warning,
 };
 use crate::fields::{
-    check_artwork, place_fields, split_oversize, FieldError, Placement, SPLIT_WORDS,
+    check_artwork, cut_hatch_at_tiling, place_fields, split_oversize, FieldError, Placement,
+    SPLIT_WORDS,
 };
+use crate::geom::seam::SeamStats;
+use crate::geom::tiling::Tiling;
 use crate::hatch::{layer_geometries, HatchError};
 use crate::import::{import_file, ImportError, ImportOptions, SkippedLayer};
 use crate::job::JobCtx;
@@ -230,14 +233,18 @@ pub fn derive_geometries(doc: &mut Document, ctx: &JobCtx) -> Result<f64, Pipeli
     }
     doc.uncut_geometries = None;
     drop_cut_warnings(&mut doc.warnings);
-    let made = layer_geometries(&doc.artwork, &doc.layers, doc.profile.field_mm, ctx).map_err(
-        |source| PipelineError::Hatch {
+    let made = layer_geometries(&doc.artwork, &doc.layers, ctx).map_err(|source| {
+        PipelineError::Hatch {
             file: doc.source.clone().unwrap_or_else(|| "document".into()),
             source,
-        },
-    )?;
+        }
+    })?;
+    // fills larger than a field are cut on the document's tiling
+    let (tiling, cut) = cut_hatch_at_tiling(made.geometries, &doc.layers, doc.profile.field_mm);
+    doc.tiling = tiling;
+    doc.seams = cut.stats;
     // indices may change: the fields go, the plans keep the geometries they were planned on
-    doc.set_geometries(made.geometries);
+    doc.set_geometries(cut.geometries);
     for w in made.warnings {
         if !doc.warnings.contains(&w) {
             doc.warnings.push(w);
@@ -251,6 +258,7 @@ pub fn derive_geometries(doc: &mut Document, ctx: &JobCtx) -> Result<f64, Pipeli
 pub fn default_pen(settings: &SolverSettings) -> Pen {
     Pen {
         hatch: settings.hatch.clone(),
+        seam: settings.seam,
         ..Pen::default()
     }
 }
@@ -352,6 +360,7 @@ fn place_and_choose(doc: &mut Document, ctx: &JobCtx) -> Result<(usize, Made), P
         // a placement that may not cut starts again from the whole geometries
         if let Some(whole) = doc.uncut_geometries.take() {
             doc.set_geometries(whole);
+            doc.seams = std::mem::take(&mut doc.uncut_seams);
             drop_cut_warnings(&mut doc.warnings);
         }
     }
@@ -368,9 +377,14 @@ fn place_and_choose(doc: &mut Document, ctx: &JobCtx) -> Result<(usize, Made), P
             source,
         })?;
         let mut geometries = doc.geometries.clone();
-        let warnings = split_oversize(&mut geometries, doc.profile.field_mm);
+        let (warnings, seams, tiling) = split_oversize(
+            &mut geometries,
+            doc.tiling.as_ref(),
+            &doc.layers,
+            doc.profile.field_mm,
+        );
         if !warnings.is_empty() {
-            cut_geometries(doc, geometries, warnings);
+            cut_geometries(doc, geometries, warnings, seams, tiling);
         }
     }
     let locked: Vec<ScanField> = doc.fields.iter().filter(|f| f.locked).cloned().collect();
@@ -431,7 +445,12 @@ fn whole_or_cut(
     } else {
         // cut: fields on the pieces, every motion allowed
         let mut pieces = doc.geometries.clone();
-        let cuts = split_oversize(&mut pieces, doc.profile.field_mm);
+        let (cuts, seams, tiling) = split_oversize(
+            &mut pieces,
+            doc.tiling.as_ref(),
+            &doc.layers,
+            doc.profile.field_mm,
+        );
         let cut_placement = place_fields(&pieces, &doc.profile, &judge.settings, locked, ctx)
             .map_err(|source| PipelineError::Fields {
                 file: file.clone(),
@@ -447,7 +466,7 @@ fn whole_or_cut(
             ("cut".to_string(), cut.0.metrics.solve_s.order),
         ];
         let (mut made, lower_bound, note) = if cut.1.duration_s() < whole.1.duration_s() {
-            cut_geometries(doc, pieces, cuts);
+            cut_geometries(doc, pieces, cuts, seams, tiling);
             doc.fields = cut_placement.fields;
             let note = format!("cut at field borders: the job takes {cut_s} s cut against {whole_s} s marked whole on the fly");
             (cut, cut_placement.lower_bound, note)
@@ -485,11 +504,19 @@ fn cut_geometries(
     doc: &mut Document,
     pieces: Vec<crate::document::Geometry>,
     warnings: Vec<Warning>,
+    seams: SeamStats,
+    tiling: Option<Tiling>,
 ) {
     let whole = doc.geometries.clone();
+    let whole_seams = doc.seams.clone();
     // indices changed: the plans keep the geometries they were planned on
-    if doc.set_geometries(pieces) && doc.uncut_geometries.is_none() {
-        doc.uncut_geometries = Some(whole);
+    if doc.set_geometries(pieces) {
+        if doc.uncut_geometries.is_none() {
+            doc.uncut_geometries = Some(whole);
+            doc.uncut_seams = whole_seams;
+        }
+        doc.seams.merge(seams);
+        doc.tiling = tiling;
     }
     for w in warnings {
         if !doc.warnings.contains(&w) {
@@ -575,6 +602,8 @@ fn complete_plan(
     ctx: &JobCtx,
 ) -> Result<(Plan, Toolpath), PipelineError> {
     plan.metrics.solve_s.total = plan.metrics.solve_s.order;
+    plan.tiling = doc.tiling.clone();
+    plan.seams = doc.seams.clone();
     if plan_seed_route(doc, &mut plan, ctx)? {
         toolpath = relower(doc, &mut plan)?;
     }

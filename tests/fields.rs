@@ -190,7 +190,7 @@ fn oversize_geometries_error_or_split() {
         "{msg}"
     );
     let before: f64 = gs.iter().map(Geometry::length_mm).sum();
-    let warnings = split_oversize(&mut gs, p.field_mm);
+    let (warnings, _, _) = split_oversize(&mut gs, None, &[], p.field_mm);
     assert_eq!(warnings.len(), 2);
     let after: f64 = gs.iter().map(Geometry::length_mm).sum();
     assert!((before - after).abs() < 1e-9);

@@ -9,10 +9,12 @@ mod tsp;
 
 use anyhow::Result;
 use clap::{Args, Parser, Subcommand, ValueEnum};
+use galvoplan::document::FillShapes;
 use galvoplan::document::{
     Algo, CostModel, FieldsMode, MachineProfile, MotionMode, PenLibrary, RouteGaSettings,
     SolverSettings, StageRouteKind, VertexMode,
 };
+use galvoplan::geom::seam::SeamForm;
 use galvoplan::hatch::{HatchSettings, OutlineMode};
 use galvoplan::import::{HiddenLayers, ImportOptions, Place};
 use std::path::PathBuf;
@@ -209,6 +211,31 @@ struct JobOpts {
     /// Outlines of hatched shapes: marked before the hatch, after it, or not at all.
     #[arg(long, value_enum, requires = "hatch")]
     hatch_outline: Option<OutlineArg>,
+    /// Which closed shapes of a layer are filled as one region: together (even-odd across the
+    /// layer: a shape inside another is a hole) or apart (each drawing element on its own).
+    #[arg(long, value_enum, requires = "hatch")]
+    hatch_shapes: Option<ShapesArg>,
+    /// How strokes are cut where they cross a seam (artwork larger than a field): straight,
+    /// overlap:D[:doubled] (each side marks D mm past the cut; kept dose alternates the ends
+    /// line by line, doubled marks 2·D twice), interlocked:BAND (cuts alternate ±BAND/2 line by
+    /// line) or staggered:BAND[:SEED] (a seeded random offset per line within the band). The
+    /// default pen's; a pen library sets it per layer (`seam = "..."`).
+    #[arg(long, value_name = "FORM", default_value = "straight", value_parser = parse_seam)]
+    seam: SeamForm,
+}
+
+/// Parses `--seam`.
+fn parse_seam(s: &str) -> Result<SeamForm, String> {
+    SeamForm::parse(s)
+}
+
+/// Which shapes are filled together, as on the command line.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+enum ShapesArg {
+    /// All closed shapes of a layer form one region (even-odd).
+    Together,
+    /// Each drawing element is filled on its own.
+    Apart,
 }
 
 /// Outline handling of hatched shapes, as on the command line.
@@ -330,6 +357,7 @@ impl JobOpts {
                 ..Default::default()
             },
             hatch: self.hatch()?,
+            seam: self.seam,
         })
     }
     fn hatch(&self) -> Result<Option<HatchSettings>> {
@@ -343,6 +371,12 @@ impl JobOpts {
                 OutlineArg::Before => OutlineMode::Before,
                 OutlineArg::After => OutlineMode::After,
                 OutlineArg::None => OutlineMode::None,
+            };
+        }
+        if let Some(shapes) = self.hatch_shapes {
+            h.shapes = match shapes {
+                ShapesArg::Together => FillShapes::Together,
+                ShapesArg::Apart => FillShapes::Apart,
             };
         }
         h.check().map_err(|e| anyhow::anyhow!("--hatch: {e}"))?;

@@ -34,6 +34,14 @@ pub struct Geometry {
     /// the import gave none. Hatch output keeps its region's layer.
     #[serde(default = "default_layer")]
     pub layer: String,
+    /// 0: marked as many times as its pen's passes. k ≥ 1: pass k of a pen with shifted passes,
+    /// cut on that pass's own tiling and marked once.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub pass: u32,
+}
+
+fn is_zero(v: &u32) -> bool {
+    *v == 0
 }
 
 fn default_layer() -> String {
@@ -70,11 +78,17 @@ impl Geometry {
             closed,
             source,
             layer,
+            pass: 0,
         }
     }
     /// The same geometry on layer `name`.
     pub fn with_layer(mut self, name: &str) -> Self {
         self.layer = name.to_string();
+        self
+    }
+    /// The same geometry as pass `pass` of a pen with shifted passes (see [`Geometry::pass`]).
+    pub fn with_pass(mut self, pass: u32) -> Self {
+        self.pass = pass;
         self
     }
     /// Bounding box.

@@ -75,6 +75,19 @@ pub enum FillRule {
     NonZero,
 }
 
+/// Which closed shapes of a layer form one region to fill.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum FillShapes {
+    /// All the layer's closed shapes together, by the fill rule (a shape inside another is a
+    /// hole with even-odd; overlapping shapes are filled once), as LightBurn does.
+    #[default]
+    Together,
+    /// Each drawing element (SVG element, DXF entity) on its own, as SVG paints them: shapes
+    /// that overlap are filled once each.
+    Apart,
+}
+
 /// Hatch settings for the closed regions of a document.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
@@ -97,6 +110,8 @@ pub struct HatchSettings {
     pub border: bool,
     /// Fill rule that turns nested contours into a region.
     pub fill_rule: FillRule,
+    /// Whether the layer's shapes are filled together or each on its own.
+    pub shapes: FillShapes,
 }
 
 impl Default for HatchSettings {
@@ -109,6 +124,7 @@ impl Default for HatchSettings {
             outline: OutlineMode::default(),
             border: true,
             fill_rule: FillRule::default(),
+            shapes: FillShapes::default(),
         }
     }
 }

@@ -16,11 +16,13 @@ mod warning;
 
 pub use artwork_import::{ArtworkImport, LayerHidden, Place, PlaceError, SkippedLayer};
 pub use geometry::{is_hatch_output, Geometry, Source, HATCH_LAYER_PREFIX};
-pub use hatch::{FillRule, HatchSettings, HatchSpecError, HatchStyle, OutlineMode, MIN_SPACING_MM};
+pub use hatch::{
+    FillRule, FillShapes, HatchSettings, HatchSpecError, HatchStyle, OutlineMode, MIN_SPACING_MM,
+};
 pub use inputs::{staleness, GeometryRevision, PlanInputs};
 pub use pens::{
-    parse_colour, pen_of, sync_layers, validate_layers, Layer, Pen, PenLibrary, PensError,
-    DEFAULT_LAYER, MAX_PASSES, PENS_VERSION,
+    parse_colour, passes_of, pen_of, sync_layers, validate_layers, Layer, Pen, PenLibrary,
+    PensError, DEFAULT_LAYER, MAX_PASSES, PENS_VERSION,
 };
 pub use plan::{
     GenerationRecord, Metrics, MotionFigures, ObjectiveKind, Plan, ScanField, StageTimes, Step,
@@ -39,15 +41,21 @@ pub use settings::{
     StageRouteKind, VertexMode,
 };
 
+use crate::geom::seam::{SeamForm, SeamStats};
+use crate::geom::tiling::Tiling;
 use serde::{Deserialize, Serialize};
 pub use warning::{short_list, Warning, LIST_MAX};
 
 /// The parts of the layer table and profile that decide the marked geometries: per layer its
-/// name, whether it is enabled and its hatch; the field size (hatch is cut at field cells).
+/// name, whether it is enabled, its hatch and seam form; the field size (hatch is cut at the
+/// seams of a tiling of field-sized cells).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct DerivedKey {
     /// (name, enabled, hatch) per layer.
     pub layers: Vec<(String, bool, Option<HatchSettings>)>,
+    /// Seam form and shifted passes (with the passes) per layer.
+    #[serde(default)]
+    pub seams: Vec<(SeamForm, bool, u32)>,
     /// Scan-field size, mm.
     pub field_mm: [f64; 2],
 }
@@ -59,6 +67,10 @@ impl DerivedKey {
             layers: layers
                 .iter()
                 .map(|l| (l.name.clone(), l.pen.enabled, l.pen.hatch.clone()))
+                .collect(),
+            seams: layers
+                .iter()
+                .map(|l| (l.pen.seam, l.pen.shift_passes, l.pen.passes))
                 .collect(),
             field_mm,
         }
@@ -93,6 +105,15 @@ pub struct Document {
     /// the split setting) starts again from these. Not saved: a project reopens as it was cut.
     #[serde(skip)]
     pub uncut_geometries: Option<Vec<Geometry>>,
+    /// The seams of `uncut_geometries` (the hatch's cut alone).
+    #[serde(skip)]
+    pub uncut_seams: SeamStats,
+    /// The tiling that cuts what is larger than a field (none: nothing is).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tiling: Option<Tiling>,
+    /// What the cuts of `geometries` at the tiling's seams did.
+    #[serde(default)]
+    pub seams: SeamStats,
     /// Warnings from the import (skipped elements, degenerate paths).
     pub warnings: Vec<Warning>,
     /// The machine the job is planned for.

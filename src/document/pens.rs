@@ -9,6 +9,7 @@
 use super::validate::InvalidValue;
 use super::HatchSettings;
 use super::{Geometry, MachineProfile};
+use crate::geom::seam::SeamForm;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
@@ -46,6 +47,13 @@ pub struct Pen {
     pub passes: u32,
     /// Hatch fill of the layer's closed shapes; none: outlines only.
     pub hatch: Option<HatchSettings>,
+    /// How the layer's strokes are cut where they cross a seam of the tiling (artwork larger
+    /// than a field).
+    pub seam: SeamForm,
+    /// With several passes, each pass after the first is cut on a tiling shifted by
+    /// `pass / passes` of a cell, so no two passes cut at the same place (more fields, more
+    /// job time; the plan reports both).
+    pub shift_passes: bool,
     /// Display colour `#rrggbb`; unset: from the layer's name when that is a colour, else from
     /// a palette.
     pub colour: Option<String>,
@@ -60,6 +68,8 @@ impl Default for Pen {
             frequency_khz: None,
             passes: 1,
             hatch: None,
+            seam: SeamForm::Straight,
+            shift_passes: false,
             colour: None,
         }
     }
@@ -138,6 +148,10 @@ struct LayerFile {
     #[serde(default)]
     hatch: Option<HatchSettings>,
     #[serde(default)]
+    seam: SeamForm,
+    #[serde(default)]
+    shift_passes: bool,
+    #[serde(default)]
     colour: Option<String>,
 }
 
@@ -160,6 +174,8 @@ impl From<LayerFile> for Layer {
                 frequency_khz: f.frequency_khz,
                 passes: f.passes,
                 hatch: f.hatch,
+                seam: f.seam,
+                shift_passes: f.shift_passes,
                 colour: f.colour,
             },
         }
@@ -214,6 +230,15 @@ pub fn parse_colour(text: &str) -> Option<[u8; 3]> {
 /// The pen of `g`'s layer, if the table has it.
 pub fn pen_of<'a>(layers: &'a [Layer], g: &Geometry) -> Option<&'a Pen> {
     layers.iter().find(|l| l.name == g.layer).map(|l| &l.pen)
+}
+
+/// How many times geometry `g` is marked: its pen's passes, or once for one pass of a pen with
+/// shifted passes (each pass is a geometry of its own, [`Geometry::pass`]).
+pub fn passes_of(layers: &[Layer], g: &Geometry) -> u32 {
+    if g.pass > 0 {
+        return 1;
+    }
+    pen_of(layers, g).map_or(1, |p| p.passes.max(1))
 }
 
 /// Checks every layer and that names are unique.

@@ -294,6 +294,12 @@ pub struct Plan {
     /// ([`super::Document::plan_geometries`]).
     #[serde(default)]
     pub geometry_rev: u64,
+    /// The tiling its geometries were cut on (none: nothing larger than a field).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tiling: Option<crate::geom::tiling::Tiling>,
+    /// What cutting at the tiling's seams did (cuts, seams, length marked twice).
+    #[serde(default)]
+    pub seams: crate::geom::seam::SeamStats,
 }
 
 impl Plan {
@@ -318,6 +324,8 @@ impl Plan {
             profile: inputs.profile.clone(),
             settings: inputs.settings.clone(),
             geometry_rev: inputs.geometry_rev,
+            tiling: None,
+            seams: Default::default(),
         }
     }
     /// The pen of geometry `g` in this plan (none: the profile's settings).

@@ -305,6 +305,10 @@ pub struct SolverSettings {
     /// Hatch fills for closed regions (none: outlines only).
     #[serde(default)]
     pub hatch: Option<super::HatchSettings>,
+    /// The seam form of the default pen (layers no pen library names): how strokes are cut
+    /// where they cross a seam of the tiling.
+    #[serde(default)]
+    pub seam: crate::geom::seam::SeamForm,
 }
 
 impl Default for SolverSettings {
@@ -324,6 +328,7 @@ impl Default for SolverSettings {
             split_oversize: false,
             ga: GaParams::default(),
             hatch: None,
+            seam: Default::default(),
         }
     }
 }

@@ -61,8 +61,30 @@ pub struct Report<'a> {
     pub pens: &'a [Layer],
     /// GA convergence history.
     pub history: &'a [GenerationRecord],
+    /// Seams: where artwork larger than a field was cut.
+    pub seams: ReportSeams<'a>,
     /// Import warnings.
     pub warnings: Vec<String>,
+}
+
+/// The seams in the report.
+#[derive(Debug, Serialize)]
+pub struct ReportSeams<'a> {
+    /// Seam lines that cut something.
+    pub count: usize,
+    /// Their length through marked area, mm.
+    pub length_mm: f64,
+    /// Cuts made.
+    pub cuts: usize,
+    /// Strokes cut into pieces.
+    pub split_strokes: usize,
+    /// Length marked twice on purpose (doubled overlap seams), mm: what a checker allows above
+    /// the artwork's length.
+    pub extra_marked_mm: f64,
+    /// The tiling's cell borders (none: nothing was larger than a field).
+    pub tiling: Option<&'a crate::geom::tiling::Tiling>,
+    /// Each seam line and its stretches through marked area.
+    pub lines: &'a [crate::geom::seam::SeamLine],
 }
 
 /// Builds the report as pretty JSON text: everything of the plan's own (its inputs, enough to
@@ -101,6 +123,15 @@ pub fn report_json(source: &str, plan: &Plan, warnings: &[Warning]) -> String {
         profile: &plan.profile,
         pens: &plan.layers,
         history: &plan.history,
+        seams: ReportSeams {
+            count: plan.seams.seams(),
+            length_mm: plan.seams.length_mm(),
+            cuts: plan.seams.cuts,
+            split_strokes: plan.seams.split_strokes,
+            extra_marked_mm: plan.seams.extra_marked_mm,
+            tiling: plan.tiling.as_ref(),
+            lines: &plan.seams.lines,
+        },
         warnings: warnings.iter().map(|w| w.to_string()).collect(),
     };
     serde_json::to_string_pretty(&r).unwrap_or_else(|e| format!("{{\"error\": \"{e}\"}}"))

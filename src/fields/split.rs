@@ -1,18 +1,22 @@
-//! `--split-oversize`: geometries larger than a field are cut into pieces that each fit one field.
+//! Cutting geometries larger than a field at the seams of one chosen tiling.
 //!
-//! The cut lines form one grid of field-sized cells anchored at the corner of all the oversize
-//! geometries (so pieces of different geometries share cells, and fields);
-//! the polyline is split exactly where it crosses a cell border, so the pieces together mark
-//! exactly the original (nothing lost, nothing twice). A closed geometry becomes open pieces; its
-//! first and last piece are joined when they lie in the same cell.
+//! One tiling ([`crate::geom::tiling`]) is chosen for the whole document over everything that
+//! must be cut: fills whose strokes do not fit a field, and geometries larger than a field. The
+//! hatch stage's strokes are cut on it when the geometries are made ([`cut_hatch_at_tiling`]);
+//! outlines and other oversize geometries are cut on the same tiling when the settings split
+//! them ([`split_oversize`]), so every cut lies on one of a few shared straight seams (or within
+//! its band, per the pen's [`SeamForm`]) and a field centred on each cell holds all its pieces.
+//! Small geometries are not cut; the tiling avoids crossing them.
 
 use super::INSIDE_EPS_MM;
-use crate::document::Warning;
+use crate::document::{is_hatch_output, pen_of, Layer, Warning};
 use crate::document::{Geometry, Source};
-use crate::geom::Pt;
+use crate::geom::seam::{cut_at_seams, SeamForm, SeamStats};
+use crate::geom::tiling::{choose_tiling, Tiling, TilingInput};
+use crate::geom::BBox;
 
-/// Pieces shorter than this (mm) are dropped: below the resolution of the exported G-code.
-pub const MIN_PIECE_MM: f64 = 1e-3;
+/// Cells are smaller than the field by this much on each side, mm, so pieces fit with slack.
+pub const FIT_MARGIN_MM: f64 = 1e-3;
 
 /// The words of a cut's warning ("geometry 3 (… mm) is larger than the scan field: split into
 /// 4 strokes at field borders"), by which the cut's warnings are found again.
@@ -24,139 +28,315 @@ pub fn is_oversize(g: &Geometry, field_mm: [f64; 2]) -> bool {
     b.width() > field_mm[0] + INSIDE_EPS_MM || b.height() > field_mm[1] + INSIDE_EPS_MM
 }
 
-/// Cuts one geometry at the borders of a grid of cells of `pitch_mm` (per axis) anchored at
-/// `origin`.
-pub fn split_geometry(g: &Geometry, origin: Pt, pitch_mm: [f64; 2]) -> Vec<Geometry> {
-    let cell = |p: Pt| -> (i64, i64) {
-        (
-            ((p.x - origin.x) / pitch_mm[0]).floor() as i64,
-            ((p.y - origin.y) / pitch_mm[1]).floor() as i64,
-        )
-    };
-    let mut path = g.points.clone();
-    if g.closed {
-        if let Some(&f) = path.first() {
-            path.push(f);
-        }
-    }
-    // pieces as (cell, points)
-    let mut pieces: Vec<((i64, i64), Vec<Pt>)> = Vec::new();
-    for w in path.windows(2) {
-        let (a, z) = (w[0], w[1]);
-        let d = z.minus(a);
-        let mut ts = vec![0.0, 1.0];
-        for (axis, (da, oa, pa)) in [(d.x, origin.x, a.x), (d.y, origin.y, a.y)]
-            .into_iter()
-            .enumerate()
-        {
-            if da == 0.0 {
-                continue;
-            }
-            let pitch = pitch_mm[axis];
-            let (lo, hi) = if da > 0.0 {
-                (pa, pa + da)
-            } else {
-                (pa + da, pa)
-            };
-            let mut k = ((lo - oa) / pitch).ceil() as i64;
-            while oa + k as f64 * pitch < hi {
-                let t = (oa + k as f64 * pitch - pa) / da;
-                if t > 0.0 && t < 1.0 {
-                    ts.push(t);
-                }
-                k += 1;
-            }
-        }
-        ts.sort_by(f64::total_cmp);
-        ts.dedup();
-        for tw in ts.windows(2) {
-            let (p, q) = (a.plus(d.scale(tw[0])), a.plus(d.scale(tw[1])));
-            if p.dist(q) <= 0.0 {
-                continue;
-            }
-            let c = cell(a.plus(d.scale((tw[0] + tw[1]) / 2.0)));
-            match pieces.last_mut() {
-                Some((pc, pts)) if *pc == c => pts.push(q),
-                _ => pieces.push((c, vec![p, q])),
-            }
-        }
-    }
-    if g.closed && pieces.len() > 1 {
-        let same = pieces.first().map(|f| f.0) == pieces.last().map(|l| l.0);
-        if same {
-            if let Some((_, mut last)) = pieces.pop() {
-                let first = std::mem::take(&mut pieces[0].1);
-                last.extend(first.into_iter().skip(1));
-                pieces[0].1 = last;
-            }
-        }
-    }
-    // a cut through a cell corner can leave a crumb shorter than the G-code resolution: drop it
-    pieces.retain(|(_, pts)| crate::geom::polyline_length(pts, false) >= MIN_PIECE_MM);
-    let closed_whole = g.closed && pieces.len() == 1;
-    pieces
-        .into_iter()
-        .enumerate()
-        .map(|(k, (_, pts))| {
-            let source = Source {
-                element: format!("{} (piece {})", g.source.element, k + 1),
-                subpath: g.source.subpath,
-                layer: g.source.layer.clone(),
-            };
-            Geometry::new(pts, closed_whole, source).with_layer(&g.layer)
-        })
-        .collect()
+/// True when a box fits in a field with [`FIT_MARGIN_MM`] to spare.
+fn fits_box(b: &BBox, field_mm: [f64; 2]) -> bool {
+    b.width() <= field_mm[0] - FIT_MARGIN_MM && b.height() <= field_mm[1] - FIT_MARGIN_MM
 }
 
-/// Replaces every oversize geometry by its pieces (in place, keeping document order) and returns
-/// a warning per split geometry.
-pub fn split_oversize(geometries: &mut Vec<Geometry>, field_mm: [f64; 2]) -> Vec<Warning> {
-    let pitch = [field_mm[0] - 1e-6, field_mm[1] - 1e-6];
-    let corner = geometries
+/// The seam form of a geometry's layer.
+fn seam_of(layers: &[Layer], g: &Geometry) -> SeamForm {
+    pen_of(layers, g).map_or(SeamForm::Straight, |p| p.seam)
+}
+
+/// The largest cell a tiling may have so that a field centred on it holds every piece (pieces
+/// pass a seam by up to the layers' seam reach).
+pub fn cell_max_mm(layers: &[Layer], field_mm: [f64; 2]) -> [f64; 2] {
+    let reach = layers
         .iter()
-        .filter(|g| is_oversize(g, field_mm))
-        .fold(crate::geom::BBox::EMPTY, |b, g| b.union(g.bbox()));
-    let origin = Pt::new(corner.min_x, corner.min_y);
-    let mut out = Vec::with_capacity(geometries.len());
-    let mut warnings = Vec::new();
-    for (i, g) in std::mem::take(geometries).into_iter().enumerate() {
-        if is_oversize(&g, field_mm) {
-            let pieces = split_geometry(&g, origin, pitch);
-            warnings.push(Warning {
-                element: g.source.element.clone(),
-                line: None,
-                message: format!(
-                    "geometry {} ({:.2} × {:.2} mm) {SPLIT_WORDS} {} strokes at field borders",
-                    i + 1,
-                    g.bbox().width(),
-                    g.bbox().height(),
-                    pieces.len()
-                ),
-            });
-            out.extend(pieces);
+        .map(|l| l.pen.seam.reach_mm())
+        .fold(0.0, f64::max);
+    let cell = |f: f64| (f - 2.0 * FIT_MARGIN_MM - 2.0 * reach).max(f * 0.25);
+    [cell(field_mm[0]), cell(field_mm[1])]
+}
+
+/// The tiling for `geometries`, or none when nothing needs cutting: its extent is the box of the
+/// oversize geometries and of the hatch strokes that do not fit a field; its seams are chosen
+/// for the fewest cuts of those, avoiding the small geometries in the extent.
+pub fn choose_document_tiling(
+    geometries: &[Geometry],
+    layers: &[Layer],
+    field_mm: [f64; 2],
+) -> Option<Tiling> {
+    let extent = geometries
+        .iter()
+        .filter(|g| !fits_box(&g.bbox(), field_mm))
+        .fold(BBox::EMPTY, |b, g| b.union(g.bbox()));
+    if extent.is_empty() {
+        return None;
+    }
+    let inputs: Vec<TilingInput> = geometries
+        .iter()
+        .filter(|g| overlaps(&g.bbox(), &extent))
+        .map(|g| TilingInput {
+            points: &g.points,
+            closed: g.closed,
+            cut: is_hatch_output(g) || !fits_box(&g.bbox(), field_mm),
+        })
+        .collect();
+    Some(choose_tiling(
+        &inputs,
+        extent,
+        cell_max_mm(layers, field_mm),
+    ))
+}
+
+fn overlaps(a: &BBox, b: &BBox) -> bool {
+    a.min_x <= b.max_x && b.min_x <= a.max_x && a.min_y <= b.max_y && b.min_y <= a.max_y
+}
+
+/// A geometry's pieces: points and whether closed.
+type Pieces = Vec<(Vec<crate::geom::Pt>, bool)>;
+
+/// Geometries cut at a tiling's seams.
+#[derive(Debug, Clone, Default)]
+pub struct Cut {
+    /// The geometries, each cut one replaced by its pieces where it was.
+    pub geometries: Vec<Geometry>,
+    /// What the cut did.
+    pub stats: SeamStats,
+    /// Which input geometries were cut, with their piece counts.
+    pub split: Vec<(usize, usize)>,
+}
+
+/// Cuts the geometries `which` selects where they cross the seams of `tiling` inside its extent,
+/// each with its layer's seam form. Pieces keep their geometry's layer; a non-hatch piece's
+/// element is named "… (piece k)".
+///
+/// A layer whose pen shifts its passes (`shift_passes`, passes n > 1) gets each cut geometry
+/// once per pass: pass 1 cut on `tiling`, pass k on `tiling` shifted by (k − 1)/n of its mean
+/// cell in both axes ([`Tiling::shifted`]), each piece marked once ([`Geometry::pass`]); so no
+/// two passes cut at the same place.
+pub fn cut_at_tiling(
+    geometries: Vec<Geometry>,
+    tiling: &Tiling,
+    layers: &[Layer],
+    field_mm: [f64; 2],
+    which: impl Fn(&Geometry) -> bool,
+) -> Cut {
+    let extent = tiling.extent();
+    let selected: Vec<bool> = geometries
+        .iter()
+        .map(|g| g.pass == 0 && which(g) && overlaps(&g.bbox(), &extent))
+        .collect();
+    let shifted_passes = |g: &Geometry| {
+        pen_of(layers, g)
+            .filter(|p| p.shift_passes && p.passes > 1)
+            .map_or(1, |p| p.passes)
+    };
+    let most = geometries
+        .iter()
+        .zip(&selected)
+        .filter(|(_, s)| **s)
+        .map(|(g, _)| shifted_passes(g))
+        .max()
+        .unwrap_or(1);
+    let cells = tiling.cells();
+    let pitch = [
+        extent.width() / cells[0] as f64,
+        extent.height() / cells[1] as f64,
+    ];
+    let cell_max = cell_max_mm(layers, field_mm);
+    // pieces per geometry per pass (pass 0: the one tiling of geometries without shifted passes)
+    let mut pieces_of: Vec<Vec<Pieces>> = vec![Vec::new(); geometries.len()];
+    let mut stats = SeamStats::default();
+    for pass in 0..most {
+        let pass_tiling;
+        let on = if pass == 0 {
+            tiling
         } else {
-            out.push(g);
+            let k = pass as f64;
+            let n = most as f64;
+            pass_tiling = tiling.shifted([pitch[0] * k / n, pitch[1] * k / n], cell_max);
+            &pass_tiling
+        };
+        let take = |i: usize| selected[i] && (pass == 0 || shifted_passes(&geometries[i]) > pass);
+        let cut = cut_forms(&geometries, on, layers, field_mm, &take);
+        stats.merge(cut.1);
+        for (i, pieces) in cut.0 {
+            let slot = &mut pieces_of[i];
+            slot.resize(pass as usize + 1, Vec::new());
+            slot[pass as usize] = pieces;
         }
     }
-    *geometries = out;
-    warnings
+    let mut out = Cut {
+        stats,
+        ..Cut::default()
+    };
+    out.geometries.reserve(geometries.len());
+    for (i, (g, passes)) in geometries.into_iter().zip(pieces_of).enumerate() {
+        let shifted = passes.len() > 1;
+        let whole = passes.len() == 1
+            && passes[0].len() == 1
+            && passes[0][0].0 == g.points
+            && passes[0][0].1 == g.closed;
+        if passes.is_empty() || whole {
+            out.geometries.push(g);
+            continue;
+        }
+        out.split.push((i, passes.iter().map(Vec::len).sum()));
+        let hatch = is_hatch_output(&g);
+        let mut k = 0;
+        for (pass, pieces) in passes.into_iter().enumerate() {
+            for (points, closed) in pieces {
+                k += 1;
+                let source = if hatch {
+                    g.source.clone()
+                } else {
+                    Source {
+                        element: format!("{} (piece {k})", g.source.element),
+                        subpath: g.source.subpath,
+                        layer: g.source.layer.clone(),
+                    }
+                };
+                let piece = Geometry::new(points, closed, source).with_layer(&g.layer);
+                out.geometries.push(if shifted {
+                    piece.with_pass(pass as u32 + 1)
+                } else {
+                    piece
+                });
+            }
+        }
+    }
+    out
+}
+
+/// Cuts the geometries `take` selects on `tiling`, one cut per seam form (crossings are ranked
+/// along each seam within a form); returns each cut geometry's pieces and the figures.
+fn cut_forms(
+    geometries: &[Geometry],
+    tiling: &Tiling,
+    layers: &[Layer],
+    field_mm: [f64; 2],
+    take: &impl Fn(usize) -> bool,
+) -> (Vec<(usize, Pieces)>, SeamStats) {
+    let mut forms: Vec<SeamForm> = Vec::new();
+    for (i, g) in geometries.iter().enumerate() {
+        let f = seam_of(layers, g);
+        if take(i) && !forms.contains(&f) {
+            forms.push(f);
+        }
+    }
+    let mut out: Vec<(usize, Pieces)> = Vec::new();
+    let mut stats = SeamStats::default();
+    for form in forms {
+        let members: Vec<usize> = (0..geometries.len())
+            .filter(|&i| take(i) && seam_of(layers, &geometries[i]) == form)
+            .collect();
+        let strokes: Vec<(&[crate::geom::Pt], bool)> = members
+            .iter()
+            .map(|&i| (geometries[i].points.as_slice(), geometries[i].closed))
+            .collect();
+        let cut = cut_at_seams(
+            &strokes,
+            tiling,
+            form,
+            |_| false,
+            |p| fits_box(&BBox::of(p), field_mm),
+        );
+        stats.merge(cut.stats);
+        let mut pieces: Vec<Pieces> = vec![Vec::new(); members.len()];
+        for (k, points, closed) in cut.pieces {
+            pieces[k].push((points, closed));
+        }
+        out.extend(members.into_iter().zip(pieces));
+    }
+    (out, stats)
+}
+
+/// The hatch stage's cut: hatch strokes crossing a seam of the document's tiling (chosen by
+/// [`choose_document_tiling`]) are cut on it, so a fill larger than a field is cut along a few
+/// straight seams. Returns the tiling (none: nothing to cut) and the cut.
+pub fn cut_hatch_at_tiling(
+    geometries: Vec<Geometry>,
+    layers: &[Layer],
+    field_mm: [f64; 2],
+) -> (Option<Tiling>, Cut) {
+    let Some(tiling) = choose_document_tiling(&geometries, layers, field_mm) else {
+        return (
+            None,
+            Cut {
+                geometries,
+                ..Cut::default()
+            },
+        );
+    };
+    let cut = cut_at_tiling(geometries, &tiling, layers, field_mm, is_hatch_output);
+    (Some(tiling), cut)
+}
+
+/// Replaces every oversize geometry by its pieces, cut at the seams of `tiling` (the document's,
+/// see [`choose_document_tiling`]; chosen here when none or when it does not cover them), in
+/// place, keeping document order. Returns a warning per split geometry and the cut's figures.
+pub fn split_oversize(
+    geometries: &mut Vec<Geometry>,
+    tiling: Option<&Tiling>,
+    layers: &[Layer],
+    field_mm: [f64; 2],
+) -> (Vec<Warning>, SeamStats, Option<Tiling>) {
+    let oversize: BBox = geometries
+        .iter()
+        .filter(|g| is_oversize(g, field_mm))
+        .fold(BBox::EMPTY, |b, g| b.union(g.bbox()));
+    if oversize.is_empty() {
+        return (Vec::new(), SeamStats::default(), tiling.cloned());
+    }
+    let tiling = match tiling {
+        Some(t) if t.extent().contains_box(&oversize, 1e-9) => t.clone(),
+        _ => match choose_document_tiling(geometries, layers, field_mm) {
+            Some(t) => t,
+            None => return (Vec::new(), SeamStats::default(), tiling.cloned()),
+        },
+    };
+    let sizes: Vec<(String, f64, f64)> = geometries
+        .iter()
+        .map(|g| {
+            (
+                g.source.element.clone(),
+                g.bbox().width(),
+                g.bbox().height(),
+            )
+        })
+        .collect();
+    let cut = cut_at_tiling(std::mem::take(geometries), &tiling, layers, field_mm, |g| {
+        is_oversize(g, field_mm)
+    });
+    let mut warnings = Vec::new();
+    *geometries = cut.geometries;
+    // warnings name the geometries by their number before the cut
+    for &(i, pieces) in &cut.split {
+        let (element, w, h) = &sizes[i];
+        warnings.push(Warning {
+            element: element.clone(),
+            line: None,
+            message: format!(
+                "geometry {} ({w:.2} × {h:.2} mm) {SPLIT_WORDS} {pieces} strokes at field borders",
+                i + 1
+            ),
+        });
+    }
+    (warnings, cut.stats, Some(tiling))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::fields::tests_support::rect;
+    use crate::geom::Pt;
     use proptest::prelude::*;
 
     #[test]
     fn big_rectangle_becomes_open_pieces_of_the_same_length() {
-        let g = rect(0.0, 0.0, 150.0, 20.0);
-        let pieces = split_geometry(&g, Pt::new(0.0, 0.0), [70.0, 70.0]);
-        // cells x: [0,70) [70,140) [140,150]: top and bottom edges cut twice, joined around the ends
-        assert_eq!(pieces.len(), 4);
-        let total: f64 = pieces.iter().map(Geometry::length_mm).sum();
-        assert!((total - g.length_mm()).abs() < 1e-9);
-        for p in &pieces {
+        let mut gs = vec![rect(0.0, 0.0, 150.0, 20.0)];
+        let whole = gs[0].length_mm();
+        let (warnings, stats, tiling) = split_oversize(&mut gs, None, &[], [70.0, 70.0]);
+        // three columns of 50 mm: top and bottom edges cut twice each, joined around the ends
+        assert_eq!(tiling.map(|t| t.cells()), Some([3, 1]));
+        assert_eq!(gs.len(), 4, "{gs:?}");
+        assert_eq!(warnings.len(), 1);
+        assert_eq!(stats.cuts, 4);
+        let total: f64 = gs.iter().map(Geometry::length_mm).sum();
+        assert!((total - whole).abs() < 1e-9);
+        for p in &gs {
             assert!(!p.closed);
             assert!(!is_oversize(p, [70.0, 70.0]));
         }
@@ -170,10 +350,12 @@ mod tests {
         ) {
             let pts: Vec<Pt> = pts.into_iter().map(|(x, y)| Pt::new(x, y)).collect();
             let g = Geometry::new(pts, closed, Source::default());
-            let pieces = split_geometry(&g, Pt::new(-3.0, 5.0), [70.0 - 1e-6, 70.0 - 1e-6]);
-            let total: f64 = pieces.iter().map(Geometry::length_mm).sum();
-            prop_assert!((total - g.length_mm()).abs() < 1e-6 * g.length_mm().max(1.0) + MIN_PIECE_MM * 4.0 * pieces.len() as f64);
-            for p in &pieces {
+            let length = g.length_mm();
+            let mut gs = vec![g];
+            split_oversize(&mut gs, None, &[], [70.0, 70.0]);
+            let total: f64 = gs.iter().map(Geometry::length_mm).sum();
+            prop_assert!((total - length).abs() < 1e-6 * length.max(1.0) + 1e-7 * 4.0 * gs.len() as f64);
+            for p in &gs {
                 prop_assert!(!is_oversize(p, [70.0, 70.0]));
             }
         }

@@ -3,6 +3,8 @@
 //! All coordinates are millimetres in machine coordinates (x right, y down, as in SVG).
 
 mod flatten;
+pub mod seam;
+pub mod tiling;
 
 pub use flatten::{flatten_cubic, flatten_quad};
 

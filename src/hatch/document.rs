@@ -1,10 +1,11 @@
-//! Hatching a document's geometries: closed geometries grouped into regions by SVG element,
-//! hatched, cut to fit scan fields, and put back in document order with their outlines.
+//! Hatching a document's geometries: closed geometries grouped into regions (a layer's shapes
+//! together, or each drawing element on its own), hatched, and put back in document order with
+//! their outlines. Strokes larger than a field are cut later, on the document's tiling
+//! (`fields::cut_hatch_at_tiling`).
 
-use super::cut::{cut, fits, Grid};
 use super::{hatch_contours, HatchError, HatchSettings, OutlineMode};
-use crate::document::{Geometry, Layer, Source, Warning};
-use crate::geom::{BBox, Pt};
+use crate::document::{FillShapes, Geometry, Layer, Source, Warning};
+use crate::geom::Pt;
 use crate::job::JobCtx;
 use rayon::prelude::*;
 use std::collections::HashMap;
@@ -21,19 +22,17 @@ pub struct HatchedGeometries {
     pub warnings: Vec<Warning>,
     /// Regions hatched.
     pub regions: usize,
-    /// Hatch geometries made (after cutting at field cells).
+    /// Hatch geometries made.
     pub hatch_geometries: usize,
 }
 
-/// Hatches the closed geometries: all closed geometries of one SVG element (same
-/// `source.element`) form one region, resolved with `settings.fill_rule`. Hatch strokes whose box
-/// does not fit in a `field_mm` scan field are cut at a grid of equal cells smaller than a field
-/// (laid over the region's hatch), so every hatch geometry fits in one field; pieces do not
-/// overlap. Hatch geometries are open polylines, or closed rings when they fit.
+/// Hatches the closed geometries: with `settings.shapes` together, all of them form one region;
+/// apart, the closed geometries of one drawing element (same `source.element`) do. A region is
+/// resolved with `settings.fill_rule`. Hatch geometries are open polylines or closed rings, as
+/// long as the fill makes them (cut to fit fields later, on the document's tiling).
 pub fn hatch_geometries(
     geometries: &[Geometry],
     settings: &HatchSettings,
-    field_mm: [f64; 2],
     ctx: &JobCtx,
 ) -> Result<HatchedGeometries, HatchError> {
     settings.check()?;
@@ -42,12 +41,14 @@ pub fn hatch_geometries(
     let mut regions: Vec<Vec<usize>> = Vec::new();
     for (i, g) in geometries.iter().enumerate() {
         if g.closed && g.points.len() >= 3 && !is_hatch_output(g) {
-            let r = *region_of
-                .entry(g.source.element.as_str())
-                .or_insert_with(|| {
-                    regions.push(Vec::new());
-                    regions.len() - 1
-                });
+            let key = match settings.shapes {
+                FillShapes::Together => "",
+                FillShapes::Apart => g.source.element.as_str(),
+            };
+            let r = *region_of.entry(key).or_insert_with(|| {
+                regions.push(Vec::new());
+                regions.len() - 1
+            });
             regions[r].push(i);
         }
     }
@@ -55,7 +56,7 @@ pub fn hatch_geometries(
         .par_iter()
         .map(|members| {
             ctx.check()?;
-            hatch_region(geometries, members, settings, field_mm, ctx)
+            hatch_region(geometries, members, settings, ctx)
         })
         .collect();
     let mut out = HatchedGeometries {
@@ -121,7 +122,6 @@ pub fn hatch_geometries(
 pub fn layer_geometries(
     artwork: &[Geometry],
     layers: &[Layer],
-    field_mm: [f64; 2],
     ctx: &JobCtx,
 ) -> Result<HatchedGeometries, HatchError> {
     let mut out = HatchedGeometries::default();
@@ -138,7 +138,7 @@ pub fn layer_geometries(
         if members.is_empty() {
             continue;
         }
-        let h = hatch_geometries(&members, settings, field_mm, ctx)?;
+        let h = hatch_geometries(&members, settings, ctx)?;
         out.warnings.extend(h.warnings);
         out.regions += h.regions;
         out.hatch_geometries += h.hatch_geometries;
@@ -158,12 +158,11 @@ pub fn layer_geometries(
     Ok(out)
 }
 
-/// One region's hatch as geometries, cut to fit fields.
+/// One region's hatch as geometries.
 fn hatch_region(
     geometries: &[Geometry],
     members: &[usize],
     settings: &HatchSettings,
-    field_mm: [f64; 2],
     ctx: &JobCtx,
 ) -> Result<Vec<Geometry>, HatchError> {
     let first = &geometries[members[0]];
@@ -181,35 +180,17 @@ fn hatch_region(
         },
         e => e,
     })?;
-    let all: Vec<Pt> = h
-        .strokes
-        .iter()
-        .flat_map(|s| s.points.iter().copied())
-        .collect();
-    let grid = Grid::new(&BBox::of(&all), field_mm);
-    let mut pieces: Vec<(Vec<Pt>, bool)> = Vec::with_capacity(h.strokes.len());
-    for s in h.strokes {
-        if fits(&s.points, field_mm) {
-            pieces.push((s.points, s.closed));
-        } else {
-            pieces.extend(
-                cut(&s.points, s.closed, &grid)
-                    .into_iter()
-                    .map(|p| (p, false)),
-            );
-        }
-    }
     let layer = format!("{HATCH_LAYER_PREFIX}{}", first.source.layer);
-    Ok(pieces
+    Ok(h.strokes
         .into_iter()
         .enumerate()
-        .map(|(k, (points, closed))| {
+        .map(|(k, s)| {
             let source = Source {
                 element: first.source.element.clone(),
                 subpath: k,
                 layer: layer.clone(),
             };
-            Geometry::new(points, closed, source).with_layer(&first.layer)
+            Geometry::new(s.points, s.closed, source).with_layer(&first.layer)
         })
         .collect())
 }
@@ -249,7 +230,8 @@ mod tests {
             geom(square(3.0, 3.0, 4.0), true, "#a"),
         ];
         let mut s = HatchSettings::new(HatchStyle::Lines, 1.0);
-        let h = hatch_geometries(&gs, &s, [70.0, 70.0], &JobCtx::default()).unwrap();
+        s.shapes = FillShapes::Apart;
+        let h = hatch_geometries(&gs, &s, &JobCtx::default()).unwrap();
         assert_eq!(h.regions, 2);
         assert_eq!(h.geometries[0].source.element, "#line");
         // outlines of #a first (both contours), then its hatch
@@ -271,10 +253,10 @@ mod tests {
             }
         }
         s.outline = OutlineMode::None;
-        let h2 = hatch_geometries(&gs, &s, [70.0, 70.0], &JobCtx::default()).unwrap();
+        let h2 = hatch_geometries(&gs, &s, &JobCtx::default()).unwrap();
         assert_eq!(h2.geometries.len(), 1 + h2.hatch_geometries);
         s.outline = OutlineMode::After;
-        let h3 = hatch_geometries(&gs, &s, [70.0, 70.0], &JobCtx::default()).unwrap();
+        let h3 = hatch_geometries(&gs, &s, &JobCtx::default()).unwrap();
         let last_a = h3
             .geometries
             .iter()
@@ -282,34 +264,65 @@ mod tests {
             .unwrap();
         assert_eq!(h3.geometries[last_a], gs[3]);
         // hatch output is never taken for a region again
-        let again = hatch_geometries(&h3.geometries, &s, [70.0, 70.0], &JobCtx::default()).unwrap();
+        let again = hatch_geometries(&h3.geometries, &s, &JobCtx::default()).unwrap();
         assert_eq!(again.regions, 2);
     }
 
+    /// Hatch samples (every 0.5 mm along the strokes) strictly inside the square `(x0, y0, w)`
+    /// shrunk by `inset`.
+    fn inside(h: &HatchedGeometries, x0: f64, y0: f64, w: f64, inset: f64) -> usize {
+        let mut n = 0;
+        for g in h.geometries.iter().filter(|g| is_hatch_output(g)) {
+            for s in g.points.windows(2) {
+                let steps = (s[0].dist(s[1]) / 0.5).ceil() as usize;
+                for k in 0..=steps {
+                    let p = s[0].plus(s[1].minus(s[0]).scale(k as f64 / steps.max(1) as f64));
+                    if p.x > x0 + inset
+                        && p.x < x0 + w - inset
+                        && p.y > y0 + inset
+                        && p.y < y0 + w - inset
+                    {
+                        n += 1;
+                    }
+                }
+            }
+        }
+        n
+    }
+
     #[test]
-    fn large_region_is_cut_to_fit_fields() {
-        let gs = vec![geom(square(0.0, 0.0, 150.0), true, "#big")];
+    fn a_layer_is_filled_together_or_apart() {
+        // a plate and a shape inside it, two elements of one layer
+        let gs = vec![
+            geom(square(0.0, 0.0, 100.0), true, "#plate"),
+            geom(square(30.0, 30.0, 40.0), true, "#inner"),
+        ];
+        let mut s = HatchSettings::new(HatchStyle::Lines, 1.0);
+        s.outline = OutlineMode::None;
+        let together = hatch_geometries(&gs, &s, &JobCtx::default()).unwrap();
+        assert_eq!(together.regions, 1);
+        // the inner shape is a hole: nothing hatched inside it (1.5 mm inset: edge offset)
+        assert_eq!(inside(&together, 30.0, 30.0, 40.0, 1.5), 0);
+        assert!(inside(&together, 0.0, 0.0, 25.0, 1.5) > 0);
+        s.shapes = FillShapes::Apart;
+        let apart = hatch_geometries(&gs, &s, &JobCtx::default()).unwrap();
+        assert_eq!(apart.regions, 2);
+        // each filled on its own: the inner square is hatched (by both fills)
+        assert!(inside(&apart, 30.0, 30.0, 40.0, 1.5) > 0);
+        let len = |h: &HatchedGeometries| h.geometries.iter().map(Geometry::length_mm).sum::<f64>();
+        assert!(len(&apart) > len(&together) + 1500.0);
+    }
+
+    #[test]
+    fn nothing_left_inside_the_edge_offset() {
         let mut s = HatchSettings::new(HatchStyle::Zigzag, 2.0);
         s.outline = OutlineMode::None;
-        let h = hatch_geometries(&gs, &s, [70.0, 70.0], &JobCtx::default()).unwrap();
-        let total: f64 = h.geometries.iter().map(Geometry::length_mm).sum();
-        // 74 lines of 146 mm + joins + border ≈ the uncut hatch
-        let uncut = hatch_contours(&[square(0.0, 0.0, 150.0)], &s, &JobCtx::default()).unwrap();
-        assert!(
-            (total - uncut.stats.total_mm).abs() < 1e-6,
-            "{total} vs {}",
-            uncut.stats.total_mm
-        );
-        for g in &h.geometries {
-            let b = g.bbox();
-            assert!(b.width() < 70.0 && b.height() < 70.0, "{}", g.describe());
-        }
         // tiny region: warning, no hatch; without outlines nothing is left, which is an error
         let tiny = vec![geom(square(0.0, 0.0, 1.0), true, "#tiny")];
-        let e = hatch_geometries(&tiny, &s, [70.0, 70.0], &JobCtx::default()).unwrap_err();
+        let e = hatch_geometries(&tiny, &s, &JobCtx::default()).unwrap_err();
         assert!(e.to_string().contains("nothing left to mark"), "{e}");
         s.outline = OutlineMode::After;
-        let h = hatch_geometries(&tiny, &s, [70.0, 70.0], &JobCtx::default()).unwrap();
+        let h = hatch_geometries(&tiny, &s, &JobCtx::default()).unwrap();
         assert_eq!(h.warnings.len(), 1);
         assert_eq!(h.geometries, tiny);
     }

@@ -17,13 +17,13 @@
 //! within `s/2` inside `O`. Parallel lines are exactly `s` apart, rings exactly `s` apart.
 //!
 //! [`hatch_contours`] fills one region; [`hatch_geometries`] fills the closed geometries of a
-//! document (one region per SVG element) and cuts strokes larger than a scan field at field-sized
-//! cells. `bench::hatch` reproduces seed 003's experiment.
+//! layer (together, or one region per drawing element); strokes larger than a scan field are cut
+//! afterwards on the document's tiling (`fields::cut_hatch_at_tiling`). `bench::hatch`
+//! reproduces seed 003's experiment.
 
 mod boundary;
 mod clip;
 mod contour;
-mod cut;
 mod document;
 mod elems;
 mod gaps;

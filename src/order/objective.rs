@@ -200,7 +200,7 @@ pub fn step_job_time_lower_bound_s(
     let marking: f64 = geometries
         .iter()
         .zip(&model.mark_s)
-        .map(|(g, t)| t * f64::from(pen_of(layers, g).map_or(1, |p| p.passes.max(1))))
+        .map(|(g, t)| t * f64::from(crate::document::passes_of(layers, g)))
         .sum();
     let mut centres: Vec<Pt> = Vec::new();
     for f in fields.iter().filter(|f| !f.geometries.is_empty()) {

@@ -1,6 +1,6 @@
 //! Passes: a layer marked several times repeats its strokes inside each field.
 
-use crate::document::{pen_of, Geometry, Layer, Step};
+use crate::document::{passes_of, Geometry, Layer, Step};
 
 /// Repeats each layer's strokes for its passes: inside each run of one field, the run's
 /// strokes are marked again, in the same order, once for every further pass of their layer
@@ -12,8 +12,7 @@ pub fn expand_passes(order: &[Step], geometries: &[Geometry], layers: &[Layer]) 
     let passes = |s: &Step| {
         geometries
             .get(s.geometry)
-            .and_then(|g| pen_of(layers, g))
-            .map_or(1, |p| p.passes)
+            .map_or(1, |g| passes_of(layers, g))
     };
     let mut out = Vec::with_capacity(order.len());
     for run in order.chunk_by(|a, b| a.field == b.field) {
