@@ -227,7 +227,7 @@ pub fn derive_geometries(doc: &mut Document, ctx: &JobCtx) -> Result<f64, Pipeli
             .collect();
     }
     sync_layers(&mut doc.layers, &doc.artwork, &default_pen(&doc.settings));
-    let key = DerivedKey::of(&doc.layers, doc.profile.field_mm);
+    let key = DerivedKey::of(&doc.layers, doc.profile.field_mm, doc.tiling_set.as_ref());
     if doc.derived_with.as_ref() == Some(&key) {
         return Ok(0.0);
     }
@@ -240,7 +240,12 @@ pub fn derive_geometries(doc: &mut Document, ctx: &JobCtx) -> Result<f64, Pipeli
         }
     })?;
     // fills larger than a field are cut on the document's tiling
-    let (tiling, cut) = cut_hatch_at_tiling(made.geometries, &doc.layers, doc.profile.field_mm);
+    let (tiling, cut) = cut_hatch_at_tiling(
+        made.geometries,
+        &doc.layers,
+        doc.profile.field_mm,
+        doc.tiling_set.as_ref(),
+    );
     doc.tiling = tiling;
     doc.seams = cut.stats;
     // indices may change: the fields go, the plans keep the geometries they were planned on
@@ -252,6 +257,25 @@ pub fn derive_geometries(doc: &mut Document, ctx: &JobCtx) -> Result<f64, Pipeli
     }
     doc.derived_with = Some(key);
     Ok(t0.elapsed().as_secs_f64())
+}
+
+/// Moves the seam of `axis` (0: a vertical seam, x; 1: a horizontal one, y) nearest to
+/// `from_mm` towards `to_mm` (as far as its neighbours allow: no cell wider than a field leaves
+/// room for). The document keeps the moved tiling as the operator's (`tiling_set`): the next
+/// [`derive_geometries`] cuts on it and the fields are placed again. Returns where the seam
+/// went, mm; none when the document has no seam on that axis.
+pub fn move_seam(doc: &mut Document, axis: usize, from_mm: f64, to_mm: f64) -> Option<f64> {
+    let tiling = doc.tiling.as_ref()?;
+    let cell_max = crate::fields::cell_max_mm(&doc.layers, doc.profile.field_mm);
+    let moved = crate::fields::move_seam(tiling, axis, from_mm, to_mm, cell_max)?;
+    let borders = moved.borders(axis);
+    let at = borders
+        .iter()
+        .zip(tiling.borders(axis))
+        .find(|(a, b)| a != b)
+        .map_or(to_mm, |(a, _)| *a);
+    doc.tiling_set = Some(moved);
+    Some(at)
 }
 
 /// The pen of layers nothing else names: defaults, with the settings' hatch (`--hatch`).

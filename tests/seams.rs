@@ -312,3 +312,25 @@ fn a_circle_on_the_plate_is_a_hole_when_filled_together() {
     plan(&mut apart);
     assert!(inside(&apart) > 50);
 }
+
+#[test]
+fn a_seam_moved_by_hand_moves_the_cuts() {
+    let mut doc = load(&plate_svg(""), "zigzag:0.5:0", SeamForm::Straight);
+    plan(&mut doc);
+    let first = doc.tiling.as_ref().unwrap().seams(0)[0];
+    let at = galvoplan::pipeline::move_seam(&mut doc, 0, first + 0.2, first - 5.0).unwrap();
+    assert!((at - (first - 5.0)).abs() < 1e-9);
+    let p = plan(&mut doc);
+    assert!(p.fields.len() <= 8, "{} fields", p.fields.len());
+    let xs = distinct(cut_points(&doc, None).iter().map(|p| p.x).collect());
+    assert!(xs.iter().any(|x| (x - at).abs() < 1e-6), "{xs:?}");
+    assert!(!xs.iter().any(|x| (x - first).abs() < 1e-6), "{xs:?}");
+    // as far as the neighbours allow: no cell wider than the field leaves room for
+    let second = doc.tiling.as_ref().unwrap().seams(0)[1];
+    let at = galvoplan::pipeline::move_seam(&mut doc, 0, at, 0.0).unwrap();
+    assert!((second - at - 70.0).abs() < 0.01, "{at} vs {second}");
+    // on a project save and load, the moved tiling stays
+    let text = serde_json::to_string(&doc).unwrap();
+    let back: Document = serde_json::from_str(&text).unwrap();
+    assert_eq!(back.tiling_set, doc.tiling_set);
+}

@@ -89,7 +89,16 @@ enum Drag {
         id: usize,
         grab: Pt,
     },
+    /// Moving a seam of `axis` (0: vertical) from `from_mm`; `at_mm` follows the pointer.
+    Seam {
+        axis: usize,
+        from_mm: f64,
+        at_mm: f64,
+    },
 }
+
+/// How near a seam the pointer grabs it, px.
+const SEAM_GRAB_PX: f32 = 5.0;
 
 /// Pan/zoom and gesture state of a canvas (shared by synchronised canvases).
 #[derive(Debug, Clone, Default)]
@@ -119,6 +128,15 @@ pub enum CanvasAction {
     EndDrag,
     /// Asked for a new field there (add tool click or double-click).
     Add(Pt),
+    /// Moved a seam (at the end of its drag).
+    MoveSeam {
+        /// 0: a vertical seam (x), 1: a horizontal one (y).
+        axis: usize,
+        /// Where it was, mm.
+        from_mm: f64,
+        /// Where it was dropped, mm.
+        to_mm: f64,
+    },
 }
 
 /// One planned path to draw.
@@ -142,6 +160,8 @@ pub struct Canvas<'a> {
     pub profile: &'a MachineProfile,
     /// Fields to draw.
     pub fields: &'a [ScanField],
+    /// Seams: where artwork larger than a field is cut (drawn with the fields).
+    pub seams: &'a [crate::geom::seam::SeamLine],
     /// The shown plan's fields in visiting order: fields are numbered 1…n in that order (the
     /// others after them), else in the order of `fields` (placement order).
     pub visiting: Option<&'a [ScanField]>,
@@ -234,6 +254,17 @@ impl Canvas<'_> {
         self.interact(ui, &response, rect, state, &mut actions);
         let painter = ui.painter_at(rect);
         paint::paint(&painter, self, &state.view, rect);
+        if let Drag::Seam { axis, at_mm, .. } = state.drag {
+            // the seam being moved, across the work area
+            let (lo, hi) = Canvas::reach(self.profile);
+            let (a, b) = if axis == 0 {
+                (Pt::new(at_mm, lo.y), Pt::new(at_mm, hi.y))
+            } else {
+                (Pt::new(lo.x, at_mm), Pt::new(hi.x, at_mm))
+            };
+            let s = |q: Pt| state.view.to_screen(rect, q);
+            painter.line_segment([s(a), s(b)], egui::Stroke::new(2.0, paint::colour::SEAM));
+        }
         let response = if state.drag == Drag::None {
             self.hover_info(response, rect, &state.view)
         } else {
@@ -254,7 +285,18 @@ impl Canvas<'_> {
         if response.drag_started() {
             let origin = ui.input(|i| i.pointer.press_origin());
             state.drag = Drag::Pan;
-            if self.editable && response.drag_started_by(PointerButton::Primary) && !self.add_tool {
+            let seam = origin.and_then(|o| {
+                self.seam_at(view.to_mm(rect, o), f64::from(SEAM_GRAB_PX / view.scale))
+            });
+            let primary =
+                self.editable && response.drag_started_by(PointerButton::Primary) && !self.add_tool;
+            if let (true, Some((axis, from_mm))) = (primary, seam) {
+                state.drag = Drag::Seam {
+                    axis,
+                    from_mm,
+                    at_mm: from_mm,
+                };
+            } else if primary {
                 if let Some(f) = origin.and_then(|o| self.field_at(view.to_mm(rect, o))) {
                     actions.push(CanvasAction::Select(Some(f.id)));
                     if !f.locked {
@@ -275,14 +317,44 @@ impl Canvas<'_> {
                         actions.push(CanvasAction::Move { id, center });
                     }
                 }
+                Drag::Seam { axis, from_mm, .. } => {
+                    if let Some(p) = response.interact_pointer_pos() {
+                        let mm = view.to_mm(rect, p);
+                        let at_mm = if axis == 0 { mm.x } else { mm.y };
+                        state.drag = Drag::Seam {
+                            axis,
+                            from_mm,
+                            at_mm,
+                        };
+                    }
+                }
                 Drag::Pan | Drag::None => view.offset += response.drag_delta(),
             }
         }
         if response.drag_stopped() {
-            if matches!(state.drag, Drag::Field { .. }) {
-                actions.push(CanvasAction::EndDrag);
+            match state.drag {
+                Drag::Field { .. } => actions.push(CanvasAction::EndDrag),
+                Drag::Seam {
+                    axis,
+                    from_mm,
+                    at_mm,
+                } if (at_mm - from_mm).abs() > 1e-6 => actions.push(CanvasAction::MoveSeam {
+                    axis,
+                    from_mm,
+                    to_mm: at_mm,
+                }),
+                _ => {}
             }
             state.drag = Drag::None;
+        }
+        if self.editable && state.drag == Drag::None {
+            let near_seam = response.hover_pos().is_some_and(|p| {
+                self.seam_at(view.to_mm(rect, p), f64::from(SEAM_GRAB_PX / view.scale))
+                    .is_some()
+            });
+            if near_seam {
+                ui.ctx().set_cursor_icon(egui::CursorIcon::Grab);
+            }
         }
         if self.editable {
             if let Some(p) = response.interact_pointer_pos() {
@@ -306,6 +378,27 @@ impl Canvas<'_> {
                 }
             }
         }
+    }
+
+    /// The seam within `tol_mm` of `p` (on its stretch through marked area): its axis and
+    /// position.
+    pub fn seam_at(&self, p: Pt, tol_mm: f64) -> Option<(usize, f64)> {
+        self.seams
+            .iter()
+            .filter(|l| {
+                let (across, along) = if l.axis == 0 { (p.x, p.y) } else { (p.y, p.x) };
+                (across - l.at_mm).abs() <= tol_mm
+                    && l.spans
+                        .iter()
+                        .any(|s| along >= s[0] - tol_mm && along <= s[1] + tol_mm)
+            })
+            .min_by(|a, b| {
+                let d = |l: &crate::geom::seam::SeamLine| {
+                    (if l.axis == 0 { p.x } else { p.y } - l.at_mm).abs()
+                };
+                d(a).total_cmp(&d(b))
+            })
+            .map(|l| (l.axis, l.at_mm))
     }
 
     /// The field under a point: of those holding it, the one with the nearest centre.

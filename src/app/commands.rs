@@ -142,7 +142,13 @@ pub fn apply(doc: &mut Document, cmd: &Command) -> Result<Outcome, String> {
         }
         Command::SetLayers(layers) => {
             validate_layers(layers).map_err(|e| e.to_string())?;
-            if doc.derived_with.as_ref() != Some(&DerivedKey::of(layers, doc.profile.field_mm)) {
+            if doc.derived_with.as_ref()
+                != Some(&DerivedKey::of(
+                    layers,
+                    doc.profile.field_mm,
+                    doc.tiling_set.as_ref(),
+                ))
+            {
                 return Err("the change needs the geometries made again (a background job)".into());
             }
             doc.layers = layers.clone();
@@ -158,6 +164,9 @@ pub fn apply(doc: &mut Document, cmd: &Command) -> Result<Outcome, String> {
             doc.kept_geometries = new.kept_geometries.clone();
             doc.layers = new.layers.clone();
             doc.derived_with = new.derived_with.clone();
+            doc.tiling = new.tiling.clone();
+            doc.seams = new.seams.clone();
+            doc.tiling_set = new.tiling_set.clone();
             doc.fields = new.fields.clone();
             doc.plans = new.plans.clone();
             doc.warnings = new.warnings.clone();

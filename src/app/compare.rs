@@ -75,7 +75,7 @@ enum RowKind {
 struct Row {
     label: &'static str,
     help: &'static str,
-    value: fn(&Metrics) -> Option<f64>,
+    value: fn(&Plan) -> Option<f64>,
     decimals: usize,
     kind: RowKind,
 }
@@ -89,49 +89,49 @@ const ROWS: &[Row] = &[
         label: "Job time (s)",
         help: "machine time of the whole job, from the lowered toolpath (stage moves, settling, \
                scanner jumps, marking, laser delays): the figure that decides",
-        value: |m| m.job_time_s,
+        value: |p| p.metrics.job_time_s,
         decimals: 3,
         kind: RowKind::Decides,
     },
     Row {
         label: "Stage moves (s)",
         help: "part of the job time: the stage travelling between fields",
-        value: |m| part(m, |b| b.stage),
+        value: |p| part(&p.metrics, |b| b.stage),
         decimals: 2,
         kind: RowKind::Part,
     },
     Row {
         label: "Stage settling (s)",
         help: "part of the job time: the stage settling after its moves",
-        value: |m| part(m, |b| b.settle),
+        value: |p| part(&p.metrics, |b| b.settle),
         decimals: 2,
         kind: RowKind::Part,
     },
     Row {
         label: "Scanner jumps (s)",
         help: "part of the job time: scanner jumps and jump delays not hidden in a stage move",
-        value: |m| part(m, |b| b.jump),
+        value: |p| part(&p.metrics, |b| b.jump),
         decimals: 2,
         kind: RowKind::Part,
     },
     Row {
         label: "Marking (s)",
         help: "part of the job time: marking at mark speed (the same for every plan)",
-        value: |m| part(m, |b| b.mark),
+        value: |p| part(&p.metrics, |b| b.mark),
         decimals: 2,
         kind: RowKind::Part,
     },
     Row {
         label: "Laser delays (s)",
         help: "part of the job time: laser-on and laser-off delays around the marks",
-        value: |m| part(m, |b| b.laser_delays),
+        value: |p| part(&p.metrics, |b| b.laser_delays),
         decimals: 2,
         kind: RowKind::Part,
     },
     Row {
         label: "Idle travel (mm)",
         help: "laser-off travel of the tool point between strokes",
-        value: |m| Some(m.idle_mm),
+        value: |p| Some(p.metrics.idle_mm),
         decimals: 1,
         kind: RowKind::Ranked,
     },
@@ -139,7 +139,7 @@ const ROWS: &[Row] = &[
         label: "Stage travel (mm)",
         help: "base-stage travel through the field centres in visiting order (step-and-scan; \
                on the fly the stage follows its route instead: see Stage route)",
-        value: |m| Some(m.base_mm),
+        value: |p| Some(p.metrics.base_mm),
         decimals: 1,
         kind: RowKind::Ranked,
     },
@@ -147,14 +147,14 @@ const ROWS: &[Row] = &[
         label: "Stage route (mm)",
         help: "length of the stage's route, sampled every millisecond (on the fly: the route it \
                follows while the scanner marks; step-and-scan: its moves between fields)",
-        value: |m| m.motion.map(|f| f.stage_route_mm),
+        value: |p| p.metrics.motion.map(|f| f.stage_route_mm),
         decimals: 1,
         kind: RowKind::Ranked,
     },
     Row {
         label: "Peak stage speed (mm/s)",
         help: "the stage's largest speed (both axes together), sampled every millisecond",
-        value: |m| m.motion.map(|f| f.stage_peak_speed_mm_s),
+        value: |p| p.metrics.motion.map(|f| f.stage_peak_speed_mm_s),
         decimals: 0,
         kind: RowKind::Ranked,
     },
@@ -162,14 +162,14 @@ const ROWS: &[Row] = &[
         label: "Stage speed variation (mm/s)",
         help: "sum of the stage's speed changes between samples (seed 001 Table IV): lower is \
                a smoother ride",
-        value: |m| m.motion.map(|f| f.stage_speed_variation_mm_s),
+        value: |p| p.metrics.motion.map(|f| f.stage_speed_variation_mm_s),
         decimals: 0,
         kind: RowKind::Ranked,
     },
     Row {
         label: "Peak scanner offset (mm)",
         help: "the largest distance of the laser point from the field centre on either axis",
-        value: |m| m.motion.map(|f| f.scan_peak_offset_mm),
+        value: |p| p.metrics.motion.map(|f| f.scan_peak_offset_mm),
         decimals: 1,
         kind: RowKind::Info,
     },
@@ -177,28 +177,50 @@ const ROWS: &[Row] = &[
         label: "Fields or regions",
         help: "number of scan fields the job visits (on the fly: regions, which may be larger \
                than the scan field)",
-        value: |m| Some(m.fields as f64),
+        value: |p| Some(p.metrics.fields as f64),
+        decimals: 0,
+        kind: RowKind::Ranked,
+    },
+    Row {
+        label: "Seams",
+        help: "seam lines where artwork larger than a field is cut (each a place where two \
+               fields' marks meet)",
+        value: |p| Some(p.seams.seams() as f64),
+        decimals: 0,
+        kind: RowKind::Ranked,
+    },
+    Row {
+        label: "Seam length (mm)",
+        help: "length of the seams through marked area: where stitching errors can show",
+        value: |p| Some(p.seams.length_mm()),
+        decimals: 1,
+        kind: RowKind::Ranked,
+    },
+    Row {
+        label: "Split strokes",
+        help: "strokes cut at seams into pieces marked from different fields",
+        value: |p| Some(p.seams.split_strokes as f64),
         decimals: 0,
         kind: RowKind::Ranked,
     },
     Row {
         label: "Direction changes",
         help: "reversals of the travel direction along the stage path",
-        value: |m| Some(m.direction_changes as f64),
+        value: |p| Some(p.metrics.direction_changes as f64),
         decimals: 0,
         kind: RowKind::Ranked,
     },
     Row {
         label: "Marked length (mm)",
         help: "marked length (the same for every plan)",
-        value: |m| Some(m.marked_mm),
+        value: |p| Some(p.metrics.marked_mm),
         decimals: 1,
         kind: RowKind::Info,
     },
     Row {
         label: "Solve time (s)",
         help: "how long the computer took to make the plan: says nothing about the plan's quality",
-        value: |m| Some(m.solve_s.total),
+        value: |p| Some(p.metrics.solve_s.total),
         decimals: 3,
         kind: RowKind::Effort,
     },
@@ -264,8 +286,8 @@ fn metrics_row(ui: &mut egui::Ui, row: &Row, a: &Plan, b: Option<&Plan>) {
         RowKind::Ranked | RowKind::Info | RowKind::Effort => ui.label(label),
     }
     .on_hover_text(row.help);
-    let va = (row.value)(&a.metrics);
-    let vb = b.and_then(|b| (row.value)(&b.metrics));
+    let va = (row.value)(a);
+    let vb = b.and_then(|b| (row.value)(b));
     value_cell(ui, row, va, vb);
     if b.is_none() {
         return;
@@ -567,6 +589,7 @@ pub fn show(
         geometries: &doc.geometries,
         profile: &doc.profile,
         fields: &doc.plans[k].fields,
+        seams: &doc.plans[k].seams.lines,
         visiting: Some(&doc.plans[k].fields),
         colours: None,
         out_of_reach: &[],
@@ -583,8 +606,8 @@ pub fn show(
         stale: stale_of(k),
         playback_t_s,
     };
-    // the metrics table's height (17 rows), or less on a small window (it scrolls then)
-    let bottom = 400.0_f32.min(ui.available_height() * 0.45);
+    // the metrics table's height (20 rows), or less on a small window (it scrolls then)
+    let bottom = 460.0_f32.min(ui.available_height() * 0.45);
     let top = (ui.available_height() - bottom - 8.0).max(100.0);
     let width = ui.available_width();
     match kb {

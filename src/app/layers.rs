@@ -5,7 +5,9 @@
 
 use super::prompts::PathAction;
 use crate::document::spec::{self, FieldSpec};
+use crate::document::FillShapes;
 use crate::document::{ArtworkImport, Layer, MachineProfile, Pen, Place};
+use crate::geom::seam::SeamForm;
 use crate::hatch::{HatchSettings, HatchStyle, OutlineMode};
 use egui::{Color32, RichText};
 
@@ -30,6 +32,7 @@ enum Col {
     Spacing,
     Angle,
     Edge,
+    SeamWidth,
 }
 
 impl Col {
@@ -43,6 +46,7 @@ impl Col {
             Col::Spacing => "spacing_mm",
             Col::Angle => "angle_deg",
             Col::Edge => "edge_offset_mm",
+            Col::SeamWidth => "seam_mm",
         }
     }
     fn is_hatch(self) -> bool {
@@ -113,7 +117,9 @@ pub struct LayerEditor {
     corner_text: Option<(Place, [String; 2])>,
 }
 
-const COLS: [Col; 7] = [
+/// The typed values, in the grid's order; the seam width (last) has a row of its own below the
+/// seam's form.
+const COLS: [Col; 8] = [
     Col::Speed,
     Col::Power,
     Col::Passes,
@@ -121,6 +127,7 @@ const COLS: [Col; 7] = [
     Col::Spacing,
     Col::Angle,
     Col::Edge,
+    Col::SeamWidth,
 ];
 
 impl LayerEditor {
@@ -408,7 +415,7 @@ impl LayerEditor {
                     _ => String::new(),
                 };
                 let hatched = layer.pen.hatch.is_some();
-                for (n, &c) in COLS.iter().enumerate() {
+                for (n, &c) in COLS.iter().enumerate().filter(|(_, c)| **c != Col::SeamWidth) {
                     if matches!(c, Col::Spacing) {
                         if let Some(l) = hatch_style_ui(ui, k, layer) {
                             out = Some(l);
@@ -428,8 +435,38 @@ impl LayerEditor {
                     if let Some(l) = outline_ui(ui, k, layer) {
                         out = Some(l);
                     }
+                    ui.end_row();
+                    if let Some(l) = shapes_ui(ui, k, layer) {
+                        out = Some(l);
+                    }
                 }
                 ui.end_row();
+                if let Some(l) = seam_ui(ui, k, layer) {
+                    out = Some(l);
+                }
+                if crate::document::spec::seam_width(&layer.pen.seam).is_some() {
+                    let n = COLS.len() - 1;
+                    if let Some(l) = self.cell(ui, k, n, Col::SeamWidth, layer, "") {
+                        out = Some(l);
+                    }
+                }
+                ui.end_row();
+                if layer.pen.passes > 1 {
+                    let mut shift = layer.pen.shift_passes;
+                    ui.label("");
+                    if ui
+                        .checkbox(&mut shift, "Shift seams between passes")
+                        .on_hover_text(
+                            "Each pass is cut on a tiling shifted by a fraction of a cell, so no two passes meet at the same seam (more fields)",
+                        )
+                        .changed()
+                    {
+                        let mut l = layer.clone();
+                        l.pen.shift_passes = shift;
+                        out = Some(l);
+                    }
+                    ui.end_row();
+                }
             });
         out
     }
@@ -552,6 +589,95 @@ fn outline_ui(ui: &mut egui::Ui, k: usize, layer: &Layer) -> Option<Layer> {
         if let Some(h) = &mut l.pen.hatch {
             h.outline = outline;
         }
+        l
+    })
+}
+
+/// Whether a hatched layer's shapes are filled together; returns the changed layer.
+fn shapes_ui(ui: &mut egui::Ui, k: usize, layer: &Layer) -> Option<Layer> {
+    let h = layer.pen.hatch.as_ref()?;
+    let mut shapes = h.shapes;
+    let label = ui.label("Shapes");
+    let name = |s: FillShapes| match s {
+        FillShapes::Together => "filled together (inner shapes are holes)",
+        FillShapes::Apart => "each filled on its own",
+    };
+    egui::ComboBox::from_id_salt(("hatch-shapes", k))
+        .selected_text(name(shapes))
+        .show_ui(ui, |ui| {
+            for s in [FillShapes::Together, FillShapes::Apart] {
+                ui.selectable_value(&mut shapes, s, name(s));
+            }
+        })
+        .response
+        .labelled_by(label.id)
+        .on_hover_text("Together: the layer's closed shapes form one region (even-odd), as LightBurn fills. Apart: each drawing element is filled on its own, as SVG paints it");
+    (shapes != h.shapes).then(|| {
+        let mut l = layer.clone();
+        if let Some(h) = &mut l.pen.hatch {
+            h.shapes = shapes;
+        }
+        l
+    })
+}
+
+/// Width given to a seam form newly chosen, mm.
+const DEFAULT_SEAM_MM: f64 = 0.5;
+
+/// How the layer's strokes are cut at seams; returns the changed layer.
+fn seam_ui(ui: &mut egui::Ui, k: usize, layer: &Layer) -> Option<Layer> {
+    let current = layer.pen.seam;
+    let width = crate::document::spec::seam_width(&current).unwrap_or(DEFAULT_SEAM_MM);
+    let forms = [
+        ("straight", SeamForm::Straight),
+        (
+            "overlap, dose kept",
+            SeamForm::Overlap {
+                overlap_mm: width,
+                doubled: false,
+            },
+        ),
+        (
+            "overlap, marked twice",
+            SeamForm::Overlap {
+                overlap_mm: width,
+                doubled: true,
+            },
+        ),
+        ("interlocked", SeamForm::Interlocked { band_mm: width }),
+        (
+            "staggered",
+            SeamForm::Staggered {
+                band_mm: width,
+                seed: 1,
+            },
+        ),
+    ];
+    let same_kind = |a: &SeamForm, b: &SeamForm| match (a, b) {
+        (SeamForm::Overlap { doubled: x, .. }, SeamForm::Overlap { doubled: y, .. }) => x == y,
+        _ => std::mem::discriminant(a) == std::mem::discriminant(b),
+    };
+    let shown = forms
+        .iter()
+        .find(|(_, f)| same_kind(f, &current))
+        .map_or("straight", |(w, _)| *w);
+    let mut chosen = current;
+    let label = ui.label("Seam");
+    egui::ComboBox::from_id_salt(("seam-form", k))
+        .selected_text(shown)
+        .show_ui(ui, |ui| {
+            for (words, f) in forms {
+                if ui.selectable_label(same_kind(&f, &current), words).clicked() {
+                    chosen = f;
+                }
+            }
+        })
+        .response
+        .labelled_by(label.id)
+        .on_hover_text("Where artwork larger than a field is cut: straight on the seam; overlap (each side marks past the cut: alternating line by line, or twice); interlocked (cuts alternate within a band, a comb); staggered (a random offset per line within a band)");
+    (chosen != current).then(|| {
+        let mut l = layer.clone();
+        l.pen.seam = chosen;
         l
     })
 }

@@ -680,6 +680,7 @@ impl App {
             geometries: &self.session.doc.geometries,
             profile: &self.session.doc.profile,
             fields: &self.session.doc.fields,
+            seams: &self.session.doc.seams.lines,
             visiting: plan.map(|p| p.fields.as_slice()),
             // layer colours when the layers tell something apart (several, or a hatch)
             colours: (self.session.doc.layers.len() > 1
@@ -739,7 +740,8 @@ impl App {
                 );
             }
         }
-        self.on_canvas(actions);
+        let repaint = ui.ctx().clone();
+        self.on_canvas(actions, &repaint);
     }
 }
 

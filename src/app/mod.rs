@@ -35,7 +35,7 @@ use crate::document::{
     SolverSettings,
 };
 use crate::job::JobCtx;
-use crate::pipeline::{derive_geometries, place_document_fields};
+use crate::pipeline::{derive_geometries, move_seam, place_document_fields};
 use commands::{Command, Outcome};
 use compare::CompareState;
 use files::{ExportKind, Recent};
@@ -490,8 +490,11 @@ impl App {
             self.set_status(e.to_string(), true);
             return;
         }
-        if Some(DerivedKey::of(&layers, self.session.doc.profile.field_mm))
-            == self.session.doc.derived_with
+        if Some(DerivedKey::of(
+            &layers,
+            self.session.doc.profile.field_mm,
+            self.session.doc.tiling_set.as_ref(),
+        )) == self.session.doc.derived_with
         {
             let _ = self.execute(Command::SetLayers(layers));
             return;
@@ -933,7 +936,7 @@ impl App {
         }
     }
 
-    fn on_canvas(&mut self, actions: Vec<CanvasAction>) {
+    fn on_canvas(&mut self, actions: Vec<CanvasAction>, repaint: &egui::Context) {
         for a in actions {
             match a {
                 CanvasAction::Select(id) => self.view.selected = id,
@@ -973,8 +976,45 @@ impl App {
                         self.view.selected = o.added;
                     }
                 }
+                CanvasAction::MoveSeam {
+                    axis,
+                    from_mm,
+                    to_mm,
+                } => self.move_seam(axis, from_mm, to_mm, repaint),
             }
         }
+    }
+
+    /// Moves a seam: the geometries are cut again on the moved tiling and the fields placed
+    /// again, in a background job (undoable when it ends).
+    pub fn move_seam(&mut self, axis: usize, from_mm: f64, to_mm: f64, repaint: &egui::Context) {
+        if self.runtime.job.is_some() {
+            self.set_status("wait for the running job to end before moving a seam", true);
+            return;
+        }
+        let mut work = self.session.doc.clone();
+        let Some(at) = move_seam(&mut work, axis, from_mm, to_mm) else {
+            self.set_status("no seam to move there", true);
+            return;
+        };
+        let which = if axis == 0 { "x" } else { "y" };
+        self.start_job("moving a seam".into(), "seam", repaint, move |ctx| {
+            derive_geometries(&mut work, ctx).map_err(|e| e.to_string())?;
+            if work.fields.is_empty() && !work.geometries.is_empty() {
+                place_document_fields(&mut work, ctx).map_err(|e| gui_error(&e))?;
+            }
+            let what = format!(
+                "move seam {which} = {from_mm:.1} mm to {at:.1} mm: {} fields, {} split strokes",
+                work.fields.len(),
+                work.seams.split_strokes
+            );
+            Ok(JobResult::Placed {
+                doc: Box::new(work),
+                what,
+                problem: None,
+                refit: false,
+            })
+        });
     }
 
     /// Draws one frame.

@@ -26,6 +26,8 @@ pub mod colour {
     pub const OUT_OF_REACH: Color32 = Color32::from_rgb(147, 51, 234);
     /// Scan fields.
     pub const FIELD: Color32 = Color32::from_rgb(79, 70, 229);
+    /// Seams (where artwork larger than a field is cut).
+    pub const SEAM: Color32 = Color32::from_rgb(220, 38, 38);
     /// The selected field.
     pub const SELECTED: Color32 = Color32::from_rgb(245, 158, 11);
     /// Idle moves of a single plan, and plan A when two are overlaid.
@@ -86,6 +88,9 @@ pub fn paint(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
         paint_fields(painter, c, view, rect);
     }
     paint_artwork(painter, c, view, rect);
+    if c.layers.fields {
+        paint_seams(painter, c, view, rect);
+    }
     // during a playback the planned path steps back behind the machine
     let path_fade = if c.playback_t_s.is_some() { 0.35 } else { 1.0 };
     for (k, path) in c.paths.iter().enumerate() {
@@ -165,6 +170,24 @@ fn paint_fields(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
         );
         painter.galley(at + Vec2::new(3.0, 1.0), galley, Color32::WHITE);
     }
+}
+
+/// The seams through marked area: dashed lines where the fields' pieces meet.
+fn paint_seams(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
+    let s = |q: Pt| view.to_screen(rect, q);
+    let stroke = Stroke::new(1.5, colour::SEAM);
+    let mut shapes = Vec::new();
+    for line in c.seams {
+        for span in &line.spans {
+            let (a, b) = if line.axis == 0 {
+                (Pt::new(line.at_mm, span[0]), Pt::new(line.at_mm, span[1]))
+            } else {
+                (Pt::new(span[0], line.at_mm), Pt::new(span[1], line.at_mm))
+            };
+            shapes.extend(Shape::dashed_line(&[s(a), s(b)], stroke, 5.0, 3.0));
+        }
+    }
+    painter.extend(shapes);
 }
 
 fn paint_artwork(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {

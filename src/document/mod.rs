@@ -56,13 +56,16 @@ pub struct DerivedKey {
     /// Seam form and shifted passes (with the passes) per layer.
     #[serde(default)]
     pub seams: Vec<(SeamForm, bool, u32)>,
+    /// The tiling the operator set by moving seams (none: the planner's).
+    #[serde(default)]
+    pub tiling_set: Option<Tiling>,
     /// Scan-field size, mm.
     pub field_mm: [f64; 2],
 }
 
 impl DerivedKey {
-    /// The key of a layer table on a field size.
-    pub fn of(layers: &[Layer], field_mm: [f64; 2]) -> Self {
+    /// The key of a layer table on a field size, with the tiling the operator set.
+    pub fn of(layers: &[Layer], field_mm: [f64; 2], tiling_set: Option<&Tiling>) -> Self {
         Self {
             layers: layers
                 .iter()
@@ -72,6 +75,7 @@ impl DerivedKey {
                 .iter()
                 .map(|l| (l.pen.seam, l.pen.shift_passes, l.pen.passes))
                 .collect(),
+            tiling_set: tiling_set.cloned(),
             field_mm,
         }
     }
@@ -114,6 +118,10 @@ pub struct Document {
     /// What the cuts of `geometries` at the tiling's seams did.
     #[serde(default)]
     pub seams: SeamStats,
+    /// The tiling as the operator set it by moving seams (none: the planner chooses; see
+    /// `pipeline::move_seam`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tiling_set: Option<Tiling>,
     /// Warnings from the import (skipped elements, degenerate paths).
     pub warnings: Vec<Warning>,
     /// The machine the job is planned for.

@@ -195,7 +195,11 @@ fn upgrade_v1(doc: &mut Document) {
     };
     sync_layers(&mut doc.layers, &doc.artwork, &default_pen);
     sync_layers(&mut doc.layers, &doc.geometries, &default_pen);
-    doc.derived_with = Some(DerivedKey::of(&doc.layers, doc.profile.field_mm));
+    doc.derived_with = Some(DerivedKey::of(
+        &doc.layers,
+        doc.profile.field_mm,
+        doc.tiling_set.as_ref(),
+    ));
 }
 
 #[cfg(test)]

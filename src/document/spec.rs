@@ -794,9 +794,55 @@ pub fn pen_specs() -> Vec<FieldSpec<Pen>> {
             u32,
             |p| p.passes
         ),
+        choice!("Shifted passes", "shift_passes", |p| yes_no(p.shift_passes)),
         choice!("Hatch", "hatch", |p| hatch_words(p.hatch.as_ref())),
+        choice!("Seam", "seam", |p| p.seam.describe()),
+        seam_width_spec(),
         colour,
     ]
+}
+
+/// The seam form's width (band or overlap), typed; its form is chosen from a list.
+fn seam_width_spec() -> FieldSpec<Pen> {
+    FieldSpec {
+        label: "Seam width",
+        unit: "mm",
+        key: "seam_mm",
+        help: "interlocked and staggered: the band the cuts spread over; overlap: how far each side marks past the cut",
+        rule: Rule::Range(1e-3, crate::geom::seam::MAX_SEAM_BAND_MM),
+        optional: true,
+        shapes_plan: true,
+        show: |p: &Pen| seam_width(&p.seam).map_or_else(String::new, |w| w.to_string()),
+        number: |p: &Pen| seam_width(&p.seam),
+        parse: |p: &mut Pen, s: &str| {
+            use crate::geom::seam::SeamForm;
+            let s = s.trim();
+            if s.is_empty() {
+                return Ok(());
+            }
+            let w: f64 = s.parse().map_err(|_| format!("'{s}' is not a number"))?;
+            p.seam = match p.seam {
+                SeamForm::Straight => SeamForm::Straight,
+                SeamForm::Overlap { doubled, .. } => SeamForm::Overlap {
+                    overlap_mm: w,
+                    doubled,
+                },
+                SeamForm::Interlocked { .. } => SeamForm::Interlocked { band_mm: w },
+                SeamForm::Staggered { seed, .. } => SeamForm::Staggered { band_mm: w, seed },
+            };
+            Ok(())
+        },
+    }
+}
+
+/// The width of a seam form (none for straight), mm.
+pub fn seam_width(f: &crate::geom::seam::SeamForm) -> Option<f64> {
+    use crate::geom::seam::SeamForm;
+    match *f {
+        SeamForm::Straight => None,
+        SeamForm::Overlap { overlap_mm, .. } => Some(overlap_mm),
+        SeamForm::Interlocked { band_mm } | SeamForm::Staggered { band_mm, .. } => Some(band_mm),
+    }
 }
 
 /// A hatch's typed values (the layers panel's hatch rows).

@@ -243,15 +243,25 @@ fn cut_forms(
     (out, stats)
 }
 
-/// The hatch stage's cut: hatch strokes crossing a seam of the document's tiling (chosen by
-/// [`choose_document_tiling`]) are cut on it, so a fill larger than a field is cut along a few
-/// straight seams. Returns the tiling (none: nothing to cut) and the cut.
+/// The hatch stage's cut: hatch strokes crossing a seam of the document's tiling are cut on it,
+/// so a fill larger than a field is cut along a few straight seams. The tiling is `set` (the
+/// operator's, after moving seams) when that still covers what needs cutting with cells that
+/// fit, else chosen ([`choose_document_tiling`]). Returns the tiling (none: nothing to cut) and
+/// the cut.
 pub fn cut_hatch_at_tiling(
     geometries: Vec<Geometry>,
     layers: &[Layer],
     field_mm: [f64; 2],
+    set: Option<&Tiling>,
 ) -> (Option<Tiling>, Cut) {
-    let Some(tiling) = choose_document_tiling(&geometries, layers, field_mm) else {
+    let chosen = choose_document_tiling(&geometries, layers, field_mm);
+    let tiling = match (set, chosen) {
+        (Some(s), Some(c)) if fits_tiling(s, &c.extent(), cell_max_mm(layers, field_mm)) => {
+            Some(s.clone())
+        }
+        (_, c) => c,
+    };
+    let Some(tiling) = tiling else {
         return (
             None,
             Cut {
@@ -262,6 +272,48 @@ pub fn cut_hatch_at_tiling(
     };
     let cut = cut_at_tiling(geometries, &tiling, layers, field_mm, is_hatch_output);
     (Some(tiling), cut)
+}
+
+/// True when `t` covers `extent` and none of its cells is wider than `cell_max`.
+fn fits_tiling(t: &Tiling, extent: &BBox, cell_max: [f64; 2]) -> bool {
+    let cells_fit = |v: &[f64], max: f64| v.windows(2).all(|w| w[1] - w[0] <= max + 1e-9);
+    t.extent().contains_box(extent, 1e-9)
+        && cells_fit(&t.xs, cell_max[0])
+        && cells_fit(&t.ys, cell_max[1])
+}
+
+/// `tiling` with the seam of `axis` (0: vertical, x; 1: horizontal, y) nearest to `from_mm`
+/// moved towards `to_mm`, as far as its neighbours allow (no cell wider than `cell_max_mm`, no
+/// cell narrower than 1 mm). None when the axis has no seam.
+pub fn move_seam(
+    tiling: &Tiling,
+    axis: usize,
+    from_mm: f64,
+    to_mm: f64,
+    cell_max_mm: [f64; 2],
+) -> Option<Tiling> {
+    const MIN_CELL_MM: f64 = 1.0;
+    let borders = tiling.borders(axis);
+    let k = (1..borders.len().saturating_sub(1)).min_by(|&a, &b| {
+        (borders[a] - from_mm)
+            .abs()
+            .total_cmp(&(borders[b] - from_mm).abs())
+    })?;
+    let (prev, next) = (borders[k - 1], borders[k + 1]);
+    let max = cell_max_mm[axis.min(1)];
+    let lo = (prev + MIN_CELL_MM).max(next - max);
+    let hi = (next - MIN_CELL_MM).min(prev + max);
+    if lo > hi {
+        return None;
+    }
+    let mut moved = tiling.clone();
+    let v = if axis == 0 {
+        &mut moved.xs
+    } else {
+        &mut moved.ys
+    };
+    v[k] = to_mm.clamp(lo, hi);
+    Some(moved)
 }
 
 /// Replaces every oversize geometry by its pieces, cut at the seams of `tiling` (the document's,
