@@ -203,9 +203,56 @@ pub fn plan_document_lowered(
     plan.metrics.solve_s.hatch = hatch_s;
     plan.metrics.solve_s.fields = fields_s;
     plan.metrics.fields_lower_bound = Some(lower_bound);
+    if doc.geometries.iter().any(|g| g.pass > 0) {
+        compare_unshifted(doc, &mut plan, &toolpath, ctx)?;
+    }
     plan.metrics.solve_s.total =
         plan.metrics.solve_s.hatch + plan.metrics.solve_s.fields + plan.metrics.solve_s.order;
     Ok((plan, toolpath))
+}
+
+/// The words that begin the note comparing shifted passes with passes on the same seams.
+const SHIFTED_PREFIX: &str = "shifted passes: ";
+
+/// A plan with shifted passes: plans the same job with every pass cut on the same seams and
+/// says both job times in a warning, so the operator sees what shifting costs. Its planning
+/// time is counted in the order stage ("unshifted").
+fn compare_unshifted(
+    doc: &mut Document,
+    plan: &mut Plan,
+    toolpath: &Toolpath,
+    ctx: &JobCtx,
+) -> Result<(), PipelineError> {
+    let t = Instant::now();
+    let mut same = Document {
+        plans: Vec::new(),
+        kept_geometries: Vec::new(),
+        derived_with: None,
+        fields: Vec::new(),
+        ..doc.clone()
+    };
+    for l in &mut same.layers {
+        l.pen.shift_passes = false;
+    }
+    let (_, unshifted) = plan_document_lowered(&mut same, ctx)?;
+    let (a, b) = (toolpath.duration_s(), unshifted.duration_s());
+    let note = format!(
+        "{SHIFTED_PREFIX}the job takes {} s with each pass cut on its own seams ({} fields), against {} s with every pass on the same seams ({} fields)",
+        format_s(a),
+        plan.fields.len(),
+        format_s(b),
+        same.fields.len()
+    );
+    doc.warnings
+        .retain(|w| !w.message.starts_with(SHIFTED_PREFIX));
+    doc.warnings.push(choice_warning(note));
+    let s = t.elapsed().as_secs_f64();
+    plan.metrics.solve_s.order += s;
+    plan.metrics
+        .solve_s
+        .order_detail
+        .push(("unshifted".into(), s));
+    Ok(())
 }
 
 /// The hatch stage: makes the geometries to mark from the artwork and its layers' pens
@@ -551,7 +598,11 @@ fn cut_geometries(
 
 /// Drops the warnings of a cut and of the whole-or-cut choice (the geometries are whole again).
 fn drop_cut_warnings(warnings: &mut Vec<Warning>) {
-    warnings.retain(|w| !w.message.starts_with(CHOICE_PREFIX) && !w.message.contains(SPLIT_WORDS));
+    warnings.retain(|w| {
+        !w.message.starts_with(CHOICE_PREFIX)
+            && !w.message.starts_with(SHIFTED_PREFIX)
+            && !w.message.contains(SPLIT_WORDS)
+    });
 }
 
 /// A warning about a choice the solve made (no element of the drawing).

@@ -271,6 +271,13 @@ fn shifted_passes_never_cut_a_line_twice_at_one_place() {
     };
     assert!((length(1) - length(2)).abs() < 1e-6 * length(1));
     assert!(doc.geometries.iter().all(|g| g.pass > 0));
+    // the job time of both choices is said
+    let note = doc
+        .warnings
+        .iter()
+        .find(|w| w.message.starts_with("shifted passes:"))
+        .expect("a note comparing shifted and unshifted passes");
+    assert!(note.message.contains("against"), "{}", note.message);
 }
 
 #[test]

@@ -192,12 +192,13 @@ struct JobOpts {
     #[arg(long)]
     include_hidden_layers: bool,
     /// Hatch the closed shapes: STYLE:SPACING_MM[:ANGLE_DEG], STYLE = zigzag | lines | cross |
-    /// contour (closed paths of one SVG element form one region, even-odd).
+    /// contour (a layer's closed shapes form one region, even-odd; see --hatch-shapes).
     #[arg(long, value_name = "STYLE:SPACING_MM[:ANGLE_DEG]")]
     hatch: Option<String>,
     /// Pens by layer (TOML: `version = 1`, `[default]`, `[[layer]]` with `name`, `enabled`,
-    /// `mark_speed_mm_s`, `power`, `frequency_khz`, `passes`, `colour`, `[layer.hatch]`); layers
-    /// it does not name get its default pen, with --hatch as that pen's hatch.
+    /// `mark_speed_mm_s`, `power`, `frequency_khz`, `passes`, `shift_passes`, `seam`, `colour`,
+    /// `[layer.hatch]`); layers it does not name get its default pen, with --hatch as that pen's
+    /// hatch.
     #[arg(long, value_name = "PENS.toml")]
     pens: Option<PathBuf>,
     /// Hatch edge offset from the outline, mm (default: one spacing).

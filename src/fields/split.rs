@@ -406,7 +406,7 @@ mod tests {
             let mut gs = vec![g];
             split_oversize(&mut gs, None, &[], [70.0, 70.0]);
             let total: f64 = gs.iter().map(Geometry::length_mm).sum();
-            prop_assert!((total - length).abs() < 1e-6 * length.max(1.0) + 1e-7 * 4.0 * gs.len() as f64);
+            prop_assert!((total - length).abs() < 1e-6 * length.max(1.0) + crate::geom::seam::MIN_PIECE_MM * 4.0 * gs.len() as f64);
             for p in &gs {
                 prop_assert!(!is_oversize(p, [70.0, 70.0]));
             }

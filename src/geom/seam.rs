@@ -30,8 +30,9 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-/// Pieces shorter than this are dropped, mm (below any machine's resolution).
-pub const MIN_PIECE_MM: f64 = 1e-7;
+/// Pieces shorter than this are dropped, mm: below the resolution of the exported G-code (a
+/// crumb where a cut passes near a vertex would print as no move at all).
+pub const MIN_PIECE_MM: f64 = 1e-3;
 /// Crossings of one seam closer than this along it belong to one stretch of marked area (a
 /// fill's lines); a seam's length through marked area sums its stretches, mm.
 pub const SEAM_BRIDGE_MM: f64 = 2.0;
