@@ -162,6 +162,8 @@ pub struct Canvas<'a> {
     pub fields: &'a [ScanField],
     /// Seams: where artwork larger than a field is cut (drawn with the fields).
     pub seams: &'a [crate::geom::seam::SeamLine],
+    /// The tiling the seams belong to (its extent: how far a seam line runs).
+    pub tiling: Option<&'a crate::geom::tiling::Tiling>,
     /// The shown plan's fields in visiting order: fields are numbered 1…n in that order (the
     /// others after them), else in the order of `fields` (placement order).
     pub visiting: Option<&'a [ScanField]>,
@@ -264,6 +266,15 @@ impl Canvas<'_> {
             };
             let s = |q: Pt| state.view.to_screen(rect, q);
             painter.line_segment([s(a), s(b)], egui::Stroke::new(2.0, paint::colour::SEAM));
+            if let Some(p) = ui.input(|i| i.pointer.hover_pos()) {
+                painter.text(
+                    p + Vec2::new(12.0, -12.0),
+                    egui::Align2::LEFT_BOTTOM,
+                    format!("seam {} = {at_mm:.1} mm", if axis == 0 { "x" } else { "y" }),
+                    egui::FontId::proportional(13.0),
+                    paint::colour::SEAM,
+                );
+            }
         }
         let response = if state.drag == Drag::None {
             self.hover_info(response, rect, &state.view)
@@ -380,17 +391,18 @@ impl Canvas<'_> {
         }
     }
 
-    /// The seam within `tol_mm` of `p` (on its stretch through marked area): its axis and
-    /// position.
+    /// The seam within `tol_mm` of `p` (along the tiling's extent): its axis and position.
     pub fn seam_at(&self, p: Pt, tol_mm: f64) -> Option<(usize, f64)> {
+        let extent = self.tiling?.extent();
         self.seams
             .iter()
             .filter(|l| {
-                let (across, along) = if l.axis == 0 { (p.x, p.y) } else { (p.y, p.x) };
-                (across - l.at_mm).abs() <= tol_mm
-                    && l.spans
-                        .iter()
-                        .any(|s| along >= s[0] - tol_mm && along <= s[1] + tol_mm)
+                let (across, along, lo, hi) = if l.axis == 0 {
+                    (p.x, p.y, extent.min_y, extent.max_y)
+                } else {
+                    (p.y, p.x, extent.min_x, extent.max_x)
+                };
+                (across - l.at_mm).abs() <= tol_mm && along >= lo - tol_mm && along <= hi + tol_mm
             })
             .min_by(|a, b| {
                 let d = |l: &crate::geom::seam::SeamLine| {

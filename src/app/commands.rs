@@ -11,6 +11,8 @@ use crate::document::{
     MachineProfile, Plan, ScanField, SolverSettings, Warning,
 };
 use crate::fields::{add_field, delete_field, move_field, reallocate, set_locked};
+use crate::geom::seam::SeamStats;
+use crate::geom::tiling::Tiling;
 use crate::geom::Pt;
 use crate::job::JobCtx;
 use crate::pipeline::place_document_fields;
@@ -176,7 +178,7 @@ pub fn apply(doc: &mut Document, cmd: &Command) -> Result<Outcome, String> {
 }
 
 /// The artwork (with its page and import choices), the geometries (with their revision and
-/// the kept revisions), plans and warnings.
+/// the kept revisions, their tiling and seams), plans and warnings.
 #[derive(Debug, Clone)]
 struct Content {
     artwork: Vec<Geometry>,
@@ -187,6 +189,9 @@ struct Content {
     kept_geometries: Vec<GeometryRevision>,
     plans: Vec<Plan>,
     warnings: Vec<Warning>,
+    tiling: Option<Tiling>,
+    seams: SeamStats,
+    tiling_set: Option<Tiling>,
 }
 
 impl Content {
@@ -200,6 +205,9 @@ impl Content {
             kept_geometries: doc.kept_geometries.clone(),
             plans: doc.plans.clone(),
             warnings: doc.warnings.clone(),
+            tiling: doc.tiling.clone(),
+            seams: doc.seams.clone(),
+            tiling_set: doc.tiling_set.clone(),
         }
     }
     /// Puts this content into the document and returns what it replaced.
@@ -213,6 +221,9 @@ impl Content {
             kept_geometries: std::mem::replace(&mut doc.kept_geometries, self.kept_geometries),
             plans: std::mem::replace(&mut doc.plans, self.plans),
             warnings: std::mem::replace(&mut doc.warnings, self.warnings),
+            tiling: std::mem::replace(&mut doc.tiling, self.tiling),
+            seams: std::mem::replace(&mut doc.seams, self.seams),
+            tiling_set: std::mem::replace(&mut doc.tiling_set, self.tiling_set),
         }
     }
 }
@@ -351,6 +362,43 @@ mod tests {
             geometries: vec![sq(10.0, 10.0), sq(150.0, 150.0)],
             ..Document::default()
         }
+    }
+
+    #[test]
+    fn undo_restores_the_tiling_a_seam_move_changed() {
+        let mut d = doc();
+        let before = Tiling {
+            xs: vec![0.0, 60.0, 120.0],
+            ys: vec![0.0, 50.0],
+        };
+        d.tiling = Some(before.clone());
+        let mut moved = d.clone();
+        let after = Tiling {
+            xs: vec![0.0, 55.0, 120.0],
+            ys: vec![0.0, 50.0],
+        };
+        moved.tiling = Some(after.clone());
+        moved.tiling_set = Some(after.clone());
+        moved.seams.cuts = 9;
+        let mut h = History::default();
+        h.execute(
+            &mut d,
+            Command::SetContent {
+                doc: Box::new(moved),
+                what: "move seam".into(),
+            },
+            None,
+            "move seam".into(),
+        )
+        .unwrap();
+        assert_eq!(d.tiling_set.as_ref(), Some(&after));
+        assert_eq!(d.seams.cuts, 9);
+        h.undo(&mut d);
+        assert_eq!(d.tiling.as_ref(), Some(&before));
+        assert_eq!(d.tiling_set, None);
+        assert_eq!(d.seams.cuts, 0);
+        h.redo(&mut d);
+        assert_eq!(d.tiling_set.as_ref(), Some(&after));
     }
 
     #[test]

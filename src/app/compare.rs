@@ -590,6 +590,7 @@ pub fn show(
         profile: &doc.profile,
         fields: &doc.plans[k].fields,
         seams: &doc.plans[k].seams.lines,
+        tiling: doc.plans[k].tiling.as_ref(),
         visiting: Some(&doc.plans[k].fields),
         colours: None,
         out_of_reach: &[],

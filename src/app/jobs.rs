@@ -160,6 +160,8 @@ impl Job {
             profile: doc.profile.clone(),
             settings: doc.settings.clone(),
             fields: doc.fields.clone(),
+            tiling: doc.tiling.clone(),
+            seams: doc.seams.clone(),
             ..Document::default()
         };
         snapshot.settings.algo = algo;

@@ -439,18 +439,20 @@ impl LayerEditor {
                     if let Some(l) = shapes_ui(ui, k, layer) {
                         out = Some(l);
                     }
+                    ui.end_row();
                 }
-                ui.end_row();
+                // the seam, its width and shifted passes each on a row of their own
                 if let Some(l) = seam_ui(ui, k, layer) {
                     out = Some(l);
                 }
+                ui.end_row();
                 if crate::document::spec::seam_width(&layer.pen.seam).is_some() {
                     let n = COLS.len() - 1;
                     if let Some(l) = self.cell(ui, k, n, Col::SeamWidth, layer, "") {
                         out = Some(l);
                     }
+                    ui.end_row();
                 }
-                ui.end_row();
                 if layer.pen.passes > 1 {
                     let mut shift = layer.pen.shift_passes;
                     ui.label("");

@@ -681,6 +681,7 @@ impl App {
             profile: &self.session.doc.profile,
             fields: &self.session.doc.fields,
             seams: &self.session.doc.seams.lines,
+            tiling: self.session.doc.tiling.as_ref(),
             visiting: plan.map(|p| p.fields.as_slice()),
             // layer colours when the layers tell something apart (several, or a hatch)
             colours: (self.session.doc.layers.len() > 1

@@ -998,15 +998,22 @@ impl App {
             return;
         };
         let which = if axis == 0 { "x" } else { "y" };
+        // a drag past what the neighbours allow stops there, and says why
+        let limited = if (at - to_mm).abs() > 0.05 {
+            let cell = crate::fields::cell_max_mm(&work.layers, work.profile.field_mm)[axis.min(1)];
+            format!(" (as far as the next seams allow: no cell wider than {cell:.1} mm)")
+        } else {
+            String::new()
+        };
         self.start_job("moving a seam".into(), "seam", repaint, move |ctx| {
             derive_geometries(&mut work, ctx).map_err(|e| e.to_string())?;
             if work.fields.is_empty() && !work.geometries.is_empty() {
                 place_document_fields(&mut work, ctx).map_err(|e| gui_error(&e))?;
             }
             let what = format!(
-                "move seam {which} = {from_mm:.1} mm to {at:.1} mm: {} fields, {} split strokes",
-                work.fields.len(),
-                work.seams.split_strokes
+                "move seam {which} = {from_mm:.1} mm to {at:.1} mm{limited}: {}, {}",
+                count(work.fields.len(), "field", "fields"),
+                count(work.seams.split_strokes, "split stroke", "split strokes")
             );
             Ok(JobResult::Placed {
                 doc: Box::new(work),

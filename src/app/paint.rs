@@ -27,7 +27,7 @@ pub mod colour {
     /// Scan fields.
     pub const FIELD: Color32 = Color32::from_rgb(79, 70, 229);
     /// Seams (where artwork larger than a field is cut).
-    pub const SEAM: Color32 = Color32::from_rgb(220, 38, 38);
+    pub const SEAM: Color32 = Color32::from_rgb(153, 27, 27);
     /// The selected field.
     pub const SELECTED: Color32 = Color32::from_rgb(245, 158, 11);
     /// Idle moves of a single plan, and plan A when two are overlaid.
@@ -172,22 +172,38 @@ fn paint_fields(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
     }
 }
 
-/// The seams through marked area: dashed lines where the fields' pieces meet.
+/// The seams: a thin line across the tiling's extent, solid and thick through marked area
+/// (unlike the dashed idle moves).
 fn paint_seams(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
+    let Some(extent) = c.tiling.map(crate::geom::tiling::Tiling::extent) else {
+        return;
+    };
     let s = |q: Pt| view.to_screen(rect, q);
-    let stroke = Stroke::new(1.5, colour::SEAM);
-    let mut shapes = Vec::new();
+    let at = |axis: usize, across: f64, along: f64| {
+        if axis == 0 {
+            s(Pt::new(across, along))
+        } else {
+            s(Pt::new(along, across))
+        }
+    };
     for line in c.seams {
+        let (lo, hi) = if line.axis == 0 {
+            (extent.min_y, extent.max_y)
+        } else {
+            (extent.min_x, extent.max_x)
+        };
+        painter.line_segment(
+            [at(line.axis, line.at_mm, lo), at(line.axis, line.at_mm, hi)],
+            Stroke::new(1.0, colour::SEAM.gamma_multiply(0.6)),
+        );
         for span in &line.spans {
-            let (a, b) = if line.axis == 0 {
-                (Pt::new(line.at_mm, span[0]), Pt::new(line.at_mm, span[1]))
-            } else {
-                (Pt::new(span[0], line.at_mm), Pt::new(span[1], line.at_mm))
-            };
-            shapes.extend(Shape::dashed_line(&[s(a), s(b)], stroke, 5.0, 3.0));
+            let (a, b) = (
+                at(line.axis, line.at_mm, span[0]),
+                at(line.axis, line.at_mm, span[1]),
+            );
+            painter.line_segment([a, b], Stroke::new(2.5, colour::SEAM));
         }
     }
-    painter.extend(shapes);
 }
 
 fn paint_artwork(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {

@@ -244,11 +244,11 @@ impl SeamStats {
 
     /// Seam length through marked area, mm.
     pub fn length_mm(&self) -> f64 {
+        // a fold from +0: an empty `sum` of floats is −0
         self.lines
             .iter()
             .flat_map(|l| l.spans.iter())
-            .map(|s| s[1] - s[0])
-            .sum()
+            .fold(0.0, |acc, s| acc + (s[1] - s[0]))
     }
 
     /// Adds another cut's figures (seam lines at the same place merge).
