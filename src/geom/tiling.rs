@@ -52,6 +52,27 @@ pub struct TilingInput<'a> {
 }
 
 impl Tiling {
+    /// The grid of cells `cell_mm` wide anchored at the extent's lower corner (the last cell of
+    /// each axis takes what is left): a tiling chosen by nothing but its corner.
+    pub fn anchored(extent: BBox, cell_mm: [f64; 2]) -> Tiling {
+        let axis = |lo: f64, hi: f64, cell: f64| -> Vec<f64> {
+            let mut v = vec![lo];
+            if cell > 0.0 && cell.is_finite() {
+                let mut k = 1.0;
+                while lo + k * cell < hi {
+                    v.push(lo + k * cell);
+                    k += 1.0;
+                }
+            }
+            v.push(hi);
+            v
+        };
+        Tiling {
+            xs: axis(extent.min_x, extent.max_x, cell_mm[0]),
+            ys: axis(extent.min_y, extent.max_y, cell_mm[1]),
+        }
+    }
+
     /// Borders of `axis` (0: x, 1: y).
     pub fn borders(&self, axis: usize) -> &[f64] {
         if axis == 0 {

@@ -36,22 +36,7 @@ pub fn hatch_geometries(
     ctx: &JobCtx,
 ) -> Result<HatchedGeometries, HatchError> {
     settings.check()?;
-    // regions in order of first appearance
-    let mut region_of: HashMap<&str, usize> = HashMap::new();
-    let mut regions: Vec<Vec<usize>> = Vec::new();
-    for (i, g) in geometries.iter().enumerate() {
-        if g.closed && g.points.len() >= 3 && !is_hatch_output(g) {
-            let key = match settings.shapes {
-                FillShapes::Together => "",
-                FillShapes::Apart => g.source.element.as_str(),
-            };
-            let r = *region_of.entry(key).or_insert_with(|| {
-                regions.push(Vec::new());
-                regions.len() - 1
-            });
-            regions[r].push(i);
-        }
-    }
+    let regions = fill_regions(geometries, settings.shapes);
     let hatched: Vec<Result<Vec<Geometry>, HatchError>> = regions
         .par_iter()
         .map(|members| {
@@ -156,6 +141,72 @@ pub fn layer_geometries(
         }
     }
     Ok(out)
+}
+
+/// The regions to fill, each a list of closed geometries (indices), in order of first
+/// appearance. Apart: the closed geometries of one drawing element form a region. Together:
+/// also shapes whose boxes overlap join one region (a shape inside another is then a hole by
+/// the fill rule, overlapping shapes are filled once); shapes apart from every other stay
+/// regions of their own, so a layer of separate shapes is filled exactly as apart (its hatch
+/// lines keep each shape's own phase).
+fn fill_regions(geometries: &[Geometry], shapes: FillShapes) -> Vec<Vec<usize>> {
+    let closed: Vec<usize> = (0..geometries.len())
+        .filter(|&i| {
+            let g = &geometries[i];
+            g.closed && g.points.len() >= 3 && !is_hatch_output(g)
+        })
+        .collect();
+    // union-find over the closed geometries (by position in `closed`)
+    let mut parent: Vec<usize> = (0..closed.len()).collect();
+    fn root(parent: &mut [usize], mut k: usize) -> usize {
+        while parent[k] != k {
+            parent[k] = parent[parent[k]];
+            k = parent[k];
+        }
+        k
+    }
+    let join = |parent: &mut Vec<usize>, a: usize, b: usize| {
+        let (ra, rb) = (root(parent, a), root(parent, b));
+        if ra != rb {
+            // the earlier one stays the root: regions keep their first member's place
+            parent[ra.max(rb)] = ra.min(rb);
+        }
+    };
+    let mut first_of: HashMap<&str, usize> = HashMap::new();
+    for (k, &i) in closed.iter().enumerate() {
+        let first = *first_of
+            .entry(geometries[i].source.element.as_str())
+            .or_insert(k);
+        join(&mut parent, first, k);
+    }
+    if shapes == FillShapes::Together {
+        // sweep over boxes sorted by their left edge: overlapping boxes join
+        let boxes: Vec<crate::geom::BBox> = closed.iter().map(|&i| geometries[i].bbox()).collect();
+        let mut by_x: Vec<usize> = (0..closed.len()).collect();
+        by_x.sort_by(|&a, &b| boxes[a].min_x.total_cmp(&boxes[b].min_x));
+        let mut open: Vec<usize> = Vec::new();
+        for &k in &by_x {
+            let b = boxes[k];
+            open.retain(|&o| boxes[o].max_x >= b.min_x);
+            for &o in &open {
+                if boxes[o].min_y <= b.max_y && b.min_y <= boxes[o].max_y {
+                    join(&mut parent, o, k);
+                }
+            }
+            open.push(k);
+        }
+    }
+    let mut region_of: HashMap<usize, usize> = HashMap::new();
+    let mut regions: Vec<Vec<usize>> = Vec::new();
+    for (k, &i) in closed.iter().enumerate() {
+        let r = root(&mut parent, k);
+        let slot = *region_of.entry(r).or_insert_with(|| {
+            regions.push(Vec::new());
+            regions.len() - 1
+        });
+        regions[slot].push(i);
+    }
+    regions
 }
 
 /// One region's hatch as geometries.
@@ -311,6 +362,21 @@ mod tests {
         assert!(inside(&apart, 30.0, 30.0, 40.0, 1.5) > 0);
         let len = |h: &HatchedGeometries| h.geometries.iter().map(Geometry::length_mm).sum::<f64>();
         assert!(len(&apart) > len(&together) + 1500.0);
+    }
+
+    #[test]
+    fn separate_shapes_are_filled_together_exactly_as_apart() {
+        let gs = vec![
+            geom(square(0.0, 0.0, 20.0), true, "#a"),
+            geom(square(30.0, 0.0, 20.0), true, "#b"),
+            geom(square(30.0, 30.0, 20.0), true, "#c"),
+        ];
+        let mut s = HatchSettings::new(HatchStyle::Zigzag, 0.7);
+        let together = hatch_geometries(&gs, &s, &JobCtx::default()).unwrap();
+        s.shapes = FillShapes::Apart;
+        let apart = hatch_geometries(&gs, &s, &JobCtx::default()).unwrap();
+        assert_eq!(together.regions, 3);
+        assert_eq!(together.geometries, apart.geometries);
     }
 
     #[test]
