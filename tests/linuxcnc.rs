@@ -105,7 +105,11 @@ fn on_the_fly_lines_last_the_planned_time_and_stay_within_the_tolerance() {
     let clock = LinuxcncClock::of(&profile).unwrap();
     let (start, lines) = otf_lines(&toolpath, tol);
     let controller_s = clock.otf_program_s(&start, &lines);
-    assert!((controller_s - toolpath.duration_s()).abs() <= 1e-6 * controller_s);
+    assert!(
+        (controller_s - toolpath.duration_s()).abs() <= 1e-6 * controller_s,
+        "{controller_s} vs {}",
+        toolpath.duration_s()
+    );
     // every waypoint lies within the tolerance of the line through it (in planned time)
     let waypoints: Vec<Vec<f64>> = waypoints_csv(&toolpath)
         .lines()

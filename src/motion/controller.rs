@@ -319,6 +319,9 @@ struct Sample {
 }
 
 /// Samples of an on-the-fly toolpath (see [`otf_lines`]), in the toolpath's time.
+/// Slack when counting whole sample periods in a segment, in periods.
+const SAMPLE_COUNT_TOL: f64 = 1e-6;
+
 fn otf_samples(toolpath: &Toolpath) -> Vec<Sample> {
     let k = toolpath.stretch();
     let period_s = OTF_SAMPLE_S * k;
@@ -336,11 +339,17 @@ fn otf_samples(toolpath: &Toolpath) -> Vec<Sample> {
     });
     let mut times = Vec::new();
     for seg in &toolpath.segments {
-        if seg.duration_s <= TIME_EPS_S {
+        // counted in planned time, with a tolerance: a stretched toolpath (times × k, rounded)
+        // samples exactly as the one it was stretched from (a segment of exactly 50 periods
+        // must not become 51)
+        let planned_s = seg.duration_s / k;
+        if planned_s <= TIME_EPS_S {
             continue;
         }
         times.clear();
-        let n = (seg.duration_s / period_s).ceil() as usize;
+        let n = (planned_s / OTF_SAMPLE_S - SAMPLE_COUNT_TOL)
+            .ceil()
+            .max(1.0) as usize;
         for j in 1..n {
             times.push(seg.start_s + j as f64 * seg.duration_s / n as f64);
         }
