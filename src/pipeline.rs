@@ -211,6 +211,25 @@ pub fn plan_document_lowered(
     Ok((plan, toolpath))
 }
 
+/// Geometries cut on one tiling in the whole-or-cut choice, placed and ordered.
+struct CutCandidate {
+    /// What the choice's timing detail calls it.
+    label: &'static str,
+    pieces: Vec<crate::document::Geometry>,
+    warnings: Vec<Warning>,
+    seams: SeamStats,
+    tiling: Option<Tiling>,
+    placement: Placement,
+    made: (Plan, Toolpath),
+}
+
+impl CutCandidate {
+    /// Its job time, s.
+    fn job_s(&self) -> f64 {
+        self.made.1.duration_s()
+    }
+}
+
 /// The field grid's cells are this much narrower than the field, mm.
 const FIELD_GRID_SLACK_MM: f64 = 1e-6;
 
@@ -552,32 +571,38 @@ fn whole_or_cut(
                 })?;
             let made =
                 order_plan(&pieces, &placement.fields, &judge, ctx).map_err(as_order_error)?;
-            cuts_made.push((label, pieces, warnings, seams, tiling, placement, made));
+            cuts_made.push(CutCandidate {
+                label,
+                pieces,
+                warnings,
+                seams,
+                tiling,
+                placement,
+                made,
+            });
         }
         // the chosen plan's order stage: every candidate's ordering
         let mut detail = vec![("whole".to_string(), whole.0.metrics.solve_s.order)];
         detail.extend(
             cuts_made
                 .iter()
-                .map(|c| (c.0.to_string(), c.6 .0.metrics.solve_s.order)),
+                .map(|c| (c.label.to_string(), c.made.0.metrics.solve_s.order)),
         );
         let order_s = detail.iter().map(|d| d.1).sum::<f64>();
         let best = cuts_made
             .into_iter()
-            .min_by(|a, b| a.6 .1.duration_s().total_cmp(&b.6 .1.duration_s()));
+            .min_by(|a, b| a.job_s().total_cmp(&b.job_s()));
         let whole_s = format_s(whole.1.duration_s());
         let (mut made, lower_bound, note) = match best {
-            Some((_, pieces, cuts, seams, tiling, placement, cut))
-                if cut.1.duration_s() < whole.1.duration_s() =>
-            {
-                let cut_s = format_s(cut.1.duration_s());
-                cut_geometries(doc, pieces, cuts, seams, tiling);
-                doc.fields = placement.fields;
+            Some(c) if c.job_s() < whole.1.duration_s() => {
+                let cut_s = format_s(c.job_s());
+                cut_geometries(doc, c.pieces, c.warnings, c.seams, c.tiling);
+                doc.fields = c.placement.fields;
                 let note = format!("cut at field borders: the job takes {cut_s} s cut against {whole_s} s marked whole on the fly");
-                (cut, placement.lower_bound, note)
+                (c.made, c.placement.lower_bound, note)
             }
             best => {
-                let cut_s = best.map_or_else(|| "–".into(), |c| format_s(c.6 .1.duration_s()));
+                let cut_s = best.map_or_else(|| "–".into(), |c| format_s(c.job_s()));
                 doc.fields = whole_region.fields;
                 let note = format!("marked whole on the fly: the job takes {whole_s} s against {cut_s} s cut at field borders");
                 (whole, whole_region.lower_bound, note)

@@ -341,3 +341,25 @@ fn a_seam_moved_by_hand_moves_the_cuts() {
     let back: Document = serde_json::from_str(&text).unwrap();
     assert_eq!(back.tiling_set, doc.tiling_set);
 }
+
+#[test]
+fn a_plan_keeps_its_geometries_when_a_hatch_change_makes_fewer() {
+    let mut doc = load(&plate_svg(""), "zigzag:0.5:0", SeamForm::Straight);
+    let p = plan(&mut doc);
+    doc.plans.push(p);
+    let before = doc.geometries.len();
+    for l in &mut doc.layers {
+        if let Some(h) = &mut l.pen.hatch {
+            h.spacing_mm = 0.8;
+        }
+    }
+    galvoplan::pipeline::derive_geometries(&mut doc, &JobCtx::default()).unwrap();
+    galvoplan::pipeline::place_document_fields(&mut doc, &JobCtx::default()).unwrap();
+    assert!(doc.geometries.len() < before);
+    // the plan names the geometries it was planned on, which the document keeps
+    doc.validate().unwrap();
+    assert_eq!(
+        doc.plan_geometries(&doc.plans[0]).map(<[_]>::len),
+        Some(before)
+    );
+}

@@ -267,13 +267,16 @@ impl Canvas<'_> {
             let s = |q: Pt| state.view.to_screen(rect, q);
             painter.line_segment([s(a), s(b)], egui::Stroke::new(2.0, paint::colour::SEAM));
             if let Some(p) = ui.input(|i| i.pointer.hover_pos()) {
-                painter.text(
-                    p + Vec2::new(12.0, -12.0),
-                    egui::Align2::LEFT_BOTTOM,
+                // white on the seam's colour: readable over dark hatch
+                let galley = painter.layout_no_wrap(
                     format!("seam {} = {at_mm:.1} mm", if axis == 0 { "x" } else { "y" }),
                     egui::FontId::proportional(13.0),
-                    paint::colour::SEAM,
+                    egui::Color32::WHITE,
                 );
+                let at = p + Vec2::new(12.0, -12.0 - galley.size().y);
+                let bg = Rect::from_min_size(at, galley.size() + Vec2::new(6.0, 2.0));
+                painter.rect_filled(bg, 3.0, paint::colour::SEAM);
+                painter.galley(at + Vec2::new(3.0, 1.0), galley, egui::Color32::WHITE);
             }
         }
         let response = if state.drag == Drag::None {

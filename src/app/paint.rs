@@ -88,9 +88,6 @@ pub fn paint(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
         paint_fields(painter, c, view, rect);
     }
     paint_artwork(painter, c, view, rect);
-    if c.layers.fields {
-        paint_seams(painter, c, view, rect);
-    }
     // during a playback the planned path steps back behind the machine
     let path_fade = if c.playback_t_s.is_some() { 0.35 } else { 1.0 };
     for (k, path) in c.paths.iter().enumerate() {
@@ -108,6 +105,10 @@ pub fn paint(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
         if c.layers.path {
             paint_path(painter, c, path, lowered, view, rect);
         }
+    }
+    // seams over the planned paths: an idle move along a seam must not hide it
+    if c.layers.fields {
+        paint_seams(painter, c, view, rect);
     }
     if let Some(t_s) = c.playback_t_s {
         let s = |q: Pt| view.to_screen(rect, q);

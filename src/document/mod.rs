@@ -164,12 +164,13 @@ impl Document {
         let held = self
             .fields
             .iter()
-            .flat_map(|f| f.geometries.iter().map(move |&g| (f.id, g)));
-        let planned = self
-            .plans
-            .iter()
-            .flat_map(|p| p.order.iter().map(|s| (s.field, s.geometry)));
-        if let Some((field, g)) = held.chain(planned).find(|&(_, g)| g >= n) {
+            .flat_map(|f| f.geometries.iter().map(move |&g| (f.id, g, n)));
+        // a plan names the geometries of its own revision (kept when they changed since)
+        let planned = self.plans.iter().flat_map(|p| {
+            let n = self.plan_geometries(p).map_or(0, <[Geometry]>::len);
+            p.order.iter().map(move |s| (s.field, s.geometry, n))
+        });
+        if let Some((field, g, n)) = held.chain(planned).find(|&(_, g, n)| g >= n) {
             return Err(InvalidValue::new(
                 format!("A geometry of scan field {field}"),
                 "geometries",
