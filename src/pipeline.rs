@@ -336,13 +336,7 @@ pub fn derive_geometries(doc: &mut Document, ctx: &JobCtx) -> Result<f64, Pipeli
 pub fn move_seam(doc: &mut Document, axis: usize, from_mm: f64, to_mm: f64) -> Option<f64> {
     let tiling = doc.tiling.as_ref()?;
     let cell_max = crate::fields::cell_max_mm(&doc.layers, doc.profile.field_mm);
-    let moved = crate::fields::move_seam(tiling, axis, from_mm, to_mm, cell_max)?;
-    let borders = moved.borders(axis);
-    let at = borders
-        .iter()
-        .zip(tiling.borders(axis))
-        .find(|(a, b)| a != b)
-        .map_or(to_mm, |(a, _)| *a);
+    let (moved, at) = crate::fields::move_seam(tiling, axis, from_mm, to_mm, cell_max)?;
     doc.tiling_set = Some(moved);
     Some(at)
 }

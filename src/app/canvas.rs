@@ -164,6 +164,8 @@ pub struct Canvas<'a> {
     pub seams: &'a [crate::geom::seam::SeamLine],
     /// The tiling the seams belong to (its extent: how far a seam line runs).
     pub tiling: Option<&'a crate::geom::tiling::Tiling>,
+    /// The widest cell the tiling may have (how far a seam can be dragged), mm.
+    pub cell_max_mm: [f64; 2],
     /// The shown plan's fields in visiting order: fields are numbered 1…n in that order (the
     /// others after them), else in the order of `fields` (placement order).
     pub visiting: Option<&'a [ScanField]>,
@@ -334,7 +336,14 @@ impl Canvas<'_> {
                 Drag::Seam { axis, from_mm, .. } => {
                     if let Some(p) = response.interact_pointer_pos() {
                         let mm = view.to_mm(rect, p);
-                        let at_mm = if axis == 0 { mm.x } else { mm.y };
+                        let to_mm = if axis == 0 { mm.x } else { mm.y };
+                        // where the seam will land: as far as its neighbours allow
+                        let at_mm = self
+                            .tiling
+                            .and_then(|t| {
+                                crate::fields::move_seam(t, axis, from_mm, to_mm, self.cell_max_mm)
+                            })
+                            .map_or(to_mm, |(_, at)| at);
                         state.drag = Drag::Seam {
                             axis,
                             from_mm,

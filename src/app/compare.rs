@@ -591,6 +591,10 @@ pub fn show(
         fields: &doc.plans[k].fields,
         seams: &doc.plans[k].seams.lines,
         tiling: doc.plans[k].tiling.as_ref(),
+        cell_max_mm: crate::fields::cell_max_mm(
+            &doc.plans[k].layers,
+            doc.plans[k].profile.field_mm,
+        ),
         visiting: Some(&doc.plans[k].fields),
         colours: None,
         out_of_reach: &[],

@@ -682,6 +682,10 @@ impl App {
             fields: &self.session.doc.fields,
             seams: &self.session.doc.seams.lines,
             tiling: self.session.doc.tiling.as_ref(),
+            cell_max_mm: crate::fields::cell_max_mm(
+                &self.session.doc.layers,
+                self.session.doc.profile.field_mm,
+            ),
             visiting: plan.map(|p| p.fields.as_slice()),
             // layer colours when the layers tell something apart (several, or a hatch)
             colours: (self.session.doc.layers.len() > 1

@@ -284,14 +284,14 @@ fn fits_tiling(t: &Tiling, extent: &BBox, cell_max: [f64; 2]) -> bool {
 
 /// `tiling` with the seam of `axis` (0: vertical, x; 1: horizontal, y) nearest to `from_mm`
 /// moved towards `to_mm`, as far as its neighbours allow (no cell wider than `cell_max_mm`, no
-/// cell narrower than 1 mm). None when the axis has no seam.
+/// cell narrower than 1 mm), and where the seam went, mm. None when the axis has no seam.
 pub fn move_seam(
     tiling: &Tiling,
     axis: usize,
     from_mm: f64,
     to_mm: f64,
     cell_max_mm: [f64; 2],
-) -> Option<Tiling> {
+) -> Option<(Tiling, f64)> {
     const MIN_CELL_MM: f64 = 1.0;
     let borders = tiling.borders(axis);
     let k = (1..borders.len().saturating_sub(1)).min_by(|&a, &b| {
@@ -312,8 +312,9 @@ pub fn move_seam(
     } else {
         &mut moved.ys
     };
-    v[k] = to_mm.clamp(lo, hi);
-    Some(moved)
+    let at = to_mm.clamp(lo, hi);
+    v[k] = at;
+    Some((moved, at))
 }
 
 /// Replaces every oversize geometry by its pieces, cut at the seams of `tiling` (the document's,
