@@ -246,13 +246,16 @@ fn compare_unshifted(
     ctx: &JobCtx,
 ) -> Result<(), PipelineError> {
     let t = Instant::now();
+    // the plans and the geometries they keep play no part: not cloned
+    let plans = std::mem::take(&mut doc.plans);
+    let kept = std::mem::take(&mut doc.kept_geometries);
     let mut same = Document {
-        plans: Vec::new(),
-        kept_geometries: Vec::new(),
         derived_with: None,
         fields: Vec::new(),
         ..doc.clone()
     };
+    doc.plans = plans;
+    doc.kept_geometries = kept;
     for l in &mut same.layers {
         l.pen.shift_passes = false;
     }
@@ -343,11 +346,7 @@ pub fn move_seam(doc: &mut Document, axis: usize, from_mm: f64, to_mm: f64) -> O
 
 /// The pen of layers nothing else names: defaults, with the settings' hatch (`--hatch`).
 pub fn default_pen(settings: &SolverSettings) -> Pen {
-    Pen {
-        hatch: settings.hatch.clone(),
-        seam: settings.seam,
-        ..Pen::default()
-    }
+    settings.default_pen()
 }
 
 /// Gives the document's layers the pens of a library (`--pens`; the library's default pen, or

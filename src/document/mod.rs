@@ -53,7 +53,7 @@ pub use warning::{short_list, Warning, LIST_MAX};
 pub struct DerivedKey {
     /// (name, enabled, hatch) per layer.
     pub layers: Vec<(String, bool, Option<HatchSettings>)>,
-    /// Seam form and shifted passes (with the passes) per layer.
+    /// Per layer: seam form, whether its passes are shifted, and then how many (1 otherwise).
     #[serde(default)]
     pub seams: Vec<(SeamForm, bool, u32)>,
     /// The tiling the operator set by moving seams (none: the planner's).
@@ -73,7 +73,12 @@ impl DerivedKey {
                 .collect(),
             seams: layers
                 .iter()
-                .map(|l| (l.pen.seam, l.pen.shift_passes, l.pen.passes))
+                // passes cut geometries of their own only when shifted: else a change of
+                // passes needs no new geometries
+                .map(|l| {
+                    let shifted = l.pen.shift_passes && l.pen.passes > 1;
+                    (l.pen.seam, shifted, if shifted { l.pen.passes } else { 1 })
+                })
                 .collect(),
             tiling_set: tiling_set.cloned(),
             field_mm,

@@ -1,7 +1,7 @@
 //! Project files: the whole [`Document`] as versioned JSON, written atomically.
 
 use super::validate::InvalidValue;
-use super::{sync_layers, DerivedKey, Document, Pen};
+use super::{sync_layers, DerivedKey, Document};
 use serde::{Deserialize, Serialize};
 use std::io::Write;
 use std::path::Path;
@@ -189,10 +189,7 @@ fn upgrade_v1(doc: &mut Document) {
         .filter(|g| !super::is_hatch_output(g))
         .cloned()
         .collect();
-    let default_pen = Pen {
-        hatch: doc.settings.hatch.clone(),
-        ..Pen::default()
-    };
+    let default_pen = doc.settings.default_pen();
     sync_layers(&mut doc.layers, &doc.artwork, &default_pen);
     sync_layers(&mut doc.layers, &doc.geometries, &default_pen);
     doc.derived_with = Some(DerivedKey::of(

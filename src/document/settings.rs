@@ -311,6 +311,18 @@ pub struct SolverSettings {
     pub seam: crate::geom::seam::SeamForm,
 }
 
+impl SolverSettings {
+    /// The pen of layers nothing else names: defaults, with these settings' hatch (`--hatch`)
+    /// and seam form (`--seam`).
+    pub fn default_pen(&self) -> super::Pen {
+        super::Pen {
+            hatch: self.hatch.clone(),
+            seam: self.seam,
+            ..super::Pen::default()
+        }
+    }
+}
+
 impl Default for SolverSettings {
     fn default() -> Self {
         Self {

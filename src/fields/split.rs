@@ -226,13 +226,7 @@ fn cut_forms(
             .iter()
             .map(|&i| (geometries[i].points.as_slice(), geometries[i].closed))
             .collect();
-        let cut = cut_at_seams(
-            &strokes,
-            tiling,
-            form,
-            |_| false,
-            |p| fits_box(&BBox::of(p), field_mm),
-        );
+        let cut = cut_at_seams(&strokes, tiling, form, |p| fits_box(&BBox::of(p), field_mm));
         stats.merge(cut.stats);
         let mut pieces: Vec<Pieces> = vec![Vec::new(); members.len()];
         for (k, points, closed) in cut.pieces {

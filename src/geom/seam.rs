@@ -16,7 +16,7 @@
 //!   of `2d` is shared line by line between the two fields (on a fill the dose is unchanged;
 //!   this is an interlocked seam of band `2d`). *Doubled*: the piece before the cut runs `d`
 //!   past the seam and the piece after it starts `d` before it, so `2d` of each crossing (along
-//!   the seam's normal) is marked twice; that length is [`SeamCut::extra_marked_mm`].
+//!   the seam's normal) is marked twice; that length is [`SeamStats::extra_marked_mm`].
 //!
 //! Every form is exact: the pieces together are the stroke (plus, for doubled overlap, the
 //! declared overlaps), and no cut leaves its segment: a cut offset that would pass the end of
@@ -297,13 +297,6 @@ pub struct SeamCut {
     pub stats: SeamStats,
 }
 
-impl SeamCut {
-    /// Length marked twice on purpose, mm (see [`SeamStats::extra_marked_mm`]).
-    pub fn extra_marked_mm(&self) -> f64 {
-        self.stats.extra_marked_mm
-    }
-}
-
 /// A stroke crossing a seam.
 #[derive(Debug, Clone, Copy)]
 struct Crossing {
@@ -320,18 +313,16 @@ struct Crossing {
     t_start: f64,
 }
 
-/// Cuts `strokes` (`points`, `closed`) where they cross the seams of `tiling`, in `form`. Strokes
-/// for which `keep_whole` says true are left whole (they cost the tiling a field, see
-/// [`super::tiling::SMALL_CROSS_WEIGHT`]). A closed stroke's last and first piece are joined
+/// Cuts `strokes` (`points`, `closed`) where they cross the seams of `tiling`, in `form` (the
+/// caller passes only the strokes to cut). A closed stroke's last and first piece are joined
 /// when `fits` says the joined piece fits a field.
 pub fn cut_at_seams(
     strokes: &[(&[Pt], bool)],
     tiling: &Tiling,
     form: SeamForm,
-    keep_whole: impl Fn(usize) -> bool,
     fits: impl Fn(&[Pt]) -> bool,
 ) -> SeamCut {
-    let mut crossings = find_crossings(strokes, tiling, &keep_whole);
+    let mut crossings = find_crossings(strokes, tiling);
     place_cuts(&mut crossings, tiling, form, strokes);
     let mut out = SeamCut::default();
     out.stats.lines = seam_lines(&crossings, tiling);
@@ -368,16 +359,12 @@ pub fn cut_at_seams(
 /// Every crossing of a stroke's segment with a seam line inside the tiling's extent: the seam
 /// at `c` is crossed by a segment whose coordinate range has `min < c ≤ max` (a vertex on the
 /// seam is cut once).
-fn find_crossings(
-    strokes: &[(&[Pt], bool)],
-    tiling: &Tiling,
-    keep_whole: &impl Fn(usize) -> bool,
-) -> Vec<Crossing> {
+fn find_crossings(strokes: &[(&[Pt], bool)], tiling: &Tiling) -> Vec<Crossing> {
     let mut out = Vec::new();
     let extent = tiling.extent();
     let eps = 1e-9;
     for (k, &(points, closed)) in strokes.iter().enumerate() {
-        if keep_whole(k) || points.len() < 2 {
+        if points.len() < 2 {
             continue;
         }
         let n = points.len();
@@ -625,7 +612,7 @@ mod tests {
 
     fn cut(form: SeamForm, ls: &[Vec<Pt>], t: &Tiling) -> SeamCut {
         let strokes: Vec<(&[Pt], bool)> = ls.iter().map(|p| (p.as_slice(), false)).collect();
-        cut_at_seams(&strokes, t, form, |_| false, |_| true)
+        cut_at_seams(&strokes, t, form, |_| true)
     }
 
     /// The x of every cut of stroke `k` (piece ends away from the stroke's ends).
@@ -674,7 +661,7 @@ mod tests {
         }
         let total: f64 = c.pieces.iter().map(|p| polyline_length(&p.1, false)).sum();
         assert!((total - 20.0 * 240.0).abs() < 1e-9);
-        assert_eq!(c.extra_marked_mm(), 0.0);
+        assert_eq!(c.stats.extra_marked_mm, 0.0);
     }
 
     #[test]
@@ -708,8 +695,8 @@ mod tests {
         );
         let total: f64 = c.pieces.iter().map(|p| polyline_length(&p.1, false)).sum();
         // 4 lines × 2 seams × 2 × 0.5 mm
-        assert!((c.extra_marked_mm() - 8.0).abs() < 1e-9);
-        assert!((total - 4.0 * 240.0 - c.extra_marked_mm()).abs() < 1e-9);
+        assert!((c.stats.extra_marked_mm - 8.0).abs() < 1e-9);
+        assert!((total - 4.0 * 240.0 - c.stats.extra_marked_mm).abs() < 1e-9);
         // each piece passes its seam by 0.5 mm on the far side of its travel
         let first = &c.pieces[0].1;
         assert!((first[1].x - 60.5).abs() < 1e-9);
@@ -721,7 +708,7 @@ mod tests {
             &ls,
             &t,
         );
-        assert_eq!(kept.extra_marked_mm(), 0.0);
+        assert_eq!(kept.stats.extra_marked_mm, 0.0);
         assert_eq!(cuts_of(&kept, 0), vec![60.5, 120.5]);
         assert_eq!(cuts_of(&kept, 1), vec![59.5, 119.5]);
     }
@@ -735,22 +722,10 @@ mod tests {
             Pt::new(0.0, 30.0),
         ];
         let none = tiling_x(&[]);
-        let c = cut_at_seams(
-            &[(&ring, true)],
-            &none,
-            SeamForm::Straight,
-            |_| false,
-            |_| true,
-        );
+        let c = cut_at_seams(&[(&ring, true)], &none, SeamForm::Straight, |_| true);
         assert_eq!(c.pieces, vec![(0, ring.clone(), true)]);
         let t = tiling_x(&[50.0]);
-        let c = cut_at_seams(
-            &[(&ring, true)],
-            &t,
-            SeamForm::Straight,
-            |_| false,
-            |_| true,
-        );
+        let c = cut_at_seams(&[(&ring, true)], &t, SeamForm::Straight, |_| true);
         assert_eq!(c.pieces.len(), 2, "{:?}", c.pieces);
         let total: f64 = c.pieces.iter().map(|p| polyline_length(&p.1, false)).sum();
         assert!((total - 260.0).abs() < 1e-9);

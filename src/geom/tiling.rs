@@ -112,26 +112,6 @@ impl Tiling {
         ]
     }
 
-    /// The box of cell `(i, j)` (column, row).
-    pub fn cell_box(&self, i: usize, j: usize) -> BBox {
-        let at = |v: &[f64], k: usize| v.get(k).copied().unwrap_or(0.0);
-        BBox {
-            min_x: at(&self.xs, i),
-            min_y: at(&self.ys, j),
-            max_x: at(&self.xs, i + 1),
-            max_y: at(&self.ys, j + 1),
-        }
-    }
-
-    /// The cell holding `p` (points outside the extent: the nearest cell).
-    pub fn cell_of(&self, p: Pt) -> (usize, usize) {
-        let index = |v: &[f64], c: f64| {
-            let inner = if v.len() > 2 { &v[1..v.len() - 1] } else { &[] };
-            inner.partition_point(|&s| s <= c)
-        };
-        (index(&self.xs, p.x), index(&self.ys, p.y))
-    }
-
     /// The seams moved by `shift_mm` per axis: a shifted pass's tiling. Seams pushed off one
     /// end come back at the other end, one mean cell width beyond the last; a gap still wider
     /// than `cell_max_mm` is split evenly. The extent is unchanged.
@@ -373,14 +353,11 @@ mod tests {
     }
 
     #[test]
-    fn cells_and_shift() {
+    fn a_shift_moves_every_seam_and_keeps_the_extent() {
         let t = Tiling {
             xs: vec![0.0, 60.0, 120.0, 180.0],
             ys: vec![0.0, 50.0],
         };
-        assert_eq!(t.cell_of(Pt::new(59.9, 3.0)), (0, 0));
-        assert_eq!(t.cell_of(Pt::new(60.0, 3.0)), (1, 0));
-        assert_eq!(t.cell_of(Pt::new(500.0, -3.0)), (2, 0));
         let s = t.shifted([30.0, 0.0], [69.0, 69.0]);
         assert_eq!(s.xs, vec![0.0, 30.0, 90.0, 150.0, 180.0]);
         assert_eq!(s.ys, t.ys);
