@@ -567,60 +567,78 @@ fn hatch_style_ui(ui: &mut egui::Ui, k: usize, layer: &Layer) -> Option<Layer> {
 /// Spacing of a newly chosen hatch, mm: visible on screen and quick to make.
 const DEFAULT_SPACING_MM: f64 = 0.5;
 
+/// A choice among a hatch's options as a labelled combo; returns the changed layer.
+struct HatchChoice<T: 'static> {
+    label: &'static str,
+    id: &'static str,
+    options: &'static [T],
+    words: fn(T) -> &'static str,
+    get: fn(&HatchSettings) -> T,
+    set: fn(&mut HatchSettings, T),
+    hover: Option<&'static str>,
+}
+
+impl<T: Copy + PartialEq + 'static> HatchChoice<T> {
+    fn ui(&self, ui: &mut egui::Ui, k: usize, layer: &Layer) -> Option<Layer> {
+        let h = layer.pen.hatch.as_ref()?;
+        let current = (self.get)(h);
+        let mut chosen = current;
+        let label = ui.label(self.label);
+        let r = egui::ComboBox::from_id_salt((self.id, k))
+            .selected_text((self.words)(current))
+            .show_ui(ui, |ui| {
+                for &o in self.options {
+                    ui.selectable_value(&mut chosen, o, (self.words)(o));
+                }
+            })
+            .response
+            .labelled_by(label.id);
+        if let Some(text) = self.hover {
+            r.on_hover_text(text);
+        }
+        (chosen != current).then(|| {
+            let mut l = layer.clone();
+            if let Some(h) = &mut l.pen.hatch {
+                (self.set)(h, chosen);
+            }
+            l
+        })
+    }
+}
+
 /// Where a hatched layer's outlines go; returns the changed layer.
 fn outline_ui(ui: &mut egui::Ui, k: usize, layer: &Layer) -> Option<Layer> {
-    let h = layer.pen.hatch.as_ref()?;
-    let mut outline = h.outline;
-    let label = ui.label("Outline");
-    let name = |o: OutlineMode| match o {
-        OutlineMode::Before => "before the hatch",
-        OutlineMode::After => "after the hatch",
-        OutlineMode::None => "not marked",
-    };
-    egui::ComboBox::from_id_salt(("hatch-outline", k))
-        .selected_text(name(outline))
-        .show_ui(ui, |ui| {
-            for o in [OutlineMode::Before, OutlineMode::After, OutlineMode::None] {
-                ui.selectable_value(&mut outline, o, name(o));
-            }
-        })
-        .response
-        .labelled_by(label.id);
-    (outline != h.outline).then(|| {
-        let mut l = layer.clone();
-        if let Some(h) = &mut l.pen.hatch {
-            h.outline = outline;
-        }
-        l
-    })
+    HatchChoice {
+        label: "Outline",
+        id: "hatch-outline",
+        options: &[OutlineMode::Before, OutlineMode::After, OutlineMode::None],
+        words: |o| match o {
+            OutlineMode::Before => "before the hatch",
+            OutlineMode::After => "after the hatch",
+            OutlineMode::None => "not marked",
+        },
+        get: |h| h.outline,
+        set: |h, o| h.outline = o,
+        hover: None,
+    }
+    .ui(ui, k, layer)
 }
 
 /// Whether a hatched layer's shapes are filled together; returns the changed layer.
 fn shapes_ui(ui: &mut egui::Ui, k: usize, layer: &Layer) -> Option<Layer> {
-    let h = layer.pen.hatch.as_ref()?;
-    let mut shapes = h.shapes;
-    let label = ui.label("Shapes");
-    let name = |s: FillShapes| match s {
-        FillShapes::Together => "filled together (inner shapes are holes)",
-        FillShapes::Apart => "each filled on its own",
-    };
-    egui::ComboBox::from_id_salt(("hatch-shapes", k))
-        .selected_text(name(shapes))
-        .show_ui(ui, |ui| {
-            for s in [FillShapes::Together, FillShapes::Apart] {
-                ui.selectable_value(&mut shapes, s, name(s));
-            }
-        })
-        .response
-        .labelled_by(label.id)
-        .on_hover_text("Together: the layer's closed shapes form one region (even-odd), as LightBurn fills. Apart: each drawing element is filled on its own, as SVG paints it");
-    (shapes != h.shapes).then(|| {
-        let mut l = layer.clone();
-        if let Some(h) = &mut l.pen.hatch {
-            h.shapes = shapes;
-        }
-        l
-    })
+    HatchChoice {
+        label: "Shapes",
+        id: "hatch-shapes",
+        options: &[FillShapes::Together, FillShapes::Apart],
+        words: |s| match s {
+            FillShapes::Together => "filled together (inner shapes are holes)",
+            FillShapes::Apart => "each filled on its own",
+        },
+        get: |h| h.shapes,
+        set: |h, s| h.shapes = s,
+        hover: Some("Together: the layer's shapes that overlap or nest are filled as one region (even-odd: an inner shape is a hole), as LightBurn fills. Apart: each drawing element is filled on its own, as SVG paints it"),
+    }
+    .ui(ui, k, layer)
 }
 
 /// Width given to a seam form newly chosen, mm.
