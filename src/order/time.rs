@@ -116,7 +116,7 @@ fn searches_per_field(fields: usize, until: Option<Instant>) -> usize {
 
 /// [`free_field_path`] with each seed (in parallel), keeping the lowest idle (the first of
 /// equals).
-fn best_free_field_path(
+pub(crate) fn best_free_field_path(
     geometries: &[Geometry],
     run: &[Step],
     seeds: &[u64],

@@ -20,6 +20,11 @@
 //! sweep; the start vertices are then chosen exactly (layered-graph DP, `VertexMode::Exact`); then
 //! local search on the real stroke ends (open geometries may flip) and the exact vertex choice
 //! alternate while the idle travel falls.
+//!
+//! A lone field has nothing to sweep towards: under the distance objective its path is the
+//! engine's free open path (no direction weight, free ends, the full kick budget, exact
+//! vertices) from a Hilbert-curve start; under the time objective the time search does the
+//! same. HHA's own steps only give it a start.
 
 use super::tsp::{
     cheapest_arc, exact_path, local_search, space_filling_order, IlsBudget, LocalSearch, LsOptions,
@@ -53,6 +58,13 @@ pub const LAST_SEARCH_SHARE: f64 = 0.95;
 /// per-field paths before the refinement, refinement rounds after the first) are divided by
 /// this: the later search starts from their tour, so their last kicks gain little.
 const PRELIMINARY_KICK_DIVISOR: usize = 8;
+
+/// A lone field's free open path under the distance objective is searched once per seed
+/// (the settings' seed xor each of these), in parallel, and the shortest kept (the first of
+/// equals: the same plan on any thread count). Two searches take the wall time of one on two
+/// cores; on 1,000 uniform dots (10 sets) the worst gap to LKH fell from +1.36 to +1.00 %
+/// (BENCHMARKS, issue 24).
+const LONE_FREE_SEEDS: [u64; 2] = [0, 0x9e37_79b9_7f4a_7c15];
 
 /// Most refinement rounds (each: every field's path between its neighbours' ends, then the exact
 /// vertices); they stop earlier once a round gains less than 0.1 %.
@@ -631,6 +643,10 @@ pub fn hha_order(
     // (on the fly no time search follows: `order_plan` runs it for step-and-scan only)
     let lone_before_time =
         time_follows && settings.motion != crate::document::MotionMode::OnTheFly && live.len() == 1;
+    // a lone field under the distance objective: its idle travel is the whole objective, so its
+    // path is the free open path (no direction weight, free ends, the full budget), as the
+    // engine alone finds it; HHA gives it only its start
+    let lone_free = !time_follows && live.len() == 1;
     let cent: Vec<Pt> = geometries.iter().map(Geometry::centroid).collect();
     let (by_centre, by_gap) = field_order_candidates(&live_owned, &cent, profile, ctx)?;
     stage_s.push(("field_order".into(), t.elapsed().as_secs_f64()));
@@ -643,7 +659,7 @@ pub fn hha_order(
         profile,
         settings,
         until: limited(FIELD_PATHS_SHARE),
-        start_only: lone_before_time,
+        start_only: lone_before_time || lone_free,
     };
     let slots = |fo: &[usize]| -> Vec<&ScanField> { fo.iter().map(|&k| live[k]).collect() };
     let mut best = stages.route(slots(&by_centre), ctx)?;
@@ -690,7 +706,7 @@ pub fn hha_order(
                     .sum::<f64>()
         };
         let mut best = objective(&steps, super::metrics::idle_mm(geometries, &steps));
-        let rounds = if lone_before_time {
+        let rounds = if lone_before_time || lone_free {
             0
         } else if time_follows {
             REFINE_ROUNDS_BEFORE_TIME
@@ -749,6 +765,13 @@ pub fn hha_order(
             }
         }
         stage_s.push(("refine".into(), t.elapsed().as_secs_f64()));
+    }
+    if lone_free {
+        let t = Instant::now();
+        let until = limited(LAST_SEARCH_SHARE);
+        let seeds = LONE_FREE_SEEDS.map(|s| settings.seed ^ s);
+        steps = super::time::best_free_field_path(geometries, &steps, &seeds, until, ctx)?;
+        stage_s.push(("free path".into(), t.elapsed().as_secs_f64()));
     }
     ctx.progress("order", 4, 4, "HHA: done");
     Ok(Ordering {

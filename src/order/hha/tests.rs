@@ -311,3 +311,43 @@ fn a_large_lone_field_before_the_time_objective_starts_along_a_hilbert_curve() {
     let (got, hilbert) = order(LONE_DESCENT_MAX);
     assert_ne!(got, hilbert, "up to the bound: HHA's own descent");
 }
+
+#[test]
+fn a_lone_field_under_the_distance_objective_keeps_the_engines_free_open_path() {
+    // 1,000 dots scattered over one 420 mm field (the TSP benchmarks' machine): the plan's idle
+    // travel is the engine's own open path (free ends, no direction weight), not HHA's swept
+    // path between fixed corners (there 9,314.7 mm on this set, +0.6 %)
+    use rand::{Rng, SeedableRng};
+    let n = 1000;
+    // the set `galvoplan tsp --generate uniform:1000 --seed 11` writes (u11 in BENCHMARKS)
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+    let gs: Vec<Geometry> = (0..n)
+        .map(|_| {
+            let (x, y) = (rng.random_range(0.0..400.0), rng.random_range(0.0..400.0));
+            stroke(x, y, 0.002)
+        })
+        .collect();
+    let mut lone = field(0, 200.0, 200.0, (0..n).collect());
+    lone.size = [420.0, 420.0];
+    let p = MachineProfile {
+        stroke_mm: [400.0, 400.0],
+        field_mm: [420.0, 420.0],
+        ..MachineProfile::default()
+    };
+    let settings = SolverSettings {
+        cost_model: crate::document::CostModel::Distance,
+        ..SolverSettings::default()
+    };
+    let ctx = JobCtx::default();
+    let o = hha_order(&gs, &[lone], &p, &settings, &ctx, &mut Vec::new()).unwrap();
+    let plan_mm = crate::order::metrics::idle_mm(&gs, &o.steps);
+    let cent: Vec<Pt> = gs.iter().map(Geometry::centroid).collect();
+    let budget = IlsBudget::for_nodes(n, None);
+    let path = crate::order::tsp::open_path(&cent, budget, settings.seed, &ctx).unwrap();
+    let engine_mm: f64 = path.windows(2).map(|w| cent[w[0]].dist(cent[w[1]])).sum();
+    // the dots are 2 µm strokes: a path through them differs by at most 2 µm a dot
+    assert!(
+        plan_mm <= engine_mm + 0.002 * n as f64,
+        "plan {plan_mm:.3} mm, engine {engine_mm:.3} mm"
+    );
+}
