@@ -50,8 +50,14 @@ impl Stat {
 pub struct BenchRow {
     /// File stem.
     pub instance: String,
-    /// Geometries imported.
+    /// Geometries planned (hatch lines and pieces cut at seams included).
     pub geometries: usize,
+    /// Strokes the toolpath marks (passes repeat strokes).
+    pub strokes: usize,
+    /// Peak resident memory of the process while the instance ran (from the OS, MB; none where
+    /// the OS does not say). Memory earlier instances left allocated counts too: bench one
+    /// instance per run for a clean figure.
+    pub peak_rss_mb: Option<f64>,
     /// Seeds run.
     pub seeds: usize,
     /// Scan fields.
@@ -85,10 +91,14 @@ pub struct BenchRow {
     pub stage_speed_variation_mm_s: Stat,
     /// Import, ms.
     pub import_ms: f64,
+    /// Hatch fills, ms.
+    pub hatch_ms: f64,
     /// Field placement, ms.
     pub fields_ms: f64,
     /// Ordering, ms.
     pub order_ms: f64,
+    /// The ordering's sub-stages of the first run (name, ms).
+    pub order_detail_ms: Vec<(String, f64)>,
     /// Export (G-code and report text), ms.
     pub export_ms: f64,
     /// Whole pipeline, ms.
@@ -120,6 +130,21 @@ pub fn collect_svgs(paths: &[PathBuf]) -> std::io::Result<Vec<PathBuf>> {
     Ok(out)
 }
 
+/// Resets the process's peak resident memory to its current one (Linux ≥ 4.0:
+/// `/proc/self/clear_refs`); false where the OS cannot.
+fn reset_peak_rss() -> bool {
+    std::fs::write("/proc/self/clear_refs", "5").is_ok()
+}
+
+/// The process's peak resident memory since the last reset, MB (Linux: `VmHWM` of
+/// `/proc/self/status`; none elsewhere).
+fn peak_rss_mb() -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb / 1024.0)
+}
+
 fn median(v: &mut [f64]) -> f64 {
     v.sort_by(f64::total_cmp);
     match v.len() {
@@ -140,9 +165,12 @@ pub fn run_instance(
     repeat: usize,
     ctx: &JobCtx,
 ) -> Result<BenchRow, PipelineError> {
-    let mut times: [Vec<f64>; 5] = Default::default();
+    let mut times: [Vec<f64>; 6] = Default::default();
     let mut quality: [Vec<f64>; 11] = Default::default();
     let (mut geometries, mut marked_mm, mut lower, mut job_lb) = (0, 0.0, None, None);
+    let (mut strokes, mut order_detail_ms) = (0, Vec::new());
+    // the peak is the instance's only when it could be reset
+    let peak_is_own = reset_peak_rss();
     for k in 0..seeds.max(1) {
         let mut s = settings.clone();
         s.seed = settings.seed.wrapping_add(k as u64);
@@ -162,6 +190,7 @@ pub fn run_instance(
             let export_s = t0.elapsed().as_secs_f64();
             for (v, x) in times.iter_mut().zip([
                 import_s,
+                plan.metrics.solve_s.hatch,
                 plan.metrics.solve_s.fields,
                 plan.metrics.solve_s.order,
                 export_s,
@@ -189,6 +218,10 @@ pub fn run_instance(
                     v.push(x);
                 }
                 geometries = doc.geometries.len();
+                strokes = toolpath.strokes.len();
+                order_detail_ms = (m.solve_s.order_detail.iter())
+                    .map(|(k, s)| (k.clone(), s * 1e3))
+                    .collect();
                 marked_mm = m.marked_mm;
                 job_lb = (plan.motion == crate::document::Motion::Step).then(|| {
                     crate::order::objective::step_job_time_lower_bound_s(
@@ -202,7 +235,8 @@ pub fn run_instance(
             }
         }
     }
-    let [mut a, mut b, mut c, mut d, mut e] = times;
+    let peak_rss_mb = peak_rss_mb().filter(|_| peak_is_own);
+    let [mut a, mut h, mut b, mut c, mut d, mut e] = times;
     let [f, o, i, bm, dc, jt, st, route, offset, peak, variation] = quality;
     Ok(BenchRow {
         instance: path
@@ -210,6 +244,8 @@ pub fn run_instance(
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_default(),
         geometries,
+        strokes,
+        peak_rss_mb,
         seeds: seeds.max(1),
         fields: Stat::of(&f),
         fields_lower_bound: lower,
@@ -226,8 +262,10 @@ pub fn run_instance(
         stage_peak_speed_mm_s: Stat::of(&peak),
         stage_speed_variation_mm_s: Stat::of(&variation),
         import_ms: median(&mut a),
+        hatch_ms: median(&mut h),
         fields_ms: median(&mut b),
         order_ms: median(&mut c),
+        order_detail_ms,
         export_ms: median(&mut d),
         total_ms: median(&mut e),
     })
@@ -236,14 +274,15 @@ pub fn run_instance(
 /// Formats rows as a Markdown table (quality as mean ± sd when several seeds ran).
 pub fn format_table(rows: &[BenchRow]) -> String {
     let mut s = String::from(
-        "| instance | geometries | fields | LB | overlap % | idle mm | base mm | marked mm | dir. changes | job s | job LB s | stage s | route mm | offset mm | peak stage mm/s | stage speed var. mm/s | import ms | fields ms | order ms | export ms | total ms |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "| instance | geometries | strokes | fields | LB | overlap % | idle mm | base mm | marked mm | dir. changes | job s | job LB s | stage s | route mm | offset mm | peak stage mm/s | stage speed var. mm/s | import ms | hatch ms | fields ms | order ms | export ms | total ms | peak MB |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
         let sd = r.seeds > 1;
         s.push_str(&format!(
-            "| {} | {} | {} | {} | {} | {} | {} | {:.1} | {} | {} | {} | {} | {} | {} | {} | {} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} |\n",
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {:.1} | {} | {} | {} | {} | {} | {} | {} | {} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} | {} |\n",
             r.instance,
             r.geometries,
+            r.strokes,
             r.fields.show(if sd { 1 } else { 0 }, sd),
             r.fields_lower_bound.map_or("–".to_string(), |v| v.to_string()),
             r.overlap_pct.show(1, sd),
@@ -260,10 +299,12 @@ pub fn format_table(rows: &[BenchRow]) -> String {
             r.stage_peak_speed_mm_s.show(0, sd),
             r.stage_speed_variation_mm_s.show(0, sd),
             r.import_ms,
+            r.hatch_ms,
             r.fields_ms,
             r.order_ms,
             r.export_ms,
-            r.total_ms
+            r.total_ms,
+            r.peak_rss_mb.map_or("–".to_string(), |v| format!("{v:.0}")),
         ));
     }
     s
