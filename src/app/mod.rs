@@ -1229,15 +1229,32 @@ pub fn fields_count(fields: &[ScanField], profile: &MachineProfile) -> String {
 /// The number shown for field `id`: 1…n in the visiting order of `visiting` (a plan's fields)
 /// for the fields it has, else by placement order (`fields`), after the plan's.
 pub fn field_number(fields: &[ScanField], visiting: Option<&[ScanField]>, id: usize) -> usize {
+    field_numbers(fields, visiting)
+        .get(&id)
+        .copied()
+        .unwrap_or(visiting.map_or(0, <[ScanField]>::len) + fields.len() + 1)
+}
+
+/// [`field_number`] of every field (and every visited one) at once, by id: what a frame that
+/// labels thousands of fields needs (one pass, not one per field).
+pub fn field_numbers(
+    fields: &[ScanField],
+    visiting: Option<&[ScanField]>,
+) -> std::collections::HashMap<usize, usize> {
     let visited = visiting.unwrap_or(&[]);
-    if let Some(k) = visited.iter().position(|f| f.id == id) {
-        return k + 1;
-    }
-    let others = fields
+    let mut out: std::collections::HashMap<usize, usize> = visited
         .iter()
-        .filter(|f| !visited.iter().any(|v| v.id == f.id));
-    let rank = others.take_while(|f| f.id != id).count();
-    visited.len() + rank + 1
+        .enumerate()
+        .map(|(k, f)| (f.id, k + 1))
+        .collect();
+    let mut next = visited.len() + 1;
+    for f in fields {
+        if let std::collections::hash_map::Entry::Vacant(e) = out.entry(f.id) {
+            e.insert(next);
+            next += 1;
+        }
+    }
+    out
 }
 
 impl eframe::App for App {

@@ -45,6 +45,57 @@ pub mod colour {
     ];
 }
 
+/// Screen points closer than this to the last one kept are left out of a drawn line, px: the
+/// line looks the same, and a zoomed-out job of 10⁵ strokes tessellates thousands of points,
+/// not millions.
+const DETAIL_PX: f32 = 0.75;
+
+/// Shapes wholly this far outside the canvas are not drawn, px (line widths and end dots).
+const CULL_MARGIN_PX: f32 = 8.0;
+
+/// A field's number is drawn only when the field is at least this much wider than its label
+/// and this tall on screen, px: smaller, the labels of neighbours overlap into a blob.
+const LABEL_MIN_H_PX: f32 = 18.0;
+
+/// Open geometries get dots at their ends only when at least this long on screen, px.
+const END_DOTS_MIN_PX: f32 = 6.0;
+
+/// `pts` (mm) on screen with the points closer than [`DETAIL_PX`] to the last kept one left out
+/// (the last point always kept; closed: back to the first), or none when the whole line lies
+/// outside `clip`.
+pub(super) fn screen_line<F: Fn(Pt) -> Pos2 + ?Sized>(
+    pts: &[Pt],
+    closed: bool,
+    s: &F,
+    clip: Rect,
+) -> Option<Vec<Pos2>> {
+    let first = *pts.first()?;
+    let mut out = Vec::with_capacity(pts.len().min(64));
+    let mut bounds = Rect::NOTHING;
+    let mut keep = |q: Pos2, out: &mut Vec<Pos2>| {
+        bounds.extend_with(q);
+        out.push(q);
+    };
+    keep(s(first), &mut out);
+    let n = pts.len();
+    for (k, &p) in pts.iter().enumerate().skip(1) {
+        let q = s(p);
+        let far = out
+            .last()
+            .is_none_or(|l| (q - *l).length_sq() >= DETAIL_PX * DETAIL_PX);
+        if far || k + 1 == n {
+            keep(q, &mut out);
+        }
+    }
+    if closed && n > 1 {
+        keep(s(first), &mut out);
+    }
+    bounds
+        .expand(CULL_MARGIN_PX)
+        .intersects(clip)
+        .then_some(out)
+}
+
 fn lerp(a: Color32, b: Color32, t: f32) -> Color32 {
     let m = |x: u8, y: u8| (f32::from(x) + (f32::from(y) - f32::from(x)) * t).round() as u8;
     Color32::from_rgb(m(a.r(), b.r()), m(a.g(), b.g()), m(a.b(), b.b()))
@@ -116,7 +167,7 @@ pub fn paint(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
         for path in &c.paths {
             if let Ok(l) = path.lowered {
                 let done = overlaid.then_some(path.colour);
-                playback::paint(painter, l, t_s, c.profile.field_mm, done, &s);
+                playback::paint(painter, l, t_s, c.profile.field_mm, done, &s, rect);
             }
         }
     }
@@ -127,14 +178,21 @@ pub fn paint(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
 fn paint_fields(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
     let s = |q: Pt| view.to_screen(rect, q);
     let fill = Color32::from_rgba_unmultiplied(79, 70, 229, 16);
-    for f in c.fields {
+    let on_screen = |f: &crate::document::ScanField| {
         let b = f.bbox();
         let r = Rect::from_two_pos(s(Pt::new(b.min_x, b.min_y)), s(Pt::new(b.max_x, b.max_y)));
-        painter.rect_filled(r, 0.0, fill);
+        r.expand(CULL_MARGIN_PX).intersects(rect).then_some(r)
+    };
+    for f in c.fields {
+        if let Some(r) = on_screen(f) {
+            painter.rect_filled(r, 0.0, fill);
+        }
     }
+    let numbers = super::field_numbers(c.fields, c.visiting);
     for f in c.fields {
-        let b = f.bbox();
-        let r = Rect::from_two_pos(s(Pt::new(b.min_x, b.min_y)), s(Pt::new(b.max_x, b.max_y)));
+        let Some(r) = on_screen(f) else {
+            continue;
+        };
         let selected = c.selected == Some(f.id);
         let stroke = if selected {
             Stroke::new(2.5, colour::SELECTED)
@@ -146,7 +204,7 @@ fn paint_fields(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
         };
         painter.rect_stroke(r, 0.0, stroke, StrokeKind::Middle);
         painter.circle_filled(s(f.center), 2.0, stroke.color);
-        let number = super::field_number(c.fields, c.visiting, f.id);
+        let number = numbers.get(&f.id).copied().unwrap_or_default();
         // a scan field shows its number; a region larger than the scan field says so
         let name = match super::field_word(f, c.profile) {
             "field" => format!("{number}"),
@@ -157,7 +215,13 @@ fn paint_fields(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
         } else {
             name
         };
-        let galley = painter.layout_no_wrap(text, FontId::proportional(13.0), Color32::WHITE);
+        // a label only where it is legible: the field wider than it and tall enough
+        let font = FontId::proportional(13.0);
+        let est_w = text.chars().count() as f32 * 7.5 + 6.0;
+        if !selected && (r.height() < LABEL_MIN_H_PX || r.width() < est_w * 1.5) {
+            continue;
+        }
+        let galley = painter.layout_no_wrap(text, font, Color32::WHITE);
         let at = r.min + Vec2::new(3.0, 3.0);
         let bg = Rect::from_min_size(at, galley.size() + Vec2::new(6.0, 2.0));
         painter.rect_filled(
@@ -241,20 +305,14 @@ fn paint_artwork(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
         let Some(g) = c.geometries.get(k) else {
             continue;
         };
-        let mut pts: Vec<Pos2> = g.points.iter().map(|&q| s(q)).collect();
-        match pts.len() {
-            0 => continue,
-            1 => shapes.push(Shape::circle_filled(
-                pts[0],
-                colour::UNCOVERED_HALO_PX / 2.0,
-                halo.color,
-            )),
-            _ => {
-                if g.closed {
-                    pts.push(pts[0]);
-                }
-                shapes.push(Shape::line(pts, halo));
-            }
+        let Some(pts) = screen_line(&g.points, g.closed, &s, rect) else {
+            continue;
+        };
+        if pts.len() == 1 {
+            let r = colour::UNCOVERED_HALO_PX / 2.0;
+            shapes.push(Shape::circle_filled(pts[0], r, halo.color));
+        } else {
+            shapes.push(Shape::line(pts, halo));
         }
     }
     for (k, g) in c.geometries.iter().enumerate() {
@@ -273,11 +331,12 @@ fn paint_artwork(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
             _ => base,
         }
         .gamma_multiply(fade);
-        let mut pts: Vec<Pos2> = g.points.iter().map(|&q| s(q)).collect();
-        if g.closed {
-            pts.push(pts[0]);
-        } else {
-            for end in [pts[0], pts[pts.len() - 1]] {
+        let Some(pts) = screen_line(&g.points, g.closed, &s, rect) else {
+            continue;
+        };
+        let (a, z) = (pts[0], pts[pts.len() - 1]);
+        if !g.closed && (z - a).length() >= END_DOTS_MIN_PX {
+            for end in [a, z] {
                 shapes.push(Shape::circle_filled(end, 1.8, col));
             }
         }
@@ -288,11 +347,9 @@ fn paint_artwork(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
         }
     }
     for &k in c.out_of_reach {
-        if let Some(g) = c.geometries.get(k) {
-            let mut pts: Vec<Pos2> = g.points.iter().map(|&q| s(q)).collect();
-            if g.closed && !pts.is_empty() {
-                pts.push(pts[0]);
-            }
+        if let Some(pts) =
+            (c.geometries.get(k)).and_then(|g| screen_line(&g.points, g.closed, &s, rect))
+        {
             // no field can hold it: dashed purple, apart from the halo of "not covered yet"
             let stroke = Stroke::new(3.0, colour::OUT_OF_REACH);
             shapes.extend(Shape::dashed_line(&pts, stroke, 6.0, 4.0));
@@ -363,7 +420,13 @@ fn paint_path(
         let (Some((_, z)), Some((a, _))) = (ends(k - 1), ends(k)) else {
             continue;
         };
-        idle_move(&mut shapes, s(z), s(a), col, c.layers.arrows);
+        let (p0, p1) = (s(z), s(a));
+        if Rect::from_two_pos(p0, p1)
+            .expand(CULL_MARGIN_PX)
+            .intersects(rect)
+        {
+            idle_move(&mut shapes, p0, p1, col, c.layers.arrows);
+        }
     }
     painter.extend(shapes);
     let n = tp.strokes.len();

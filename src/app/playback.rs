@@ -240,16 +240,17 @@ pub fn paint(
     field_mm: [f64; 2],
     done: Option<Color32>,
     to_screen: &dyn Fn(Pt) -> Pos2,
+    clip: Rect,
 ) {
     let tp = &l.toolpath;
     let marks = Stroke::new(2.2, done.unwrap_or(DONE));
     let n_done = l.strokes_done(t_s);
     let mut shapes = Vec::with_capacity(n_done + 1);
     for k in 0..n_done {
-        shapes.push(polyline(
-            tp.stroke_points(k).iter().map(|&p| to_screen(p)),
-            marks,
-        ));
+        // at screen resolution, and none off the canvas
+        if let Some(pts) = super::paint::screen_line(tp.stroke_points(k), false, to_screen, clip) {
+            shapes.push(polyline(pts.into_iter(), marks));
+        }
     }
     let state = tp.state_at(t_s);
     if let Some(&(start_s, end_s)) = l.mark_s.get(n_done) {
