@@ -187,7 +187,10 @@ impl StepTime<'_> {
 /// * the scanner's jumps inside fields: every stroke of a field but the one marked first is
 ///   reached by a jump from another stroke of that field, at least the jump delay plus the
 ///   distance between the two strokes' bounding boxes at jump speed; the field's largest such
-///   term is left out (the first stroke's jump may hide in the stage move).
+///   term is left out (the first stroke's jump may hide in the stage move). In a field of more
+///   than [`EXACT_GAPS_MAX`] strokes the distance is taken as 0 (the jump delay alone: still a
+///   bound, found in O(strokes) instead of O(strokes²); dense fills, where such fields occur,
+///   have overlapping boxes and gaps near 0 anyway).
 ///
 /// The gap between a plan's job time and this bound is the most any better order could gain.
 pub fn step_job_time_lower_bound_s(
@@ -212,6 +215,9 @@ pub fn step_job_time_lower_bound_s(
     let jumps: f64 = fields
         .iter()
         .map(|f| {
+            if f.geometries.len() > EXACT_GAPS_MAX {
+                return f.geometries.len().saturating_sub(1) as f64 * model.jump_delay_s;
+            }
             let boxes: Vec<crate::geom::BBox> = f
                 .geometries
                 .iter()
@@ -233,6 +239,10 @@ pub fn step_job_time_lower_bound_s(
         .sum();
     marking + stage + jumps
 }
+
+/// Largest field whose strokes' nearest gaps [`step_job_time_lower_bound_s`] computes exactly
+/// (pairwise: 4 million box gaps at this size, about 10 ms).
+pub const EXACT_GAPS_MAX: usize = 2000;
 
 /// The least distance between two boxes (0 when they overlap), mm.
 fn box_gap_mm(a: &crate::geom::BBox, b: &crate::geom::BBox) -> f64 {
@@ -351,6 +361,58 @@ mod tests {
         assert!(
             (model - lowered).abs() <= 1e-9 * lowered,
             "{model} vs {lowered}"
+        );
+    }
+
+    #[test]
+    fn the_lower_bound_of_a_large_field_counts_its_jump_delays_and_stays_below_the_job() {
+        // rows of 0.5 mm squares 1 mm apart in one field: beyond the exact-gap size the jumps
+        // count their delays only; either way the bound is below the lowered job time
+        let profile = MachineProfile::default();
+        let bound_and_time = |n: usize| {
+            let gs: Vec<Geometry> = (0..n)
+                .map(|k| rect((k % 60) as f64, (k / 60) as f64, 0.5, 0.5))
+                .collect();
+            let field = ScanField {
+                id: 0,
+                center: Pt::new(30.0, 30.0),
+                size: profile.field_mm,
+                geometries: (0..n).collect(),
+                locked: false,
+            };
+            let steps: Vec<Step> = (0..n).map(|g| Step::from_choice(g, 0, &gs[g], 0)).collect();
+            let inputs = PlanInputs {
+                geometry_rev: 0,
+                profile: profile.clone(),
+                layers: Vec::new(),
+                settings: SolverSettings::default(),
+            };
+            let fields = vec![field];
+            let plan = Plan::new(
+                &inputs,
+                crate::document::Motion::Step,
+                fields.clone(),
+                steps,
+            );
+            let job_s = lower(&gs, &plan, &profile).unwrap().duration_s();
+            let bound_s = step_job_time_lower_bound_s(&gs, &fields, &[], &profile);
+            let marking_s: f64 = StepTime::new(&gs, &fields, &[], &profile)
+                .mark_s
+                .iter()
+                .sum();
+            (bound_s, job_s, marking_s)
+        };
+        let (exact, job, marking) = bound_and_time(EXACT_GAPS_MAX);
+        assert!(exact <= job, "{exact} > {job}");
+        // the nearest square is 0.5 mm away: more than the delays alone
+        let delays = (EXACT_GAPS_MAX - 1) as f64 * profile.laser.jump_delay_s;
+        assert!(exact - marking > delays + 1e-9);
+        let (large, job, marking) = bound_and_time(EXACT_GAPS_MAX + 1);
+        assert!(large <= job, "{large} > {job}");
+        let delays = EXACT_GAPS_MAX as f64 * profile.laser.jump_delay_s;
+        assert!(
+            (large - marking - delays).abs() < 1e-9,
+            "{large} {marking} {delays}"
         );
     }
 }
