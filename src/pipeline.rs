@@ -149,7 +149,7 @@ pub fn load_artwork(
     opts.resolution_mm = 0.1_f64.powi(i32::try_from(profile.gcode.decimals).unwrap_or(i32::MAX));
     let imported = import_file(path, &opts)?;
     let mut layers = Vec::new();
-    sync_layers(&mut layers, &imported.geometries, &default_pen(&settings));
+    sync_layers(&mut layers, &imported.geometries, &settings.default_pen());
     let doc = Document {
         source: Some(path.display().to_string()),
         page_mm: imported.page_mm,
@@ -298,7 +298,7 @@ pub fn derive_geometries(doc: &mut Document, ctx: &JobCtx) -> Result<f64, Pipeli
             .cloned()
             .collect();
     }
-    sync_layers(&mut doc.layers, &doc.artwork, &default_pen(&doc.settings));
+    sync_layers(&mut doc.layers, &doc.artwork, &doc.settings.default_pen());
     let key = DerivedKey::of(&doc.layers, doc.profile.field_mm, doc.tiling_set.as_ref());
     if doc.derived_with.as_ref() == Some(&key) {
         return Ok(0.0);
@@ -344,17 +344,12 @@ pub fn move_seam(doc: &mut Document, axis: usize, from_mm: f64, to_mm: f64) -> O
     Some(at)
 }
 
-/// The pen of layers nothing else names: defaults, with the settings' hatch (`--hatch`).
-pub fn default_pen(settings: &SolverSettings) -> Pen {
-    settings.default_pen()
-}
-
 /// Gives the document's layers the pens of a library (`--pens`; the library's default pen, or
 /// the settings' hatch as the default pen's hatch, for layers it does not name); returns the
 /// names the library has but the document lacks. The geometries are made again on the next
 /// [`derive_geometries`].
 pub fn apply_pen_library(doc: &mut Document, library: &PenLibrary) -> Vec<String> {
-    sync_layers(&mut doc.layers, &doc.artwork, &default_pen(&doc.settings));
+    sync_layers(&mut doc.layers, &doc.artwork, &doc.settings.default_pen());
     let mut library = library.clone();
     if let Some(h) = &doc.settings.hatch {
         let d = library.default.get_or_insert_with(Pen::default);

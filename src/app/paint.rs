@@ -57,6 +57,10 @@ const CULL_MARGIN_PX: f32 = 8.0;
 /// and this tall on screen, px: smaller, the labels of neighbours overlap into a blob.
 const LABEL_MIN_H_PX: f32 = 18.0;
 
+/// Width of a digit of a field label, px (13 px proportional font, a little over): the label's
+/// width is judged from it before the label is laid out.
+const LABEL_CHAR_PX: f32 = 7.5;
+
 /// Open geometries get dots at their ends only when at least this long on screen, px.
 const END_DOTS_MIN_PX: f32 = 6.0;
 
@@ -217,7 +221,7 @@ fn paint_fields(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
         };
         // a label only where it is legible: the field wider than it and tall enough
         let font = FontId::proportional(13.0);
-        let est_w = text.chars().count() as f32 * 7.5 + 6.0;
+        let est_w = text.chars().count() as f32 * LABEL_CHAR_PX + 6.0;
         if !selected && (r.height() < LABEL_MIN_H_PX || r.width() < est_w * 1.5) {
             continue;
         }
@@ -273,25 +277,13 @@ fn paint_seams(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
 
 fn paint_artwork(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
     let s = |q: Pt| view.to_screen(rect, q);
-    // marks coloured by their position in the first plan's toolpath
-    let rank: Option<Vec<f32>> = c
+    // marks coloured by their position in the first plan's toolpath (ranked once, when lowered)
+    let rank: Option<&[f32]> = c
         .paths
         .first()
         .and_then(|p| p.lowered.ok())
         .filter(|_| c.layers.order_colours && c.layers.path)
-        .map(|l| {
-            let strokes = &l.toolpath.strokes;
-            let mut r = vec![-1.0; c.geometries.len()];
-            let n = (strokes.len().max(2) - 1) as f32;
-            for (i, st) in strokes.iter().enumerate() {
-                if let Some(x) = r.get_mut(st.geometry) {
-                    if *x < 0.0 {
-                        *x = i as f32 / n;
-                    }
-                }
-            }
-            r
-        });
+        .map(|l| l.rank_by_geometry.as_slice());
     // during a playback the artwork is faded: the marks done are drawn over it
     let fade = if c.playback_t_s.is_some() { 0.3 } else { 1.0 };
     let mut shapes = Vec::with_capacity(c.geometries.len() + c.uncovered.len());
@@ -327,7 +319,9 @@ fn paint_artwork(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
         // layer colours (several layers or a hatch) win over the colours by order
         let by_layer = c.colours.is_some();
         let col = match &rank {
-            Some(r) if r[k] >= 0.0 && !by_layer => lerp(colour::ORDER[0], colour::ORDER[1], r[k]),
+            Some(r) if !by_layer && r.get(k).is_some_and(|&x| x >= 0.0) => {
+                lerp(colour::ORDER[0], colour::ORDER[1], r[k])
+            }
             _ => base,
         }
         .gamma_multiply(fade);

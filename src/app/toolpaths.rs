@@ -20,6 +20,9 @@ pub struct Lowered {
     pub route_mm: Vec<Pt>,
     /// The on-the-fly motion sampled for the plots (`None` for step-and-scan).
     pub motion: Option<MotionSamples>,
+    /// Per geometry (index), where its first stroke comes in the marking order, 0…1 (−1: not
+    /// marked): the canvas colours marks by it.
+    pub rank_by_geometry: Vec<f32>,
 }
 
 impl Lowered {
@@ -36,11 +39,13 @@ impl Lowered {
         }
         let route_mm = route_points_mm(&toolpath);
         let motion = MotionSamples::of(&toolpath);
+        let rank_by_geometry = rank_by_geometry(&toolpath);
         Self {
             toolpath,
             mark_s,
             route_mm,
             motion,
+            rank_by_geometry,
         }
     }
 
@@ -63,6 +68,20 @@ impl Lowered {
     pub fn stroke_of_geometry(&self, g: usize) -> Option<usize> {
         self.toolpath.strokes.iter().position(|s| s.geometry == g)
     }
+}
+
+/// Per geometry, the place of its first stroke in the marking order, 0…1 (−1: not marked).
+fn rank_by_geometry(toolpath: &Toolpath) -> Vec<f32> {
+    let strokes = &toolpath.strokes;
+    let len = strokes.iter().map(|s| s.geometry + 1).max().unwrap_or(0);
+    let mut r = vec![-1.0; len];
+    let n = (strokes.len().max(2) - 1) as f32;
+    for (i, st) in strokes.iter().enumerate() {
+        if r[st.geometry] < 0.0 {
+            r[st.geometry] = i as f32 / n;
+        }
+    }
+    r
 }
 
 /// Which plan a cached toolpath was lowered from; a different key means lowering again. A plan

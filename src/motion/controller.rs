@@ -318,10 +318,10 @@ struct Sample {
     stroke: Option<usize>,
 }
 
-/// Samples of an on-the-fly toolpath (see [`otf_lines`]), in the toolpath's time.
 /// Slack when counting whole sample periods in a segment, in periods.
 const SAMPLE_COUNT_TOL: f64 = 1e-6;
 
+/// Samples of an on-the-fly toolpath (see [`otf_lines`]), in the toolpath's time.
 fn otf_samples(toolpath: &Toolpath) -> Vec<Sample> {
     let k = toolpath.stretch();
     let period_s = OTF_SAMPLE_S * k;

@@ -507,8 +507,9 @@ struct Stages<'a> {
     settings: &'a SolverSettings,
     /// When the per-field searches stop (a share of `--time-limit`).
     until: Option<Instant>,
-    /// A later search redoes the field's path with its full budget and free ends (the time
-    /// objective on a lone field): the path is only a start, a descent up to
+    /// A later search redoes the field's path with its full budget and free ends (a lone
+    /// field: the time objective's search, or the free open path under the distance
+    /// objective): the path is only a start, a descent up to
     /// [`LONE_DESCENT_MAX`] geometries and a Hilbert curve beyond.
     start_only: bool,
 }
