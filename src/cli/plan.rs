@@ -3,10 +3,10 @@
 use super::progress::BarProgress;
 use super::PlanArgs;
 use anyhow::{Context, Result};
-use galvoplan::document::write_atomic;
+use galvoplan::document::{write_atomic, write_atomic_with};
 use galvoplan::export::{
     check_outputs, geometry_svg, preview_svg, report_json, trajectory_csv, trajectory_period_s,
-    waypoints_csv, write_gcode,
+    waypoints_csv, write_gcode_to,
 };
 use galvoplan::import::Place;
 use galvoplan::job::Progress;
@@ -101,8 +101,20 @@ pub fn run(a: &PlanArgs) -> Result<()> {
         trajectory_csv(&toolpath, p)
     });
     let waypoints = a.waypoints.as_ref().map(|_| waypoints_csv(&toolpath));
-    let gcode = write_gcode(&toolpath, &plan, doc.page_mm[1], &source)
-        .with_context(|| format!("{}: cannot write G-code", a.output.display()))?;
+    // streamed into the output file (atomically: written whole or not at all)
+    let mut gcode_error = None;
+    write_atomic_with(&a.output, |f| {
+        write_gcode_to(f, &toolpath, &plan, doc.page_mm[1], &source).map_err(|e| {
+            let io = std::io::Error::other(e.to_string());
+            gcode_error = Some(e);
+            io
+        })
+    })
+    .map_err(|e| match gcode_error.take() {
+        Some(g) => anyhow::Error::new(g),
+        None => anyhow::Error::new(e),
+    })
+    .with_context(|| format!("{}: cannot write G-code", a.output.display()))?;
     let preview = a
         .preview
         .as_ref()
@@ -120,7 +132,6 @@ pub fn run(a: &PlanArgs) -> Result<()> {
         write_atomic(path, text.as_bytes())
             .with_context(|| format!("{}: cannot write", path.display()))
     };
-    write(&a.output, &gcode)?;
     finish_recording(recorder.as_ref())?;
     if let Some(p) = &a.report {
         write(p, &report_json(&source, &plan, &doc.warnings))?;

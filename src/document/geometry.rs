@@ -38,6 +38,32 @@ pub struct Geometry {
     /// cut on that pass's own tiling and marked once.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub pass: u32,
+    /// The run of strokes it belongs to, when a fill fixes their marking order (see [`Run`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub run: Option<Run>,
+}
+
+/// A run: strokes of one fill whose marking order the fill already fixes, so that planning
+/// may treat them as one node ([`super::runs`]). The members of a run are consecutive in the
+/// geometry list and share the run's id, their source element, layer and pass; they are listed
+/// in marking order.
+#[derive(Debug, Clone, Copy, Serialize, Deserialize, PartialEq, Eq, Hash)]
+pub struct Run {
+    /// Tells consecutive runs of one fill apart.
+    pub id: u32,
+    /// How its members follow one another.
+    pub order: RunOrder,
+}
+
+/// How the members of a [`Run`] follow one another.
+#[derive(Debug, Clone, Copy, Serialize, Deserialize, PartialEq, Eq, Hash)]
+pub enum RunOrder {
+    /// Pieces of a closed loop, each running along it: the run may be entered at any member and
+    /// is marked round to the one before it (or, cut short, from either end).
+    Loop,
+    /// Parallel chords swept back and forth: every other member is marked reversed, from
+    /// either end of the run.
+    Sweep,
 }
 
 fn is_zero(v: &u32) -> bool {
@@ -79,6 +105,7 @@ impl Geometry {
             source,
             layer,
             pass: 0,
+            run: None,
         }
     }
     /// The same geometry on layer `name`.
@@ -89,6 +116,11 @@ impl Geometry {
     /// The same geometry as pass `pass` of a pen with shifted passes (see [`Geometry::pass`]).
     pub fn with_pass(mut self, pass: u32) -> Self {
         self.pass = pass;
+        self
+    }
+    /// The same geometry as a member of `run`.
+    pub fn with_run(mut self, run: Option<Run>) -> Self {
+        self.run = run;
         self
     }
     /// Bounding box.

@@ -9,13 +9,14 @@ mod plan;
 mod profile;
 mod project;
 mod route;
+pub mod runs;
 mod settings;
 pub mod spec;
 pub mod validate;
 mod warning;
 
 pub use artwork_import::{ArtworkImport, LayerHidden, Place, PlaceError, SkippedLayer};
-pub use geometry::{is_hatch_output, Geometry, Source, HATCH_LAYER_PREFIX};
+pub use geometry::{is_hatch_output, Geometry, Run, RunOrder, Source, HATCH_LAYER_PREFIX};
 pub use hatch::{
     FillRule, FillShapes, HatchSettings, HatchSpecError, HatchStyle, OutlineMode, MIN_SPACING_MM,
 };
@@ -33,7 +34,8 @@ pub use profile::{
     ProfileError, ScannerSpeeds, BUILTIN, PROFILE_VERSION,
 };
 pub use project::{
-    load_project, parse_project, save_project, write_atomic, ProjectError, PROJECT_VERSION,
+    load_project, parse_project, save_project, write_atomic, write_atomic_with, ProjectError,
+    PROJECT_VERSION,
 };
 pub use route::TimedRoute;
 pub use settings::{

@@ -30,6 +30,9 @@ pub enum GcodeError {
         /// The segment's kind.
         kind: crate::motion::SegmentKind,
     },
+    /// The output could not be written.
+    #[error("cannot write the G-code: {0}")]
+    Write(String),
     /// A stroke names a layer the plan does not have (lowering never does).
     #[error("stroke {stroke} of the toolpath names layer {layer}, which the plan does not have")]
     NoLayer {
@@ -109,9 +112,23 @@ impl Words<'_> {
     }
     /// `X.. Y..`, or the scanner words for an offset in stage-scanner mode.
     pub(super) fn xy(&self, axes: [&str; 2], p: Pt) -> String {
-        format!("{}{} {}{}", axes[0], self.num(p.x), axes[1], self.num(p.y))
+        let mut out = String::new();
+        self.push_xy(&mut out, axes, p);
+        out
+    }
+    /// [`Words::xy`] appended to `out`.
+    pub(super) fn push_xy(&self, out: &mut String, axes: [&str; 2], p: Pt) {
+        let decimals = self.profile.gcode.decimals;
+        out.push_str(axes[0]);
+        crate::geom::push_mm(out, p.x, decimals);
+        out.push(' ');
+        out.push_str(axes[1]);
+        crate::geom::push_mm(out, p.y, decimals);
     }
 }
+
+/// The G-code is handed to the writer in pieces of about this many bytes.
+const CHUNK_BYTES: usize = 1 << 16;
 
 /// Writes the toolpath of `plan` as G-code in the dialect of the plan's profile; Y is mirrored
 /// about `page_height_mm` when the dialect says `flip_y`. Fields are numbered 1…n in visiting
@@ -122,6 +139,26 @@ pub fn write_gcode(
     page_height_mm: f64,
     title: &str,
 ) -> Result<String, GcodeError> {
+    let mut out = Vec::with_capacity(toolpath.strokes.len() * 64);
+    write_gcode_to(&mut out, toolpath, plan, page_height_mm, title)?;
+    String::from_utf8(out).map_err(|e| GcodeError::Write(e.to_string()))
+}
+
+/// [`write_gcode`] streamed to `sink` in pieces (a million strokes make about 100 MB of
+/// G-code, which is never held whole).
+pub fn write_gcode_to(
+    sink: &mut (impl std::io::Write + ?Sized),
+    toolpath: &Toolpath,
+    plan: &Plan,
+    page_height_mm: f64,
+    title: &str,
+) -> Result<(), GcodeError> {
+    let mut flush = |buf: &mut String| -> Result<(), GcodeError> {
+        sink.write_all(buf.as_bytes())
+            .map_err(|e| GcodeError::Write(e.to_string()))?;
+        buf.clear();
+        Ok(())
+    };
     let profile = &plan.profile;
     let d = &profile.gcode;
     let w = Words {
@@ -146,9 +183,10 @@ pub fn write_gcode(
     if d.mode == GcodeMode::Linuxcnc {
         let mut head = String::new();
         header(&mut head, toolpath, plan, title, true);
-        return super::linuxcnc::write_program(toolpath, plan, &w, &head);
+        let mut program = super::linuxcnc::write_program(toolpath, plan, &w, &head)?;
+        return flush(&mut program);
     }
-    let mut out = String::with_capacity(toolpath.strokes.len() * 64);
+    let mut out = String::with_capacity(CHUNK_BYTES + 4096);
     header(&mut out, toolpath, plan, title, false);
     let _ = writeln!(out, "{}", d.laser_off);
     let number: std::collections::HashMap<usize, usize> = plan
@@ -172,11 +210,11 @@ pub fn write_gcode(
             }
         }
         let points = toolpath.stroke_points(k);
-        let place = |p: Pt| -> String {
+        let place = |out: &mut String, p: Pt| {
             if stage_scanner {
-                w.xy(scan_axes, w.offset(p.minus(stroke.stage)))
+                w.push_xy(out, scan_axes, w.offset(p.minus(stroke.stage)));
             } else {
-                w.xy(["X", "Y"], w.position(p))
+                w.push_xy(out, ["X", "Y"], w.position(p));
             }
         };
         let Some((&first, rest)) = points.split_first() else {
@@ -195,19 +233,28 @@ pub fn write_gcode(
                 let _ = writeln!(out, "{c}");
             }
         }
-        let _ = writeln!(out, "G0 {}", place(first));
-        let _ = writeln!(out, "{}", pen.on);
+        out.push_str("G0 ");
+        place(&mut out, first);
+        out.push('\n');
+        out.push_str(&pen.on);
+        out.push('\n');
         for (j, &p) in rest.iter().enumerate() {
+            out.push_str("G1 ");
+            place(&mut out, p);
             if j == 0 {
-                let _ = writeln!(out, "G1 {} F{}", place(p), pen.feed);
-            } else {
-                let _ = writeln!(out, "G1 {}", place(p));
+                out.push_str(" F");
+                out.push_str(&pen.feed);
             }
+            out.push('\n');
         }
-        let _ = writeln!(out, "{}", d.laser_off);
+        out.push_str(&d.laser_off);
+        out.push('\n');
+        if out.len() >= CHUNK_BYTES {
+            flush(&mut out)?;
+        }
     }
     out.push_str("; end\n");
-    Ok(out)
+    flush(&mut out)
 }
 
 /// The comment lines at the top: `; ..` lines, or `(..)` for LinuxCNC (`parens`).

@@ -216,7 +216,10 @@ impl<'a, 'w> Program<'a, 'w> {
         }
         for seg in &toolpath.segments {
             match (seg.kind, seg.stage, seg.scan) {
-                (SegmentKind::StageMove, StageMotion::Move(mv), scan) => {
+                (SegmentKind::StageMove, StageMotion::Move(m), scan) => {
+                    let Some(mv) = toolpath.stage_moves.get(m) else {
+                        return Err(GcodeError::Unwritable { kind: seg.kind });
+                    };
                     self.before_move(false);
                     let to = mv.position(seg.duration_s);
                     if let Some(s) = toolpath.strokes.iter().find(|s| s.stage == to) {

@@ -9,7 +9,7 @@ mod report;
 mod svg_preview;
 mod trajectory;
 
-pub use gcode::{write_gcode, GcodeError};
+pub use gcode::{write_gcode, write_gcode_to, GcodeError};
 pub use guard::{check_outputs, OutputClash};
 pub use linuxcnc_config::{linuxcnc_config, ConfigFile, LIMIT_MARGIN_MM};
 pub use report::{report_json, Report};

@@ -26,6 +26,7 @@ pub use split::{
     move_seam, split_oversize, Cut, FIT_MARGIN_MM, SPLIT_WORDS,
 };
 
+use crate::document::runs::Contraction;
 use crate::document::{FieldsMode, Geometry, MachineProfile, ScanField, SolverSettings};
 use crate::job::{Cancelled, JobCtx};
 use thiserror::Error;
@@ -81,8 +82,15 @@ pub struct Placement {
     pub lower_bound: usize,
 }
 
+/// Run chunks the field stage places as one node are at most this share of a field wide and
+/// tall: they fit a field with room for the cover to move it (a chunk nearly a field wide
+/// would pin its field).
+const RUN_CHUNK_FIELD_SHARE: f64 = 0.5;
+
 /// Places scan fields for `geometries` with the mode in `settings`, keeping `locked` fields, and
-/// allocates every geometry to exactly one field (`ScanField::geometries`).
+/// allocates every geometry to exactly one field (`ScanField::geometries`). Runs of strokes a
+/// fill orders (`document::Run`) are placed as one node per chunk of at most half a field
+/// ([`Contraction::within`]), so a chunk's members share a field.
 pub fn place_fields(
     geometries: &[Geometry],
     profile: &MachineProfile,
@@ -91,6 +99,35 @@ pub fn place_fields(
     ctx: &JobCtx,
 ) -> Result<Placement, FieldError> {
     check_reach(geometries, profile)?;
+    let max_mm = profile.field_mm.map(|f| f * RUN_CHUNK_FIELD_SHARE);
+    let Some(runs) = Contraction::within(geometries, max_mm) else {
+        let fields = place_nodes(geometries, profile, settings, locked, ctx)?;
+        let lower_bound = cover::lower_bound(&auto::feasible_rects(geometries, profile));
+        return Ok(Placement {
+            fields,
+            lower_bound,
+        });
+    };
+    let fields = place_nodes(runs.nodes(), profile, settings, locked, ctx)?;
+    let representatives: Vec<Geometry> = runs
+        .representatives()
+        .into_iter()
+        .map(|g| geometries[g].clone())
+        .collect();
+    Ok(Placement {
+        fields: runs.fields_to_geometries(fields),
+        lower_bound: cover::lower_bound(&auto::feasible_rects(&representatives, profile)),
+    })
+}
+
+/// [`place_fields`] on nodes (geometries, or the proxies of run chunks): the placed fields.
+fn place_nodes(
+    geometries: &[Geometry],
+    profile: &MachineProfile,
+    settings: &SolverSettings,
+    locked: &[ScanField],
+    ctx: &JobCtx,
+) -> Result<Vec<ScanField>, FieldError> {
     let locked: Vec<ScanField> = locked
         .iter()
         .map(|f| ScanField {
@@ -145,11 +182,7 @@ pub fn place_fields(
             missing.first().copied().unwrap_or(0),
         ));
     }
-    let lower_bound = cover::lower_bound(&auto::feasible_rects(geometries, profile));
-    Ok(Placement {
-        fields,
-        lower_bound,
-    })
+    Ok(fields)
 }
 
 #[cfg(test)]

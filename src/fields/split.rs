@@ -197,7 +197,46 @@ pub fn cut_at_tiling(
             }
         }
     }
+    split_runs_at_cells(&mut out.geometries, tiling);
     out
+}
+
+/// Runs (`document::Run`) are cut where consecutive members lie in different cells of
+/// `tiling` (a seam through the gap between two members cuts no stroke): each stretch gets an
+/// id of its own, so that no run chunk the field stage places as one node straddles a seam
+/// (it would need a field of its own across two cells). Pieces of cut strokes are loose
+/// already.
+fn split_runs_at_cells(geometries: &mut [Geometry], tiling: &Tiling) {
+    let cell = |g: &Geometry| {
+        let c = g.bbox().center();
+        let at = |borders: &[f64], v: f64| borders.partition_point(|&b| b <= v);
+        (at(&tiling.xs, c.x), at(&tiling.ys, c.y))
+    };
+    // fresh ids above any a fill gives (a fill numbers its runs from 1 per region)
+    let mut next_id = u32::MAX / 2;
+    let mut last: Option<(crate::document::Run, (usize, usize), u32)> = None;
+    for k in 0..geometries.len() {
+        let Some(run) = geometries[k].run else {
+            last = None;
+            continue;
+        };
+        let here = cell(&geometries[k]);
+        let same_run = k > 0
+            && last.is_some_and(|(r, _, _)| r == run)
+            && geometries[k - 1].source.element == geometries[k].source.element
+            && geometries[k - 1].layer == geometries[k].layer
+            && geometries[k - 1].pass == geometries[k].pass;
+        let id = match last {
+            Some((_, c, id)) if same_run && c == here => id,
+            Some(_) if same_run => {
+                next_id = next_id.wrapping_add(1);
+                next_id
+            }
+            _ => run.id,
+        };
+        last = Some((run, here, id));
+        geometries[k].run = Some(crate::document::Run { id, ..run });
+    }
 }
 
 /// Cuts the geometries `take` selects on `tiling`, one cut per seam form (crossings are ranked

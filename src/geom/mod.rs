@@ -193,16 +193,27 @@ pub fn point_segment_dist(p: Pt, a: Pt, b: Pt) -> f64 {
 /// A length in mm with `decimals` decimals, trailing zeros trimmed and no negative zero
 /// (`-15.5000` → `-15.5`, `-0.0000` → `0`): how G-code words and messages write a coordinate.
 pub fn format_mm(v: f64, decimals: usize) -> String {
-    let s = format!("{v:.decimals$}");
-    let s = if s.contains('.') {
-        s.trim_end_matches('0').trim_end_matches('.').to_string()
-    } else {
-        s
-    };
-    if s == "-0" {
-        "0".into()
-    } else {
-        s
+    let mut s = String::new();
+    push_mm(&mut s, v, decimals);
+    s
+}
+
+/// [`format_mm`] appended to `out` (no allocation once `out` has room: G-code writes millions).
+pub fn push_mm(out: &mut String, v: f64, decimals: usize) {
+    use std::fmt::Write;
+    let start = out.len();
+    // writing to a String cannot fail
+    let _ = write!(out, "{v:.decimals$}");
+    if out[start..].contains('.') {
+        let kept = out[start..]
+            .trim_end_matches('0')
+            .trim_end_matches('.')
+            .len();
+        out.truncate(start + kept);
+    }
+    if &out[start..] == "-0" {
+        out.truncate(start);
+        out.push('0');
     }
 }
 
@@ -216,6 +227,12 @@ mod tests {
         assert_eq!(format_mm(170.0, 4), "170");
         assert_eq!(format_mm(-0.00001, 4), "0");
         assert_eq!(format_mm(0.12345, 3), "0.123");
+        assert_eq!(format_mm(-0.0, 0), "0");
+        assert_eq!(format_mm(120.0, 0), "120");
+        let mut s = String::from("X");
+        push_mm(&mut s, 2.50, 3);
+        push_mm(&mut s, -0.0001, 3);
+        assert_eq!(s, "X2.50");
     }
 
     #[test]

@@ -194,13 +194,23 @@ impl<'a> Boundary<'a> {
 
     /// The boundary pieces no join uses, merged into maximal polylines; loops without any used
     /// piece come back whole and closed. Each item is `(points, closed)`.
+    #[cfg(test)]
     pub(crate) fn unused(&self) -> Vec<(Vec<Pt>, bool)> {
+        self.unused_by_loop()
+            .into_iter()
+            .map(|(_, pts, closed)| (pts, closed))
+            .collect()
+    }
+
+    /// [`Boundary::unused`] with each item's loop index first; the pieces of a loop come in
+    /// its order.
+    pub(crate) fn unused_by_loop(&self) -> Vec<(u32, Vec<Pt>, bool)> {
         let mut out = Vec::new();
         for (li, l) in self.loops.iter().enumerate() {
             let used = &self.used[li];
             let m = used.len();
             if used.iter().all(|u| !u) {
-                out.push((l.clone(), true));
+                out.push((li as u32, l.clone(), true));
                 continue;
             }
             for start in 0..m {
@@ -221,7 +231,7 @@ impl<'a> Boundary<'a> {
                 };
                 let mut pts = vec![self.marks[li][start].pt];
                 self.walk(a, b, true, &mut pts);
-                out.push((pts, false));
+                out.push((li as u32, pts, false));
             }
         }
         out

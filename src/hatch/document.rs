@@ -241,7 +241,9 @@ fn hatch_region(
                 subpath: k,
                 layer: layer.clone(),
             };
-            Geometry::new(s.points, s.closed, source).with_layer(&first.layer)
+            Geometry::new(s.points, s.closed, source)
+                .with_layer(&first.layer)
+                .with_run(s.run)
         })
         .collect())
 }

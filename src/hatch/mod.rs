@@ -35,6 +35,7 @@ mod zigzag;
 pub use crate::document::{
     FillRule, HatchSettings, HatchSpecError, HatchStyle, OutlineMode, MIN_SPACING_MM,
 };
+use crate::document::{Run, RunOrder};
 pub use document::{
     hatch_geometries, is_hatch_output, layer_geometries, HatchedGeometries, HATCH_LAYER_PREFIX,
 };
@@ -115,6 +116,9 @@ pub struct HatchStroke {
     pub points: Vec<Pt>,
     /// Closed (marked back to the first point).
     pub closed: bool,
+    /// The run it belongs to, where the fill fixes the order of its strokes: the border pieces
+    /// of one boundary loop (round the loop), the zigzag parts of one sweep (line by line).
+    pub run: Option<Run>,
 }
 
 impl HatchStroke {
@@ -191,6 +195,12 @@ pub fn hatch_contours(
         level,
         points,
         closed,
+        run: None,
+    };
+    let mut runs = 0u32;
+    let mut new_run = |order| {
+        runs += 1;
+        Some(Run { id: runs, order })
     };
     if settings.style == HatchStyle::Contour {
         ctx.check()?;
@@ -248,15 +258,41 @@ pub fn hatch_contours(
             let refs: Vec<&scan::Scan> = scans.iter().collect();
             let mut boundary = Boundary::new(&flat, &refs);
             for (f, sc) in scans.iter().enumerate() {
-                for part in zigzag::link(sc, f, &mut boundary) {
-                    out.strokes
-                        .push(stroke(StrokeKind::Zigzag, f as u8, 0, part.points, false));
+                let mut parts = zigzag::link(sc, f, &mut boundary);
+                // each sweep's parts together, line by line; a sweep of two parts or more is
+                // one run
+                parts.sort_by_key(|p| p.sweep);
+                let mut k = 0;
+                while k < parts.len() {
+                    let end = k + parts[k..]
+                        .iter()
+                        .take_while(|p| p.sweep == parts[k].sweep)
+                        .count();
+                    let run = if end - k > 1 {
+                        new_run(RunOrder::Sweep)
+                    } else {
+                        None
+                    };
+                    for part in &mut parts[k..end] {
+                        let points = std::mem::take(&mut part.points);
+                        out.strokes.push(HatchStroke {
+                            run,
+                            ..stroke(StrokeKind::Zigzag, f as u8, 0, points, false)
+                        });
+                    }
+                    k = end;
                 }
             }
             if settings.border {
-                for (pts, closed) in boundary.unused() {
-                    out.strokes
-                        .push(stroke(StrokeKind::Border, 0, 0, pts, closed));
+                let mut loop_run = (u32::MAX, None);
+                for (loop_id, pts, closed) in boundary.unused_by_loop() {
+                    if loop_run.0 != loop_id {
+                        loop_run = (loop_id, new_run(RunOrder::Loop));
+                    }
+                    out.strokes.push(HatchStroke {
+                        run: if closed { None } else { loop_run.1 },
+                        ..stroke(StrokeKind::Border, 0, 0, pts, closed)
+                    });
                 }
             }
         }

@@ -6,6 +6,12 @@
 //! region and the laser stays on. Lines are swept in order; every open polyline tries to continue
 //! from its free end to the next line, chords nobody reaches start new polylines. Each polyline
 //! is one part the laser sweeps without lifting; all of them run towards larger `v`.
+//!
+//! Where a walk is not free (a join of another family already marks that boundary piece), the
+//! part ends and the chord it would have reached starts a new part of the same *sweep*, entered
+//! at that end: parts of one sweep follow one another line by line, back and forth, one
+//! boundary piece apart, so they are marked as one run (`document::RunOrder::Sweep`) with a
+//! jump where the join would have been.
 
 use super::boundary::Boundary;
 use super::scan::{Chord, Scan};
@@ -16,6 +22,8 @@ use crate::geom::Pt;
 pub(crate) struct Part {
     /// Points in marking order.
     pub points: Vec<Pt>,
+    /// Its sweep (numbered from 0 in order of first part); see the module doc.
+    pub sweep: u32,
 }
 
 fn push(points: &mut Vec<Pt>, p: Pt) {
@@ -41,7 +49,8 @@ pub(crate) fn link(scan: &Scan, family: usize, boundary: &mut Boundary) -> Vec<P
     let mut active: Vec<(usize, u32)> = Vec::new();
     // The chord end reached from `x` by walking the boundary into the next band, if that is an
     // untaken chord on the next line and the walk is free.
-    let step = |x: u32, boundary: &Boundary, taken: &[Vec<bool>]| -> Option<u32> {
+    // With `free`, the walk must also be free; without, the chord end is only adjacent.
+    let reach = |x: u32, boundary: &Boundary, taken: &[Vec<bool>], free: bool| -> Option<u32> {
         let cx = scan.crossings[x as usize];
         let p = boundary.pos(family, x);
         let q = boundary.neighbour(p, cx.forward_down);
@@ -49,13 +58,21 @@ pub(crate) fn link(scan: &Scan, family: usize, boundary: &mut Boundary) -> Vec<P
         let cy = scan.crossings[y as usize];
         let ok = cy.line == cx.line + 1
             && !taken[cy.line as usize][chord_of[y as usize].0 as usize]
-            && boundary.is_free(p, q, cx.forward_down);
+            && (!free || boundary.is_free(p, q, cx.forward_down));
         ok.then_some(y)
     };
+    let step = |x: u32, boundary: &Boundary, taken: &[Vec<bool>]| reach(x, boundary, taken, true);
+    let mut sweeps = 0u32;
     for j in 0..n_lines {
         let mut next_active = Vec::new();
+        // the sweep a chord of this line continues, when a part could not join it
+        let mut inherit: Vec<Option<(u32, u32)>> = vec![None; scan.lines[j].len()];
         for &(part, exit) in &active {
             let Some(y) = step(exit, boundary, &taken) else {
+                if let Some(y) = reach(exit, boundary, &taken, false) {
+                    let ci = chord_of[y as usize].0 as usize;
+                    inherit[ci].get_or_insert((parts[part].sweep, y));
+                }
                 continue;
             };
             let cx = scan.crossings[exit as usize];
@@ -71,18 +88,36 @@ pub(crate) fn link(scan: &Scan, family: usize, boundary: &mut Boundary) -> Vec<P
                 continue;
             }
             taken[j][ci] = true;
-            // leave through the end that can continue to the next line, if either can
-            let exit =
-                if step(hi, boundary, &taken).is_some() || step(lo, boundary, &taken).is_none() {
+            // a sweep's chord enters at the end next to the last one (so the sweep goes back
+            // and forth); a new part leaves through the end that can continue to the next
+            // line, if either can
+            let exit = match inherit[ci] {
+                Some((_, y)) => {
+                    if y == hi {
+                        lo
+                    } else {
+                        hi
+                    }
+                }
+                None if step(hi, boundary, &taken).is_some()
+                    || step(lo, boundary, &taken).is_none() =>
+                {
                     hi
-                } else {
-                    lo
-                };
+                }
+                None => lo,
+            };
             let entry = if exit == hi { lo } else { hi };
             let mut points = vec![scan.crossings[entry as usize].pt];
             push(&mut points, scan.crossings[exit as usize].pt);
             next_active.push((parts.len(), exit));
-            parts.push(Part { points });
+            let sweep = inherit[ci].map_or_else(
+                || {
+                    sweeps += 1;
+                    sweeps - 1
+                },
+                |(sweep, _)| sweep,
+            );
+            parts.push(Part { points, sweep });
         }
         active = next_active;
     }

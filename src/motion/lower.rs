@@ -3,7 +3,7 @@
 use super::axis::StageDynamics;
 use super::controller::LinuxcncClock;
 use super::toolpath::{ScanMotion, Segment, SegmentKind, StageMotion, Toolpath};
-use crate::document::{Geometry, MachineProfile, Plan};
+use crate::document::{Geometry, MachineProfile, Plan, ScanField};
 use crate::geom::Pt;
 use thiserror::Error;
 
@@ -65,6 +65,17 @@ pub fn lower(
     profile: &MachineProfile,
 ) -> Result<Toolpath, LowerError> {
     let mut b = Builder::new(profile);
+    // per stroke: a jump, its delay, the laser delays and the mark; per field change a move
+    // and its settling
+    let points: usize = plan
+        .order
+        .iter()
+        .filter_map(|s| geometries.get(s.geometry))
+        .map(|g| g.points.len() + usize::from(g.closed))
+        .sum();
+    let n = plan.order.len();
+    b.path.reserve(n, points, 5 * n + 2 * plan.fields.len());
+    let mut field_at: Option<&ScanField> = None;
     for (k, step) in plan.order.iter().enumerate() {
         let g = geometries
             .get(step.geometry)
@@ -72,14 +83,18 @@ pub fn lower(
                 step: k,
                 geometry: step.geometry,
             })?;
-        let field = plan
-            .fields
-            .iter()
-            .find(|f| f.id == step.field)
-            .ok_or(LowerError::NoField {
-                step: k,
-                field: step.field,
-            })?;
+        let field = match field_at {
+            Some(f) if f.id == step.field => f,
+            _ => plan
+                .fields
+                .iter()
+                .find(|f| f.id == step.field)
+                .ok_or(LowerError::NoField {
+                    step: k,
+                    field: step.field,
+                })?,
+        };
+        field_at = Some(field);
         let path = g.marking_path(step.start_vertex, step.reversed);
         check_reach(&path, field.center, field.size).map_err(|excess_mm| {
             LowerError::OutOfReach {
@@ -233,7 +248,9 @@ impl<'a> Builder<'a> {
         } else {
             ScanMotion::Hold(self.scan_at)
         };
-        self.push(SegmentKind::StageMove, move_s, StageMotion::Move(mv), scan);
+        self.path.stage_moves.push(mv);
+        let moving = StageMotion::Move(self.path.stage_moves.len() - 1);
+        self.push(SegmentKind::StageMove, move_s, moving, scan);
         self.stage_at = center;
         if hidden {
             self.scan_at = offset;

@@ -35,8 +35,10 @@ pub enum SegmentKind {
 pub enum StageMotion {
     /// At rest at a position (mm).
     Hold(Pt),
-    /// A rest-to-rest move starting with the segment.
-    Move(StageMove),
+    /// A rest-to-rest move starting with the segment: index into [`Toolpath::stage_moves`]
+    /// (kept apart so that a segment stays small: a million strokes make five million
+    /// segments, and only field changes move the stage).
+    Move(usize),
     /// On the toolpath's continuous route ([`Toolpath::route`], on the fly).
     Route,
 }
@@ -146,6 +148,8 @@ impl MachineState {
 pub struct Toolpath {
     /// Segments in time order; each starts where the previous one ends.
     pub segments: Vec<Segment>,
+    /// The stage moves [`StageMotion::Move`] segments make.
+    pub stage_moves: Vec<StageMove>,
     /// Marked strokes in marking order.
     pub strokes: Vec<Stroke>,
     /// The stage's continuous route (on the fly), which [`StageMotion::Route`] segments follow.
@@ -160,6 +164,15 @@ pub struct Toolpath {
 }
 
 impl Toolpath {
+    /// Room for `strokes` strokes of `points` points in all and `segments` segments: a
+    /// lowering that knows its sizes asks once (on a million strokes the segment list is
+    /// about 500 MB; grown by doubling it would briefly need half as much again).
+    pub(crate) fn reserve(&mut self, strokes: usize, points: usize, segments: usize) {
+        self.strokes.reserve_exact(strokes);
+        self.points.reserve_exact(points);
+        self.arc_mm.reserve_exact(points);
+        self.segments.reserve_exact(segments);
+    }
     /// Adds a stroke's points; returns its index.
     pub(crate) fn push_stroke(
         &mut self,
@@ -203,6 +216,7 @@ impl Toolpath {
         }
         let mut out = Toolpath {
             segments: Vec::with_capacity(self.segments.len() + self.strokes.len()),
+            stage_moves: self.stage_moves.clone(),
             strokes: self.strokes.clone(),
             route: None,
             stretch: None,
@@ -370,7 +384,10 @@ impl Toolpath {
         let local_s = (t_s - seg.start_s).clamp(0.0, seg.duration_s);
         let stage = match &seg.stage {
             StageMotion::Hold(p) => *p,
-            StageMotion::Move(m) => m.position(local_s / self.stretch()),
+            StageMotion::Move(m) => self
+                .stage_moves
+                .get(*m)
+                .map_or(Pt::default(), |m| m.position(local_s / self.stretch())),
             // the route goes on past the job's end (the stage comes to rest on it)
             StageMotion::Route => self
                 .route

@@ -17,6 +17,7 @@ pub use as_is::as_is_order;
 pub use baseline::baseline_order;
 pub use passes::expand_passes;
 
+use crate::document::runs::Contraction;
 use crate::document::{
     Algo, CostModel, GenerationRecord, Geometry, Motion, ObjectiveKind, Plan, PlanInputs,
     ScanField, SolverSettings, Step,
@@ -62,6 +63,8 @@ pub fn order_plan(
     ctx: &JobCtx,
 ) -> Result<(Plan, Toolpath), OrderError> {
     check_allocation(geometries.len(), fields)?;
+    // as-is marks the strokes as they come: no runs
+    let nodes = Nodes::of(geometries, fields, inputs.settings.algo != Algo::AsIs);
     let settings = &inputs.settings;
     let motions = settings.motion.candidates();
     let t0 = std::time::Instant::now();
@@ -74,7 +77,13 @@ pub fn order_plan(
             // a cancel keeps the plan made so far
             break;
         }
-        let lower = Candidates::new(geometries, fields, inputs, motion, ctx);
+        if let (Motion::OnTheFly, Some(step)) = (motion, &best) {
+            if let Some(skip) = flying_cannot_gain(&nodes, inputs, step.toolpath.duration_s()) {
+                detail.push(skip);
+                continue;
+            }
+        }
+        let lower = Candidates::new(&nodes, inputs, motion, ctx);
         let mut stages = Vec::new();
         let made = match settings.algo {
             Algo::Hga if hga_after => hha_finished(&lower, t0, &mut stages)
@@ -104,7 +113,7 @@ pub fn order_plan(
     let mut best = best.ok_or(OrderError::Unallocated(0, 0))?;
     if hga_after && !ctx.is_cancelled() {
         // the GA runs in the motion whose HHA plan was faster, seeded with that plan
-        let lower = Candidates::new(geometries, fields, inputs, best.motion, ctx);
+        let lower = Candidates::new(&nodes, inputs, best.motion, ctx);
         let mut stages = Vec::new();
         let hha = (best.ordering, best.toolpath);
         let seed = settings.ga.seed_with_hha.then_some(hha);
@@ -118,7 +127,7 @@ pub fn order_plan(
         };
     }
     let order_s = t0.elapsed().as_secs_f64();
-    let lower = Candidates::new(geometries, fields, inputs, best.motion, ctx);
+    let lower = Candidates::new(&nodes, inputs, best.motion, ctx);
     let mut plan = lower.plan(&best.ordering);
     let mut m = metrics::compute(
         geometries,
@@ -133,6 +142,37 @@ pub fn order_plan(
     plan.metrics = m;
     plan.history = best.history;
     Ok((plan, best.toolpath))
+}
+
+/// Under auto, on the fly is not planned for a job of more than this many strokes (passes
+/// counted) when step-and-scan is already near the floor ([`FLY_GAIN_MIN`]).
+pub const FLY_SKIP_STROKES_MIN: usize = 20_000;
+
+/// The least share of the step-and-scan job time that on the fly must be able to gain to be
+/// planned on a large job: its job time is at least the marking floor
+/// ([`objective::marking_floor_s`]), so it can gain at most the step plan's time above that
+/// floor. Its lowering costs about 55 µs a stroke (13 s on a 239,200-stroke fill, planned
+/// twice: by fields and by bands; BENCHMARKS, issue 24), for at most this much.
+pub const FLY_GAIN_MIN: f64 = 0.02;
+
+/// Some((the order detail's entry, s)) when on the fly is not worth planning after a step-and-
+/// scan plan of `step_s` on a large job: it could gain less than [`FLY_GAIN_MIN`] of it.
+fn flying_cannot_gain(nodes: &Nodes, inputs: &PlanInputs, step_s: f64) -> Option<(String, f64)> {
+    let t = std::time::Instant::now();
+    let strokes: usize = nodes
+        .geometries
+        .iter()
+        .map(|g| crate::document::passes_of(&inputs.layers, g) as usize)
+        .sum();
+    if strokes <= FLY_SKIP_STROKES_MIN {
+        return None;
+    }
+    let floor_s = objective::marking_floor_s(nodes.geometries, &inputs.layers, &inputs.profile);
+    (step_s - floor_s < FLY_GAIN_MIN * step_s).then(|| {
+        let label =
+            format!("on the fly: not planned (step-and-scan {step_s:.1} s, floor {floor_s:.1} s)");
+        (label, t.elapsed().as_secs_f64())
+    })
 }
 
 /// A finished candidate plan: its motion, ordering, toolpath and GA history.
@@ -264,7 +304,7 @@ fn hga_plan(
     let mut history = r.history;
     let ga = finish(lower, r.ordering, None, detail)?;
     let value = |c: &(Ordering, Toolpath)| match kind {
-        ObjectiveKind::IdleMm => metrics::idle_mm(geometries, &lower.plan(&c.0).order),
+        ObjectiveKind::IdleMm => metrics::idle_mm(lower.real, &lower.plan(&c.0).order),
         ObjectiveKind::JobTimeS | ObjectiveKind::StepJobTimeEstimateS => c.1.duration_s(),
     };
     let best = match seed {
@@ -283,12 +323,47 @@ fn hga_plan(
     Ok((best.0, best.1, history))
 }
 
-/// The one lower-and-compare helper: turns candidate orderings into plans of the solve's
-/// inputs (pens, passes, profile, motion) and lowers them, so that every keep-the-faster
-/// choice is judged on the time law the plan will have.
-struct Candidates<'a> {
+/// The solve's geometries and fields, and the nodes its searches order: each chunk of a run
+/// one node ([`Contraction::in_fields`]), or the geometries themselves when there is
+/// no run.
+struct Nodes<'a> {
     geometries: &'a [Geometry],
     fields: &'a [ScanField],
+    runs: Option<(Contraction, Vec<ScanField>)>,
+}
+
+impl<'a> Nodes<'a> {
+    fn of(geometries: &'a [Geometry], fields: &'a [ScanField], by_runs: bool) -> Self {
+        let runs = by_runs
+            .then(|| Contraction::in_fields(geometries, fields))
+            .flatten()
+            .map(|c| {
+                let node_fields = c.fields_to_nodes(fields);
+                (c, node_fields)
+            });
+        Self {
+            geometries,
+            fields,
+            runs,
+        }
+    }
+}
+
+/// The one lower-and-compare helper: turns candidate orderings into plans of the solve's
+/// inputs (pens, passes, profile, motion) and lowers them, so that every keep-the-faster
+/// choice is judged on the time law the plan will have. Orderings are over the nodes
+/// (`geometries`, `fields`); plans and toolpaths over the real geometries.
+struct Candidates<'a> {
+    /// The nodes the searches order.
+    geometries: &'a [Geometry],
+    /// The fields over the nodes.
+    fields: &'a [ScanField],
+    /// The geometries the plan marks.
+    real: &'a [Geometry],
+    /// The fields over them.
+    real_fields: &'a [ScanField],
+    /// How nodes expand to geometries (none: the nodes are the geometries).
+    runs: Option<&'a Contraction>,
     inputs: &'a PlanInputs,
     /// The motion the candidates run in.
     motion: Motion,
@@ -298,20 +373,21 @@ struct Candidates<'a> {
 }
 
 impl<'a> Candidates<'a> {
-    fn new(
-        geometries: &'a [Geometry],
-        fields: &'a [ScanField],
-        inputs: &'a PlanInputs,
-        motion: Motion,
-        ctx: &'a JobCtx,
-    ) -> Self {
+    fn new(nodes: &'a Nodes<'a>, inputs: &'a PlanInputs, motion: Motion, ctx: &'a JobCtx) -> Self {
         let settings = SolverSettings {
             motion: motion.into(),
             ..inputs.settings.clone()
         };
+        let (geometries, fields, runs) = match &nodes.runs {
+            Some((c, node_fields)) => (c.nodes(), node_fields.as_slice(), Some(c)),
+            None => (nodes.geometries, nodes.fields, None),
+        };
         Self {
             geometries,
             fields,
+            real: nodes.geometries,
+            real_fields: nodes.fields,
+            runs,
             inputs,
             motion,
             settings,
@@ -322,11 +398,19 @@ impl<'a> Candidates<'a> {
     /// The plan of an ordering (unnamed, without metrics): its fields in visiting order, its
     /// strokes repeated for their layers' passes.
     fn plan(&self, ordering: &Ordering) -> Plan {
-        let order = expand_passes(&ordering.steps, self.geometries, &self.inputs.layers);
+        let expanded;
+        let steps = match self.runs {
+            Some(c) => {
+                expanded = c.steps_to_geometries(&ordering.steps, self.real);
+                &expanded
+            }
+            None => &ordering.steps,
+        };
+        let order = expand_passes(steps, self.real, &self.inputs.layers);
         Plan::new(
             self.inputs,
             self.motion,
-            fields_in_order(self.fields, &ordering.field_order),
+            fields_in_order(self.real_fields, &ordering.field_order),
             order,
         )
     }
@@ -340,7 +424,7 @@ impl<'a> Candidates<'a> {
         } else {
             self.ctx
         };
-        match lower_motion(self.geometries, &self.plan(ordering), None, ctx) {
+        match lower_motion(self.real, &self.plan(ordering), None, ctx) {
             Err(MotionError::OnTheFly(OtfError::Cancelled(c))) => Err(OrderError::Cancelled(c)),
             other => Ok(other?),
         }
@@ -407,7 +491,6 @@ fn time_ordering(
     ordering: Ordering,
     until: Option<std::time::Instant>,
 ) -> Result<(Ordering, Toolpath), OrderError> {
-    let by_distance = lower.toolpath(&ordering)?;
     let refined = match time::refine_for_time(
         lower.geometries,
         lower.fields,
@@ -418,11 +501,22 @@ fn time_ordering(
         lower.ctx,
     ) {
         Ok(refined) => refined,
-        Err(Cancelled) => return Ok((ordering, by_distance)),
+        Err(Cancelled) => {
+            let by_distance = lower.toolpath(&ordering)?;
+            return Ok((ordering, by_distance));
+        }
     };
+    // one toolpath at a time (hundreds of MB on a million strokes): the distance ordering's
+    // is made again when it wins
+    let by_distance_s = lower.toolpath(&ordering)?.duration_s();
     let by_time = lower.toolpath(&refined)?;
     // the refinement on a tie: it is what the time objective chose
-    Ok(faster((refined, by_time), (ordering, by_distance)))
+    if by_time.duration_s() <= by_distance_s {
+        return Ok((refined, by_time));
+    }
+    drop(by_time);
+    let by_distance = lower.toolpath(&ordering)?;
+    Ok((ordering, by_distance))
 }
 
 /// Every geometry must be allocated to exactly one field.

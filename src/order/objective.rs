@@ -240,6 +240,27 @@ pub fn step_job_time_lower_bound_s(
     marking + stage + jumps
 }
 
+/// A lower bound on the job time of these strokes in any motion and any order (s): every
+/// stroke's marking and laser delays, once per pass, and a jump delay before every stroke but
+/// the first. Neither motion can beat it: on the fly the tool keeps the scanner's time law or
+/// a slower one (its jumps, delays and marks are only ever stretched), and step-and-scan adds
+/// stage moves and jump travel to it. On a controller clock the laser and jump delays are left
+/// out (still a bound).
+pub fn marking_floor_s(geometries: &[Geometry], layers: &[Layer], profile: &MachineProfile) -> f64 {
+    let model = StepTime::new(geometries, &[], layers, profile);
+    let mut strokes = 0.0;
+    let mut marking = 0.0;
+    for (g, t) in geometries.iter().zip(&model.mark_s) {
+        let passes = f64::from(crate::document::passes_of(layers, g));
+        strokes += passes;
+        marking += t * passes;
+    }
+    if model.clock.is_some() {
+        return marking;
+    }
+    marking + (strokes - 1.0).max(0.0) * model.jump_delay_s
+}
+
 /// Largest field whose strokes' nearest gaps [`step_job_time_lower_bound_s`] computes exactly
 /// (pairwise: 4 million box gaps at this size, about 10 ms).
 pub const EXACT_GAPS_MAX: usize = 2000;
