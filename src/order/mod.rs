@@ -398,15 +398,19 @@ impl<'a> Candidates<'a> {
     /// The plan of an ordering (unnamed, without metrics): its fields in visiting order, its
     /// strokes repeated for their layers' passes.
     fn plan(&self, ordering: &Ordering) -> Plan {
-        let expanded;
-        let steps = match self.runs {
-            Some(c) => {
-                expanded = c.steps_to_geometries(&ordering.steps, self.real);
-                &expanded
+        let layers = &self.inputs.layers;
+        let order = match self.runs {
+            // a million steps: not copied again when no pen repeats its strokes
+            Some(c) if layers.iter().all(|l| l.pen.passes <= 1) => {
+                c.steps_to_geometries(&ordering.steps, self.real)
             }
-            None => &ordering.steps,
+            Some(c) => expand_passes(
+                &c.steps_to_geometries(&ordering.steps, self.real),
+                self.real,
+                layers,
+            ),
+            None => expand_passes(&ordering.steps, self.real, layers),
         };
-        let order = expand_passes(steps, self.real, &self.inputs.layers);
         Plan::new(
             self.inputs,
             self.motion,
