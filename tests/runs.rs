@@ -167,3 +167,51 @@ fn the_marking_floor_is_below_both_motions() {
         assert!(floor <= job_s(&plan) + 1e-9, "{motion:?}: {floor} {b:?}");
     }
 }
+
+#[test]
+fn fills_cut_on_a_tiling_plan_by_runs_into_valid_jobs() {
+    // a field smaller than the shapes: fills are cut at seams, runs split at cells
+    let path = common::root().join("tests/data/hatch/apmcm-multi.svg");
+    for style in [HatchStyle::Zigzag, HatchStyle::Cross] {
+        for angle_deg in [0.0, 30.0, 90.0] {
+            let settings = SolverSettings {
+                hatch: Some(HatchSettings {
+                    angle_deg,
+                    ..HatchSettings::new(style, 0.4)
+                }),
+                split_oversize: true,
+                motion: MotionMode::Step,
+                ..SolverSettings::default()
+            };
+            let profile = MachineProfile {
+                field_mm: [20.0, 20.0],
+                ..MachineProfile::default()
+            };
+            let (mut doc, _) =
+                load_svg(&path, profile, settings, &ImportOptions::default()).unwrap();
+            let plan = plan_document(&mut doc, &JobCtx::default()).unwrap();
+            common::check_plan(&doc, &plan);
+            assert!(
+                doc.geometries.iter().any(|g| g.run.is_some()),
+                "{style:?} at {angle_deg}°: no runs"
+            );
+            // each stretch of a run lies in one tiling cell: it fits a field
+            let key = |g: &Geometry| g.run.map(|r| (r, g.source.element.clone(), g.pass));
+            let gs = &doc.geometries;
+            let mut k = 0;
+            while k < gs.len() {
+                let end = k + gs[k..].iter().take_while(|g| key(g) == key(&gs[k])).count();
+                if key(&gs[k]).is_some() {
+                    let b = gs[k..end]
+                        .iter()
+                        .fold(galvoplan::geom::BBox::EMPTY, |b, g| b.union(g.bbox()));
+                    assert!(
+                        b.width() <= 20.0 && b.height() <= 20.0,
+                        "{style:?} at {angle_deg}°: run stretch {k}..{end} is {b:?}"
+                    );
+                }
+                k = end;
+            }
+        }
+    }
+}
