@@ -203,6 +203,12 @@ pub fn plan_document_lowered(
     plan.metrics.solve_s.hatch = hatch_s;
     plan.metrics.solve_s.fields = fields_s;
     plan.metrics.fields_lower_bound = Some(lower_bound);
+    // why auto planned one motion only, said like the whole-or-cut choice (the last solve's)
+    doc.warnings
+        .retain(|w| !w.message.starts_with(crate::order::FLY_NOT_PLANNED));
+    if let Some(note) = &plan.metrics.motion_note {
+        doc.warnings.push(choice_warning(note.clone()));
+    }
     if doc.geometries.iter().any(|g| g.pass > 0) {
         compare_unshifted(doc, &mut plan, &toolpath, ctx)?;
     }
@@ -412,6 +418,7 @@ fn relower(doc: &Document, plan: &mut Plan) -> Result<Toolpath, PipelineError> {
     plan.metrics = crate::document::Metrics {
         solve_s: std::mem::take(&mut plan.metrics.solve_s),
         fields_lower_bound: plan.metrics.fields_lower_bound,
+        motion_note: plan.metrics.motion_note.take(),
         ..m
     };
     Ok(toolpath)

@@ -140,6 +140,14 @@ fn a_large_fill_near_its_floor_is_not_planned_on_the_fly() {
             .any(|(k, _)| k.starts_with("on the fly: not planned")),
         "{detail:?}"
     );
+    assert!(
+        plan.metrics.motion_note.is_some()
+            && doc.warnings.iter().any(|w| w
+                .message
+                .starts_with("on the fly: not planned: step-and-scan takes")),
+        "{:?}",
+        doc.warnings
+    );
     // on the fly could gain less than 2 %: the step plan is within that of the floor
     let floor = marking_floor_s(&doc.geometries, &doc.layers, &doc.profile);
     let job = job_s(&plan);

@@ -170,6 +170,10 @@ pub struct Metrics {
     pub motion: Option<MotionFigures>,
     /// Wall time per stage, s.
     pub solve_s: StageTimes,
+    /// Why a solve that may choose its motion planned only this one (none: it planned every
+    /// motion it allows, or was asked for one).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub motion_note: Option<String>,
 }
 
 /// What the values of a GA history measure: the plan's objective.

@@ -65,6 +65,11 @@ fn run_key(g: &Geometry) -> Option<(Run, &str, &str, u32)> {
         .map(|r| (r, g.source.element.as_str(), g.layer.as_str(), g.pass))
 }
 
+/// True when `next`, listed right after `prev`, is a member of the same run.
+pub fn continues_run(prev: &Geometry, next: &Geometry) -> bool {
+    next.run.is_some() && run_key(prev) == run_key(next)
+}
+
 impl Contraction {
     /// Chunks no wider or taller than `max_mm` (the field stage: a chunk must fit a field and
     /// leave the cover room to move). None when no chunk has two members.
@@ -105,15 +110,15 @@ impl Contraction {
         let mut spans: Vec<(usize, usize)> = Vec::new();
         let mut i = 0;
         while i < geometries.len() {
-            let Some(key) = run_key(&geometries[i]) else {
+            if geometries[i].run.is_none() {
                 spans.push((i, i + 1));
                 i += 1;
                 continue;
-            };
+            }
             join(None, i);
             let mut end = i + 1;
             while end < geometries.len()
-                && run_key(&geometries[end]) == Some(key)
+                && continues_run(&geometries[end - 1], &geometries[end])
                 && join(Some(end - 1), end)
             {
                 end += 1;

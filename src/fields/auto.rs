@@ -8,9 +8,12 @@ use crate::geom::{BBox, Pt};
 use crate::job::JobCtx;
 
 /// Feasible-centre rectangles of every geometry.
-pub fn feasible_rects(geometries: &[Geometry], profile: &MachineProfile) -> Vec<FRect> {
+pub fn feasible_rects<'a>(
+    geometries: impl IntoIterator<Item = &'a Geometry>,
+    profile: &MachineProfile,
+) -> Vec<FRect> {
     geometries
-        .iter()
+        .into_iter()
         .map(|g| {
             let (x, y) = center_range(&g.bbox(), profile);
             FRect { x, y }

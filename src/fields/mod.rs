@@ -109,14 +109,10 @@ pub fn place_fields(
         });
     };
     let fields = place_nodes(runs.nodes(), profile, settings, locked, ctx)?;
-    let representatives: Vec<Geometry> = runs
-        .representatives()
-        .into_iter()
-        .map(|g| geometries[g].clone())
-        .collect();
+    let representatives = runs.representatives().into_iter().map(|g| &geometries[g]);
     Ok(Placement {
         fields: runs.fields_to_geometries(fields),
-        lower_bound: cover::lower_bound(&auto::feasible_rects(&representatives, profile)),
+        lower_bound: cover::lower_bound(&auto::feasible_rects(representatives, profile)),
     })
 }
 

@@ -9,6 +9,7 @@
 //! Small geometries are not cut; the tiling avoids crossing them.
 
 use super::INSIDE_EPS_MM;
+use crate::document::runs::continues_run;
 use crate::document::{is_hatch_output, pen_of, Layer, Warning};
 use crate::document::{Geometry, Source};
 use crate::geom::seam::{cut_at_seams, SeamForm, SeamStats};
@@ -212,30 +213,33 @@ fn split_runs_at_cells(geometries: &mut [Geometry], tiling: &Tiling) {
         let at = |borders: &[f64], v: f64| borders.partition_point(|&b| b <= v);
         (at(&tiling.xs, c.x), at(&tiling.ys, c.y))
     };
-    // fresh ids above any a fill gives (a fill numbers its runs from 1 per region)
+    // fresh ids above any a fill gives (a fill numbers its runs from 1 per region); the new
+    // ids are found on the fill's own first, then set
     let mut next_id = u32::MAX / 2;
-    let mut last: Option<(crate::document::Run, (usize, usize), u32)> = None;
+    let mut ids: Vec<Option<u32>> = vec![None; geometries.len()];
+    let mut last_cell = (usize::MAX, usize::MAX);
     for k in 0..geometries.len() {
         let Some(run) = geometries[k].run else {
-            last = None;
             continue;
         };
         let here = cell(&geometries[k]);
-        let same_run = k > 0
-            && last.is_some_and(|(r, _, _)| r == run)
-            && geometries[k - 1].source.element == geometries[k].source.element
-            && geometries[k - 1].layer == geometries[k].layer
-            && geometries[k - 1].pass == geometries[k].pass;
-        let id = match last {
-            Some((_, c, id)) if same_run && c == here => id,
-            Some(_) if same_run => {
+        let id = match ids.get(k.wrapping_sub(1)).copied().flatten() {
+            Some(id) if continues_run(&geometries[k - 1], &geometries[k]) && here == last_cell => {
+                id
+            }
+            Some(_) if continues_run(&geometries[k - 1], &geometries[k]) => {
                 next_id = next_id.wrapping_add(1);
                 next_id
             }
             _ => run.id,
         };
-        last = Some((run, here, id));
-        geometries[k].run = Some(crate::document::Run { id, ..run });
+        ids[k] = Some(id);
+        last_cell = here;
+    }
+    for (g, id) in geometries.iter_mut().zip(ids) {
+        if let (Some(run), Some(id)) = (&mut g.run, id) {
+            run.id = id;
+        }
     }
 }
 

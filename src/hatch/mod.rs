@@ -200,7 +200,7 @@ pub fn hatch_contours(
     let mut runs = 0u32;
     let mut new_run = |order| {
         runs += 1;
-        Some(Run { id: runs, order })
+        Run { id: runs, order }
     };
     if settings.style == HatchStyle::Contour {
         ctx.check()?;
@@ -262,32 +262,22 @@ pub fn hatch_contours(
                 // each sweep's parts together, line by line; a sweep of two parts or more is
                 // one run
                 parts.sort_by_key(|p| p.sweep);
-                let mut k = 0;
-                while k < parts.len() {
-                    let end = k + parts[k..]
-                        .iter()
-                        .take_while(|p| p.sweep == parts[k].sweep)
-                        .count();
-                    let run = if end - k > 1 {
-                        new_run(RunOrder::Sweep)
-                    } else {
-                        None
-                    };
-                    for part in &mut parts[k..end] {
+                for sweep in parts.chunk_by_mut(|a, b| a.sweep == b.sweep) {
+                    let run = (sweep.len() > 1).then(|| new_run(RunOrder::Sweep));
+                    for part in sweep {
                         let points = std::mem::take(&mut part.points);
                         out.strokes.push(HatchStroke {
                             run,
                             ..stroke(StrokeKind::Zigzag, f as u8, 0, points, false)
                         });
                     }
-                    k = end;
                 }
             }
             if settings.border {
                 let mut loop_run = (u32::MAX, None);
                 for (loop_id, pts, closed) in boundary.unused_by_loop() {
                     if loop_run.0 != loop_id {
-                        loop_run = (loop_id, new_run(RunOrder::Loop));
+                        loop_run = (loop_id, Some(new_run(RunOrder::Loop)));
                     }
                     out.strokes.push(HatchStroke {
                         run: if closed { None } else { loop_run.1 },

@@ -59,6 +59,7 @@ pub fn compute(
         job_time_breakdown_s: Some(toolpath.breakdown()),
         motion: Some(motion),
         solve_s: Default::default(),
+        motion_note: None,
     }
 }
 

@@ -70,6 +70,7 @@ pub fn order_plan(
     let t0 = std::time::Instant::now();
     let mut detail = Vec::new();
     let mut best: Option<Made> = None;
+    let mut motion_note = None;
     // HGA under auto: the motion is chosen on finished HHA plans, the GA then runs in it alone
     let hga_after = settings.algo == Algo::Hga && motions.len() > 1;
     for &motion in motions {
@@ -78,8 +79,10 @@ pub fn order_plan(
             break;
         }
         if let (Motion::OnTheFly, Some(step)) = (motion, &best) {
-            if let Some(skip) = flying_cannot_gain(&nodes, inputs, step.toolpath.duration_s()) {
-                detail.push(skip);
+            let t = std::time::Instant::now();
+            if let Some(note) = flying_cannot_gain(&nodes, inputs, step.toolpath.duration_s()) {
+                detail.push((FLY_NOT_PLANNED.into(), t.elapsed().as_secs_f64()));
+                motion_note = Some(note);
                 continue;
             }
         }
@@ -139,6 +142,7 @@ pub fn order_plan(
     m.solve_s.order = order_s;
     m.solve_s.order_detail = detail;
     plan.name = settings.plan_title_as(best.motion);
+    m.motion_note = motion_note;
     plan.metrics = m;
     plan.history = best.history;
     Ok((plan, best.toolpath))
@@ -155,10 +159,13 @@ pub const FLY_SKIP_STROKES_MIN: usize = 20_000;
 /// twice: by fields and by bands; BENCHMARKS, issue 24), for at most this much.
 pub const FLY_GAIN_MIN: f64 = 0.02;
 
-/// Some((the order detail's entry, s)) when on the fly is not worth planning after a step-and-
-/// scan plan of `step_s` on a large job: it could gain less than [`FLY_GAIN_MIN`] of it.
-fn flying_cannot_gain(nodes: &Nodes, inputs: &PlanInputs, step_s: f64) -> Option<(String, f64)> {
-    let t = std::time::Instant::now();
+/// How the order stage's detail and the plan's motion note ([`crate::document::Metrics::motion_note`]) begin
+/// when on the fly was not planned.
+pub const FLY_NOT_PLANNED: &str = "on the fly: not planned";
+
+/// The plan's motion note when on the fly is not worth planning after a step-and-scan plan of
+/// `step_s` on a large job: it could gain less than [`FLY_GAIN_MIN`] of it.
+fn flying_cannot_gain(nodes: &Nodes, inputs: &PlanInputs, step_s: f64) -> Option<String> {
     let strokes: usize = nodes
         .geometries
         .iter()
@@ -169,9 +176,10 @@ fn flying_cannot_gain(nodes: &Nodes, inputs: &PlanInputs, step_s: f64) -> Option
     }
     let floor_s = objective::marking_floor_s(nodes.geometries, &inputs.layers, &inputs.profile);
     (step_s - floor_s < FLY_GAIN_MIN * step_s).then(|| {
-        let label =
-            format!("on the fly: not planned (step-and-scan {step_s:.1} s, floor {floor_s:.1} s)");
-        (label, t.elapsed().as_secs_f64())
+        format!(
+            "{FLY_NOT_PLANNED}: step-and-scan takes {step_s:.3} s, within {:.0} % of the {floor_s:.3} s that marking and the laser's and jumps' delays take in any motion, so on the fly could gain less than that ({strokes} strokes)",
+            FLY_GAIN_MIN * 100.0
+        )
     })
 }
 
