@@ -11,6 +11,8 @@
 #   zoom   wheel in and out over the canvas centre, ZOOM_CYCLES x (ZOOM_STEPS in, ZOOM_STEPS out)
 #   pan    middle-button drag in circles over the canvas (the middle button always pans)
 #   solve  "Run HHA", then the pointer keeps moving over the canvas; frames with solving=1 counted
+#   after  the solve over and the plan shown, nothing happens (no frames expected)
+#   play   "Play": the playback draws the job for PLAY_S s, the pointer still
 # With PROFILE, the profile is loaded through the GUI (Machine profile > Load TOML… > path
 # field) and the fields re-placed ("Re-place automatically") before the phases.
 #
@@ -18,8 +20,9 @@
 #   DISPLAY_NUM  X display to use (default 98; an Xvfb is started on it when none answers)
 #   OUT          folder for the frame log and screenshots (default: a temporary folder, removed)
 #   SHOTS=1      take screenshots into OUT: after loading (fit) and zoomed in ZOOM_SHOT wheel steps
-#                (before the phases), and the same once the solve is over (solved, solved-zoomed)
-#   IDLE_S ZOOM_CYCLES ZOOM_STEPS PAN_S SOLVE_S   phase lengths (defaults below)
+#                (before the phases), at the end of the playback (played), and once the solve is
+#                over (solved, solved-zoomed)
+#   IDLE_S ZOOM_CYCLES ZOOM_STEPS PAN_S SOLVE_S PLAY_S   phase lengths (defaults below)
 #   LOAD_MAX_S   longest wait for the file (or the re-placement) to finish (default 300)
 # The click positions assume the default 1500 x 950 window on a 1500 x 950 screen with egui's
 # default scale; override BTN_* / CANVAS_* if the layout changes (take a screenshot to check).
@@ -41,6 +44,7 @@ ZOOM_STEPS=${ZOOM_STEPS:-6}
 ZOOM_SHOT=${ZOOM_SHOT:-5}
 PAN_S=${PAN_S:-6}
 SOLVE_S=${SOLVE_S:-30}
+PLAY_S=${PLAY_S:-10}
 LOAD_MAX_S=${LOAD_MAX_S:-300}
 # screen positions (px) in the default layout
 CANVAS_X=${CANVAS_X:-809}          # centre of the work-area canvas
@@ -51,6 +55,8 @@ BTN_LOAD_TOML=${BTN_LOAD_TOML:-"55 163"}       # profile section: "Load TOML…"
 PATH_FIELD=${PATH_FIELD:-"743 494"}            # the path field of the "Load a machine profile" window
 BTN_REPLACE=${BTN_REPLACE:-"617 37"}           # toolbar: "Re-place automatically"
 BTN_RUN_HHA=${BTN_RUN_HHA:-"746 37"}           # toolbar: "Run HHA"
+BTN_PLAY=${BTN_PLAY:-"472 68"}                 # playback strip: "Play" (then "Pause")
+BTN_REWIND=${BTN_REWIND:-"407 68"}             # playback strip: "Rewind"
 AWAY=${AWAY:-"1300 700"}                       # off the canvas (right panel), for screenshots
 
 KEEP_OUT=${OUT:+1}
@@ -217,8 +223,25 @@ sleep 0.5
 circle "$SOLVE_S" 150
 ENDS+=("$(lines)")                # no settling: a running solve repaints continuously
 alive
-if [ -n "${SHOTS:-}" ]; then        # the plan, once the solve is over (at most LOAD_MAX_S)
-  for _ in $(seq 1 "$LOAD_MAX_S"); do [ "$(tail -n 1 "$LOG" | cut -d' ' -f3)" = 0 ] && break; sleep 1; done
+# the plan, once the solve is over (at most LOAD_MAX_S)
+for _ in $(seq 1 "$LOAD_MAX_S"); do [ "$(tail -n 1 "$LOG" | cut -d' ' -f3)" = 0 ] && break; sleep 1; done
+fit_view
+xdotool mousemove $AWAY
+settle
+phase_begin after                  # the plan shown, nothing happens: no frames expected
+sleep "$IDLE_S"
+phase_end
+
+xdotool mousemove $BTN_PLAY
+settle
+phase_begin play                   # the playback repaints every frame, the pointer still
+xdotool click 1
+sleep "$PLAY_S"
+ENDS+=("$(lines)")
+shot played
+xdotool mousemove $BTN_PLAY; settle; xdotool click 1; settle   # pause
+if [ -n "${SHOTS:-}" ]; then
+  click_at "$BTN_REWIND"
   fit_view
   shot solved
   xdotool click --repeat "$ZOOM_SHOT" --delay 100 4

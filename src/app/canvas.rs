@@ -2,10 +2,11 @@
 //! Drawing is in `super::paint`; the canvas never changes the document, it returns
 //! [`CanvasAction`]s that the app turns into commands.
 
+use super::hit::HitIndex;
 use super::paint;
 use super::toolpaths::Lowered;
 use crate::document::{Geometry, MachineProfile, Plan, ScanField};
-use crate::geom::{point_segment_dist, BBox, Pt};
+use crate::geom::{BBox, Pt};
 use egui::{Color32, PointerButton, Pos2, Rect, Sense, Vec2};
 use serde::{Deserialize, Serialize};
 
@@ -189,6 +190,9 @@ pub struct Canvas<'a> {
     pub stale: &'a [String],
     /// Playback time: the machine is drawn at this job time (`None`: the planned path only).
     pub playback_t_s: Option<f64>,
+    /// Changes whenever the artwork, its colours or coverage change: the canvas keeps a raster
+    /// of what it draws while this (and what it compares by value) stays the same.
+    pub revision: u64,
 }
 
 /// Screen distance within which the pointer "hovers" a geometry, px.
@@ -238,7 +242,6 @@ impl Canvas<'_> {
         let label = self.label.to_string();
         response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Canvas, true, &label));
         let mut actions = Vec::new();
-        let (lo, hi) = self.content_bounds();
         if let Some(old) = state.rect {
             // keep the content anchored to the centre when the canvas is resized
             state.view.offset += (rect.size() - old.size()) / 2.0;
@@ -250,6 +253,7 @@ impl Canvas<'_> {
                 rect.min + Vec2::Y * caption_px.min(rect.height() * 0.5),
                 rect.max,
             );
+            let (lo, hi) = self.content_bounds();
             state.view.fit(below_caption, lo, hi);
             state.view.offset += below_caption.min - rect.min;
             state.fit_requested = false;
@@ -257,7 +261,7 @@ impl Canvas<'_> {
         state.rect = Some(rect);
         self.interact(ui, &response, rect, state, &mut actions);
         let painter = ui.painter_at(rect);
-        paint::paint(&painter, self, &state.view, rect);
+        paint::paint(&painter, self, &state.view, rect, response.id);
         if let Drag::Seam { axis, at_mm, .. } = state.drag {
             // the seam being moved, across the work area
             let (lo, hi) = Canvas::reach(self.profile);
@@ -433,32 +437,33 @@ impl Canvas<'_> {
             .min_by(|a, b| p.dist2(a.center).total_cmp(&p.dist2(b.center)))
     }
 
-    /// The geometry nearest to `p` within `tol_mm`.
-    pub fn geometry_at(&self, p: Pt, tol_mm: f64) -> Option<usize> {
-        let mut best: Option<(f64, usize)> = None;
-        for (k, g) in self.geometries.iter().enumerate() {
-            let b = g.bbox();
-            if p.x < b.min_x - tol_mm
-                || p.x > b.max_x + tol_mm
-                || p.y < b.min_y - tol_mm
-                || p.y > b.max_y + tol_mm
-            {
-                continue;
+    /// The geometry nearest to `p` within `tol_mm`, found through a grid over the geometries
+    /// kept in `ctx`'s memory under `id` while the artwork stays the same.
+    pub fn geometry_at(
+        &self,
+        ctx: &egui::Context,
+        id: egui::Id,
+        p: Pt,
+        tol_mm: f64,
+    ) -> Option<usize> {
+        type Kept = (usize, usize, u64, std::sync::Arc<HitIndex>);
+        let id = id.with("hit index");
+        let key = (
+            self.geometries.as_ptr() as usize,
+            self.geometries.len(),
+            self.revision,
+        );
+        let kept: Option<Kept> = ctx.data(|d| d.get_temp(id));
+        let index = match kept {
+            Some((ptr, len, rev, index)) if (ptr, len, rev) == key => index,
+            _ => {
+                let index = std::sync::Arc::new(HitIndex::new(self.geometries));
+                let kept: Kept = (key.0, key.1, key.2, std::sync::Arc::clone(&index));
+                ctx.data_mut(|d| d.insert_temp(id, kept));
+                index
             }
-            let n = g.points.len();
-            let segs = if g.closed { n } else { n.saturating_sub(1) };
-            let d = if n == 1 {
-                p.dist(g.points[0])
-            } else {
-                (0..segs)
-                    .map(|i| point_segment_dist(p, g.points[i], g.points[(i + 1) % n]))
-                    .fold(f64::INFINITY, f64::min)
-            };
-            if d <= tol_mm && best.is_none_or(|(bd, _)| d < bd) {
-                best = Some((d, k));
-            }
-        }
-        best.map(|b| b.1)
+        };
+        index.nearest(self.geometries, p, tol_mm)
     }
 
     fn hover_info(&self, response: egui::Response, rect: Rect, view: &View) -> egui::Response {
@@ -467,7 +472,7 @@ impl Canvas<'_> {
         };
         let p = view.to_mm(rect, pos);
         let tol = f64::from(HOVER_PX / view.scale.max(1e-6));
-        let geometry = self.geometry_at(p, tol);
+        let geometry = self.geometry_at(&response.ctx, response.id, p, tol);
         let field = self.field_at(p).filter(|_| self.layers.fields);
         let mut lines = vec![format!("x {:.2} mm, y {:.2} mm", p.x, p.y)];
         if let Some(k) = geometry {

@@ -567,6 +567,7 @@ pub fn show(
     toolpaths: &ToolpathCache,
     stale: &[Vec<String>],
     layers: Layers,
+    revision: u64,
 ) {
     let stale_of = |k: usize| stale.get(k).map_or(&[][..], Vec::as_slice);
     st.fix(doc.plans.len());
@@ -610,6 +611,7 @@ pub fn show(
         layers,
         stale: stale_of(k),
         playback_t_s,
+        revision,
     };
     // the metrics table's height (20 rows), or less on a small window (it scrolls then)
     let bottom = 460.0_f32.min(ui.available_height() * 0.45);

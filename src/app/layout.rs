@@ -44,6 +44,7 @@ impl App {
             Tab::Workbench => self.workbench_view(ui),
             Tab::Compare => {
                 if self.has_document() {
+                    let revision = self.canvas_revision();
                     compare::show(
                         ui,
                         &mut self.view.compare,
@@ -51,6 +52,7 @@ impl App {
                         &self.session.toolpaths,
                         &self.session.stale,
                         self.view.layers,
+                        revision,
                     );
                 } else {
                     ui.label("Open a document first.");
@@ -713,6 +715,7 @@ impl App {
             layers: self.view.layers,
             stale: &stale,
             playback_t_s,
+            revision: self.canvas_revision(),
         };
         let motion = lowered.and_then(Result::ok).and_then(|l| l.motion.as_ref());
         let header_px = 2.0 * ui.spacing().interact_size.y;

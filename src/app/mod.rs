@@ -17,6 +17,7 @@ pub mod canvas;
 pub mod commands;
 pub mod compare;
 pub mod files;
+mod hit;
 pub mod jobs;
 pub mod layers;
 mod layout;
@@ -25,6 +26,7 @@ mod paint;
 pub mod panels;
 pub mod playback;
 mod prompts;
+mod raster;
 pub mod session;
 pub mod toolpaths;
 
@@ -217,6 +219,9 @@ struct ViewState {
     imports: u64,
     /// Each geometry's layer colour.
     colours: Vec<egui::Color32>,
+    /// Counts refreshes of what the canvases draw (with the session's revision: the canvases'
+    /// raster caches are redrawn when it changes).
+    canvas_revision: u64,
     /// The folder last exported to, per kind of export.
     export_dirs: files::ExportDirs,
     /// DejaVu Sans is installed as the fallback font (arrows, symbols, layer names in other
@@ -281,6 +286,7 @@ impl App {
                 quit_confirmed: false,
                 imports: 0,
                 colours: Vec::new(),
+                canvas_revision: 0,
                 export_dirs: prefs.export_dirs,
                 fonts_installed: false,
             },
@@ -661,6 +667,12 @@ impl App {
         self.refresh_view();
     }
 
+    /// What the canvases' raster caches are keyed by besides what they compare by value: the
+    /// document's revision and the view's refreshes.
+    fn canvas_revision(&self) -> u64 {
+        self.session.revision ^ self.view.canvas_revision.rotate_left(32)
+    }
+
     /// Recomputes what derives from the document after a change.
     fn refresh(&mut self) {
         self.session.refresh();
@@ -669,6 +681,7 @@ impl App {
 
     /// The view's part of a refresh (the session's is done): layer colours, the selection.
     fn refresh_view(&mut self) {
+        self.view.canvas_revision += 1;
         let doc = &self.session.doc;
         let rgb: std::collections::HashMap<&str, egui::Color32> = doc
             .layers

@@ -105,8 +105,46 @@ fn lerp(a: Color32, b: Color32, t: f32) -> Color32 {
     Color32::from_rgb(m(a.r(), b.r()), m(a.g(), b.g()), m(a.b(), b.b()))
 }
 
-/// Paints the canvas content into `rect`.
-pub fn paint(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
+/// Paints the canvas content into `rect`: the background, the heavy layers (from their raster
+/// when there is one, see [`super::raster`]), then what is drawn over them every frame (field
+/// labels, start and end markers, the playback, the caption and the scale bar).
+pub fn paint(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect, id: egui::Id) {
+    paint_background(painter, c, view, rect);
+    super::raster::paint(
+        painter.ctx(),
+        painter,
+        id,
+        content_key(c),
+        (view.scale, view.offset),
+        rect,
+        &|clip| heavy_shapes(c, view, rect, clip),
+    );
+    if c.layers.fields {
+        paint_field_labels(painter, c, view, rect);
+    }
+    if c.layers.path {
+        for path in &c.paths {
+            if let Ok(lowered) = path.lowered {
+                paint_markers(painter, lowered, view, rect);
+            }
+        }
+    }
+    if let Some(t_s) = c.playback_t_s {
+        let overlaid = c.paths.len() > 1;
+        for (k, path) in c.paths.iter().enumerate() {
+            if let Ok(l) = path.lowered {
+                let done = overlaid.then_some(path.colour);
+                let field_mm = c.profile.field_mm;
+                playback::paint(painter, id.with(k), l, t_s, field_mm, done, view, rect);
+            }
+        }
+    }
+    paint_caption(painter, c, rect);
+    paint_scale_bar(painter, view, rect);
+}
+
+/// The work area: the laser's reach and the base stroke (dashed, named).
+fn paint_background(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
     painter.rect_filled(rect, 0.0, Color32::from_gray(252));
     let s = |q: Pt| view.to_screen(rect, q);
     let (lo, hi) = Canvas::reach(c.profile);
@@ -139,10 +177,70 @@ pub fn paint(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
         FontId::proportional(11.0),
         Color32::from_gray(120),
     );
-    if c.layers.fields {
-        paint_fields(painter, c, view, rect);
+}
+
+/// A fingerprint of everything [`heavy_shapes`] draws but the view: a raster is shown only for
+/// the content it was drawn from. Slices too large to hash every frame (geometries, their
+/// colours, coverage) count by identity and length, with the canvas's `revision`, which
+/// changes with them; fields, seams, layers and paths by value.
+fn content_key(c: &Canvas<'_>) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut h = rustc_hash::FxHasher::default();
+    c.revision.hash(&mut h);
+    let slice = |h: &mut rustc_hash::FxHasher, ptr: usize, len: usize| {
+        ptr.hash(h);
+        len.hash(h);
+    };
+    slice(&mut h, c.geometries.as_ptr() as usize, c.geometries.len());
+    if let Some(colours) = c.colours {
+        slice(&mut h, colours.as_ptr() as usize, colours.len());
     }
-    paint_artwork(painter, c, view, rect);
+    slice(&mut h, c.uncovered.as_ptr() as usize, c.uncovered.len());
+    slice(
+        &mut h,
+        c.out_of_reach.as_ptr() as usize,
+        c.out_of_reach.len(),
+    );
+    for f in c.fields {
+        (f.id, f.locked, f.geometries.len()).hash(&mut h);
+        [f.center.x, f.center.y, f.size[0], f.size[1]]
+            .map(f64::to_bits)
+            .hash(&mut h);
+    }
+    for line in c.seams {
+        (line.axis, line.at_mm.to_bits()).hash(&mut h);
+        for span in &line.spans {
+            span.map(f64::to_bits).hash(&mut h);
+        }
+    }
+    c.tiling
+        .map(|t| {
+            let e = t.extent();
+            [e.min_x, e.min_y, e.max_x, e.max_y].map(f64::to_bits)
+        })
+        .hash(&mut h);
+    let l = c.layers;
+    [l.fields, l.path, l.arrows, l.base_path, l.order_colours].hash(&mut h);
+    c.selected.hash(&mut h);
+    (c.stale.is_empty(), c.playback_t_s.is_some()).hash(&mut h);
+    for p in &c.paths {
+        p.colour.to_array().hash(&mut h);
+        match p.lowered {
+            Ok(l) => (std::ptr::from_ref(l) as usize, l.toolpath.strokes.len()).hash(&mut h),
+            Err(why) => why.hash(&mut h),
+        }
+    }
+    h.finish()
+}
+
+/// The heavy layers as shapes for `view` over the canvas `rect`, left out where wholly outside
+/// `clip` (screen): fields, artwork, the stage's path or route, idle moves and seams.
+pub(super) fn heavy_shapes(c: &Canvas<'_>, view: &View, rect: Rect, clip: Rect) -> Vec<Shape> {
+    let mut shapes = Vec::new();
+    if c.layers.fields {
+        field_shapes(&mut shapes, c, view, rect, clip);
+    }
+    artwork_shapes(&mut shapes, c, view, rect, clip);
     // during a playback the planned path steps back behind the machine
     let path_fade = if c.playback_t_s.is_some() { 0.35 } else { 1.0 };
     for (k, path) in c.paths.iter().enumerate() {
@@ -153,61 +251,87 @@ pub fn paint(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
             } else {
                 path.colour
             };
-            paint_route(painter, lowered, view, rect, col.gamma_multiply(path_fade));
+            route_shapes(
+                &mut shapes,
+                lowered,
+                view,
+                rect,
+                col.gamma_multiply(path_fade),
+            );
         } else if c.layers.base_path && k == 0 {
-            paint_base_path(painter, lowered, view, rect, path_fade);
+            base_path_shapes(&mut shapes, lowered, view, rect, path_fade);
         }
         if c.layers.path {
-            paint_path(painter, c, path, lowered, view, rect);
+            idle_move_shapes(&mut shapes, c, path, lowered, view, rect, clip);
         }
     }
     // seams over the planned paths: an idle move along a seam must not hide it
     if c.layers.fields {
-        paint_seams(painter, c, view, rect);
+        seam_shapes(&mut shapes, c, view, rect);
     }
-    if let Some(t_s) = c.playback_t_s {
-        let s = |q: Pt| view.to_screen(rect, q);
-        let overlaid = c.paths.len() > 1;
-        for path in &c.paths {
-            if let Ok(l) = path.lowered {
-                let done = overlaid.then_some(path.colour);
-                playback::paint(painter, l, t_s, c.profile.field_mm, done, &s, rect);
-            }
-        }
-    }
-    paint_caption(painter, c, rect);
-    paint_scale_bar(painter, view, rect);
+    shapes
 }
 
-fn paint_fields(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
+/// A field's rectangle on screen, none when wholly outside `clip`.
+fn field_on_screen(
+    f: &crate::document::ScanField,
+    view: &View,
+    rect: Rect,
+    clip: Rect,
+) -> Option<Rect> {
     let s = |q: Pt| view.to_screen(rect, q);
+    let b = f.bbox();
+    let r = Rect::from_two_pos(s(Pt::new(b.min_x, b.min_y)), s(Pt::new(b.max_x, b.max_y)));
+    r.expand(CULL_MARGIN_PX).intersects(clip).then_some(r)
+}
+
+/// The outline of field `f`: the selected one thick and amber, locked ones thicker.
+fn field_stroke(c: &Canvas<'_>, f: &crate::document::ScanField) -> Stroke {
+    if c.selected == Some(f.id) {
+        Stroke::new(2.5, colour::SELECTED)
+    } else {
+        Stroke::new(
+            if f.locked { 2.0 } else { 1.0 },
+            colour::FIELD.gamma_multiply(0.8),
+        )
+    }
+}
+
+fn field_shapes(shapes: &mut Vec<Shape>, c: &Canvas<'_>, view: &View, rect: Rect, clip: Rect) {
     let fill = Color32::from_rgba_unmultiplied(79, 70, 229, 16);
-    let on_screen = |f: &crate::document::ScanField| {
-        let b = f.bbox();
-        let r = Rect::from_two_pos(s(Pt::new(b.min_x, b.min_y)), s(Pt::new(b.max_x, b.max_y)));
-        r.expand(CULL_MARGIN_PX).intersects(rect).then_some(r)
-    };
     for f in c.fields {
-        if let Some(r) = on_screen(f) {
-            painter.rect_filled(r, 0.0, fill);
+        if let Some(r) = field_on_screen(f, view, rect, clip) {
+            shapes.push(Shape::rect_filled(r, 0.0, fill));
         }
     }
-    let numbers = super::field_numbers(c.fields, c.visiting);
     for f in c.fields {
-        let Some(r) = on_screen(f) else {
+        if let Some(r) = field_on_screen(f, view, rect, clip) {
+            let stroke = field_stroke(c, f);
+            shapes.push(Shape::rect_stroke(r, 0.0, stroke, StrokeKind::Middle));
+            shapes.push(Shape::circle_filled(
+                view.to_screen(rect, f.center),
+                2.0,
+                stroke.color,
+            ));
+        }
+    }
+}
+
+/// Field numbers (and "locked"), where legible: over the artwork, every frame.
+fn paint_field_labels(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
+    let mut numbers = None;
+    for f in c.fields {
+        let Some(r) = field_on_screen(f, view, rect, rect) else {
             continue;
         };
         let selected = c.selected == Some(f.id);
-        let stroke = if selected {
-            Stroke::new(2.5, colour::SELECTED)
-        } else {
-            Stroke::new(
-                if f.locked { 2.0 } else { 1.0 },
-                colour::FIELD.gamma_multiply(0.8),
-            )
-        };
-        painter.rect_stroke(r, 0.0, stroke, StrokeKind::Middle);
-        painter.circle_filled(s(f.center), 2.0, stroke.color);
+        // a label only where it is legible: the field wider than it and tall enough (judged
+        // for a one-digit label first, before the numbers are counted)
+        let est_w = |chars: usize| chars as f32 * LABEL_CHAR_PX + 6.0;
+        if !selected && (r.height() < LABEL_MIN_H_PX || r.width() < est_w(1) * 1.5) {
+            continue;
+        }
+        let numbers = numbers.get_or_insert_with(|| super::field_numbers(c.fields, c.visiting));
         let number = numbers.get(&f.id).copied().unwrap_or_default();
         // a scan field shows its number; a region larger than the scan field says so
         let name = match super::field_word(f, c.profile) {
@@ -219,13 +343,10 @@ fn paint_fields(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
         } else {
             name
         };
-        // a label only where it is legible: the field wider than it and tall enough
-        let font = FontId::proportional(13.0);
-        let est_w = text.chars().count() as f32 * LABEL_CHAR_PX + 6.0;
-        if !selected && (r.height() < LABEL_MIN_H_PX || r.width() < est_w * 1.5) {
+        if !selected && r.width() < est_w(text.chars().count()) * 1.5 {
             continue;
         }
-        let galley = painter.layout_no_wrap(text, font, Color32::WHITE);
+        let galley = painter.layout_no_wrap(text, FontId::proportional(13.0), Color32::WHITE);
         let at = r.min + Vec2::new(3.0, 3.0);
         let bg = Rect::from_min_size(at, galley.size() + Vec2::new(6.0, 2.0));
         painter.rect_filled(
@@ -243,7 +364,7 @@ fn paint_fields(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
 
 /// The seams: a thin line across the tiling's extent, solid and thick through marked area
 /// (unlike the dashed idle moves).
-fn paint_seams(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
+fn seam_shapes(shapes: &mut Vec<Shape>, c: &Canvas<'_>, view: &View, rect: Rect) {
     let Some(extent) = c.tiling.map(crate::geom::tiling::Tiling::extent) else {
         return;
     };
@@ -261,21 +382,21 @@ fn paint_seams(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
         } else {
             (extent.min_x, extent.max_x)
         };
-        painter.line_segment(
+        shapes.push(Shape::line_segment(
             [at(line.axis, line.at_mm, lo), at(line.axis, line.at_mm, hi)],
             Stroke::new(1.0, colour::SEAM.gamma_multiply(0.6)),
-        );
+        ));
         for span in &line.spans {
             let (a, b) = (
                 at(line.axis, line.at_mm, span[0]),
                 at(line.axis, line.at_mm, span[1]),
             );
-            painter.line_segment([a, b], Stroke::new(2.5, colour::SEAM));
+            shapes.push(Shape::line_segment([a, b], Stroke::new(2.5, colour::SEAM)));
         }
     }
 }
 
-fn paint_artwork(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
+fn artwork_shapes(shapes: &mut Vec<Shape>, c: &Canvas<'_>, view: &View, rect: Rect, clip: Rect) {
     let s = |q: Pt| view.to_screen(rect, q);
     // marks coloured by their position in the first plan's toolpath (ranked once, when lowered)
     let rank: Option<&[f32]> = c
@@ -286,7 +407,7 @@ fn paint_artwork(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
         .map(|l| l.rank_by_geometry.as_slice());
     // during a playback the artwork is faded: the marks done are drawn over it
     let fade = if c.playback_t_s.is_some() { 0.3 } else { 1.0 };
-    let mut shapes = Vec::with_capacity(c.geometries.len() + c.uncovered.len());
+    shapes.reserve(c.geometries.len() + c.uncovered.len());
     // not covered yet: a translucent magenta halo under the geometry, which keeps its colour
     // (no layer colour can be mistaken for it: no geometry is drawn with a halo otherwise)
     let halo = Stroke::new(
@@ -297,7 +418,7 @@ fn paint_artwork(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
         let Some(g) = c.geometries.get(k) else {
             continue;
         };
-        let Some(pts) = screen_line(&g.points, g.closed, &s, rect) else {
+        let Some(pts) = screen_line(&g.points, g.closed, &s, clip) else {
             continue;
         };
         if pts.len() == 1 {
@@ -325,7 +446,7 @@ fn paint_artwork(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
             _ => base,
         }
         .gamma_multiply(fade);
-        let Some(pts) = screen_line(&g.points, g.closed, &s, rect) else {
+        let Some(pts) = screen_line(&g.points, g.closed, &s, clip) else {
             continue;
         };
         let (a, z) = (pts[0], pts[pts.len() - 1]);
@@ -342,18 +463,17 @@ fn paint_artwork(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
     }
     for &k in c.out_of_reach {
         if let Some(pts) =
-            (c.geometries.get(k)).and_then(|g| screen_line(&g.points, g.closed, &s, rect))
+            (c.geometries.get(k)).and_then(|g| screen_line(&g.points, g.closed, &s, clip))
         {
             // no field can hold it: dashed purple, apart from the halo of "not covered yet"
             let stroke = Stroke::new(3.0, colour::OUT_OF_REACH);
             shapes.extend(Shape::dashed_line(&pts, stroke, 6.0, 4.0));
         }
     }
-    painter.extend(shapes);
 }
 
 /// The stage path: the stage positions of the strokes in marking order.
-fn paint_base_path(painter: &Painter, l: &Lowered, view: &View, rect: Rect, fade: f32) {
+fn base_path_shapes(shapes: &mut Vec<Shape>, l: &Lowered, view: &View, rect: Rect, fade: f32) {
     let mut pts: Vec<Pos2> = Vec::new();
     let mut last: Option<Pt> = None;
     for st in &l.toolpath.strokes {
@@ -363,7 +483,7 @@ fn paint_base_path(painter: &Painter, l: &Lowered, view: &View, rect: Rect, fade
         }
     }
     if pts.len() > 1 {
-        painter.extend(Shape::dashed_line(
+        shapes.extend(Shape::dashed_line(
             &pts,
             Stroke::new(2.0, colour::FIELD.gamma_multiply(0.6 * fade)),
             2.0,
@@ -373,25 +493,26 @@ fn paint_base_path(painter: &Painter, l: &Lowered, view: &View, rect: Rect, fade
 }
 
 /// The stage route of an on-the-fly job: a solid line through the sampled stage positions.
-fn paint_route(painter: &Painter, l: &Lowered, view: &View, rect: Rect, col: Color32) {
+fn route_shapes(shapes: &mut Vec<Shape>, l: &Lowered, view: &View, rect: Rect, col: Color32) {
     let pts: Vec<Pos2> = l
         .route_mm
         .iter()
         .map(|&p| view.to_screen(rect, p))
         .collect();
     if pts.len() > 1 {
-        painter.add(Shape::line(pts, Stroke::new(2.5, col.gamma_multiply(0.8))));
+        shapes.push(Shape::line(pts, Stroke::new(2.5, col.gamma_multiply(0.8))));
     }
 }
 
-/// Idle moves between consecutive strokes (dashed, with arrows), start `S` and end `E`.
-fn paint_path(
-    painter: &Painter,
+/// Idle moves between consecutive strokes (dashed, with arrows).
+fn idle_move_shapes(
+    shapes: &mut Vec<Shape>,
     c: &Canvas<'_>,
     path: &PathLayer<'_>,
     l: &Lowered,
     view: &View,
     rect: Rect,
+    clip: Rect,
 ) {
     let s = |q: Pt| view.to_screen(rect, q);
     let col = if !c.stale.is_empty() {
@@ -409,7 +530,6 @@ fn paint_path(
         let p = tp.stroke_points(k);
         p.first().copied().zip(p.last().copied())
     };
-    let mut shapes = Vec::new();
     for k in 1..tp.strokes.len() {
         let (Some((_, z)), Some((a, _))) = (ends(k - 1), ends(k)) else {
             continue;
@@ -417,14 +537,23 @@ fn paint_path(
         let (p0, p1) = (s(z), s(a));
         if Rect::from_two_pos(p0, p1)
             .expand(CULL_MARGIN_PX)
-            .intersects(rect)
+            .intersects(clip)
         {
-            idle_move(&mut shapes, p0, p1, col, c.layers.arrows);
+            idle_move(shapes, p0, p1, col, c.layers.arrows);
         }
     }
-    painter.extend(shapes);
+}
+
+/// The start `S` and end `E` of a planned path.
+fn paint_markers(painter: &Painter, l: &Lowered, view: &View, rect: Rect) {
+    let tp = &l.toolpath;
+    let ends = |k: usize| {
+        let p = tp.stroke_points(k);
+        p.first().copied().zip(p.last().copied())
+    };
     let n = tp.strokes.len();
     if let (Some((start, _)), Some((_, end))) = (ends(0), n.checked_sub(1).and_then(ends)) {
+        let s = |q: Pt| view.to_screen(rect, q);
         start_end_markers(painter, s(start), s(end));
     }
 }
@@ -677,4 +806,72 @@ fn paint_scale_bar(painter: &Painter, view: &View, rect: Rect) {
         FontId::proportional(11.0),
         Color32::from_gray(60),
     );
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used, clippy::expect_used)]
+    use super::*;
+    use crate::job::JobCtx;
+    use crate::pipeline::order_document_lowered;
+    use std::sync::atomic::AtomicBool;
+
+    /// Every shape of the heavy layers (fields, halos, out-of-reach dashes, artwork, stage
+    /// path, idle moves with arrows) has a raster form, and the raster of the demo's plan
+    /// covers the canvas where the artwork is.
+    #[test]
+    fn heavy_layers_rasterise_whole() {
+        let doc = super::super::session::tests::demo().doc;
+        let (plan, toolpath) = order_document_lowered(&doc, &JobCtx::default()).unwrap();
+        let lowered = Lowered::new(toolpath);
+        let canvas = Canvas {
+            label: "test",
+            geometries: &doc.geometries,
+            profile: &doc.profile,
+            fields: &doc.fields,
+            seams: &[],
+            tiling: None,
+            cell_max_mm: [0.0; 2],
+            visiting: None,
+            colours: None,
+            out_of_reach: &[1],
+            paths: vec![PathLayer {
+                plan: &plan,
+                lowered: Ok(&lowered),
+                colour: colour::PATH_A,
+            }],
+            uncovered: &[0, 1],
+            selected: doc.fields.first().map(|f| f.id),
+            editable: true,
+            add_tool: false,
+            layers: Default::default(),
+            stale: &[],
+            playback_t_s: None,
+            revision: 0,
+        };
+        let rect = Rect::from_min_size(Pos2::new(10.0, 20.0), Vec2::new(400.0, 300.0));
+        let mut view = View::default();
+        view.fit(rect, Pt::new(0.0, 0.0), Pt::new(300.0, 300.0));
+        let shapes = heavy_shapes(&canvas, &view, rect, rect);
+        assert!(shapes.len() > doc.geometries.len());
+        assert!(super::super::raster::supported(&shapes));
+        let mut pixmap = tiny_skia::Pixmap::new(400, 300).unwrap();
+        super::super::raster::rasterise(
+            &shapes,
+            rect.min,
+            1.0,
+            &mut pixmap,
+            &AtomicBool::new(false),
+        )
+        .unwrap();
+        let painted = pixmap.pixels().iter().filter(|p| p.alpha() > 0).count();
+        assert!(painted > 1000, "{painted} pixels painted");
+        // the content key follows what is drawn, not the view
+        let key = content_key(&canvas);
+        let unselected = Canvas {
+            selected: None,
+            ..canvas
+        };
+        assert_ne!(content_key(&unselected), key);
+    }
 }

@@ -230,37 +230,60 @@ const STAGE: Color32 = Color32::from_rgb(14, 116, 144);
 /// Fill of the scan field around the stage.
 const STAGE_FILL: Color32 = Color32::from_rgba_premultiplied(2, 16, 20, 36);
 
-/// Draws the job at `t_s`: marks done (the current one up to the tool point), the stage as a
-/// cross with the scan-field outline (`field_mm`) around it, and the laser spot (filled when
-/// the laser is on, hollow when off). `done` is `None` for the single-plan colour.
+/// Draws the job at `t_s` in `rect` seen through `view`: marks done (the current one up to the
+/// tool point), the stage as a cross with the scan-field outline (`field_mm`) around it, and
+/// the laser spot (filled when the laser is on, hollow when off). `done` is `None` for the
+/// single-plan colour. The marks done are kept as a raster under `id` that grows with them
+/// (`raster::paint_prefix`): a frame draws only the marks since the last raster, not all.
+#[allow(clippy::too_many_arguments)]
 pub fn paint(
     painter: &Painter,
+    id: egui::Id,
     l: &Lowered,
     t_s: f64,
     field_mm: [f64; 2],
     done: Option<Color32>,
-    to_screen: &dyn Fn(Pt) -> Pos2,
-    clip: Rect,
+    view: &super::canvas::View,
+    rect: Rect,
 ) {
+    let to_screen = |q: Pt| view.to_screen(rect, q);
     let tp = &l.toolpath;
     let marks = Stroke::new(2.2, done.unwrap_or(DONE));
     let n_done = l.strokes_done(t_s);
-    let mut shapes = Vec::with_capacity(n_done + 1);
-    for k in 0..n_done {
-        // at screen resolution, and none off the canvas
-        if let Some(pts) = super::paint::screen_line(tp.stroke_points(k), false, to_screen, clip) {
-            shapes.push(polyline(pts.into_iter(), marks));
-        }
-    }
+    let content = {
+        use std::hash::{Hash, Hasher};
+        let mut h = rustc_hash::FxHasher::default();
+        (std::ptr::from_ref(l) as usize, tp.strokes.len()).hash(&mut h);
+        marks.color.to_array().hash(&mut h);
+        h.finish()
+    };
+    let marks_done = |range: std::ops::Range<usize>, clip: Rect| -> Vec<Shape> {
+        range
+            .filter_map(|k| {
+                // at screen resolution, and none off the canvas
+                super::paint::screen_line(tp.stroke_points(k), false, &to_screen, clip)
+                    .map(|pts| polyline(pts.into_iter(), marks))
+            })
+            .collect()
+    };
+    super::raster::paint_prefix(
+        painter.ctx(),
+        painter,
+        id,
+        content,
+        n_done,
+        (view.scale, view.offset),
+        rect,
+        &marks_done,
+    );
     let state = tp.state_at(t_s);
     if let Some(&(start_s, end_s)) = l.mark_s.get(n_done) {
         if state.laser && t_s >= start_s && end_s > start_s {
             let u = (t_s - start_s) / (end_s - start_s);
             let pts = partial(tp.stroke_points(n_done), u, state.tcp());
-            shapes.push(polyline(pts.into_iter().map(to_screen), marks));
+            painter.add(polyline(pts.into_iter().map(to_screen), marks));
         }
     }
-    painter.extend(shapes);
     let stage = to_screen(state.stage);
     let half = Pt::new(field_mm[0] / 2.0, field_mm[1] / 2.0);
     let r = Rect::from_two_pos(

@@ -225,13 +225,14 @@ fn can_be_covered(g: &crate::document::Geometry, profile: &MachineProfile) -> bo
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     #![allow(clippy::unwrap_used, clippy::expect_used)]
     use super::*;
     use crate::job::JobCtx;
     use crate::pipeline::{load_svg, order_document_lowered, place_document_fields};
 
-    fn demo() -> Session {
+    /// The demo artwork with its fields placed, as a session (also for the canvas's tests).
+    pub(in crate::app) fn demo() -> Session {
         let path =
             std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/examples/demo.svg");
         let (mut doc, _) = load_svg(
