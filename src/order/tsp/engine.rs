@@ -54,6 +54,9 @@ pub(super) struct Engine<'p> {
     /// `plain`, and no node may flip: every node is a point (`s = e`), so an edge is the
     /// distance between two points whatever the orientations.
     plain_points: bool,
+    /// With `plain_points`, each node's point, packed (the hot path reads nothing else);
+    /// empty otherwise.
+    points: Vec<crate::geom::Pt>,
 }
 
 /// Why a local search stopped early.
@@ -87,10 +90,17 @@ impl<'p> Engine<'p> {
             && (prob.cluster.is_empty() || prob.cluster_penalty == 0.0)
             && prob.metric == TravelCost::Distance;
         let ring = Ring::new(tour, &prob.flippable);
+        let plain_points = plain && !ring.any_flippable();
+        let points = if plain_points {
+            prob.nodes.iter().map(|node| node.s).collect()
+        } else {
+            Vec::new()
+        };
         Some(Engine {
             prob,
             nbr,
-            plain_points: plain && !ring.any_flippable(),
+            plain_points,
+            points,
             ring,
             lo,
             hi,
@@ -104,20 +114,33 @@ impl<'p> Engine<'p> {
         })
     }
 
+    /// Every node is a point and the cost is their distance (see `plain_points`).
+    pub(super) fn plain_points(&self) -> bool {
+        self.plain_points
+    }
+
     /// Number of nodes.
     pub(super) fn len(&self) -> usize {
         self.ring.len()
     }
 
     /// Cost of the edge `u → v` with the current orientations.
+    #[inline(always)]
     pub(super) fn edge(&self, u: usize, v: usize) -> f64 {
         if self.plain_points {
-            return self.prob.nodes[u].s.dist(self.prob.nodes[v].s);
+            return self.points[u].dist(self.points[v]);
         }
+        self.edge_oriented(u, v)
+    }
+
+    /// [`Engine::edge`] with the orientations (not between two points).
+    #[inline(never)]
+    fn edge_oriented(&self, u: usize, v: usize) -> f64 {
         self.cost_o(u, self.ring.flipped(u), v, self.ring.flipped(v))
     }
 
     /// The problem's `cost_o`, computed directly when the cost is plain distance.
+    #[inline]
     fn cost_o(&self, u: usize, fu: bool, v: usize, fv: bool) -> f64 {
         if self.plain {
             let (a, b) = (&self.prob.nodes[u], &self.prob.nodes[v]);
@@ -130,16 +153,24 @@ impl<'p> Engine<'p> {
     }
 
     /// Cost of the edge `u → v` when `u`'s orientation is toggled (`tu`) and/or `v`'s (`tv`).
+    #[inline(always)]
     pub(super) fn edge_toggled(&self, u: usize, tu: bool, v: usize, tv: bool) -> f64 {
         if self.plain_points {
-            return self.prob.nodes[u].s.dist(self.prob.nodes[v].s);
+            return self.points[u].dist(self.points[v]);
         }
+        self.edge_toggled_oriented(u, tu, v, tv)
+    }
+
+    /// [`Engine::edge_toggled`] with the orientations (not between two points).
+    #[inline(never)]
+    fn edge_toggled_oriented(&self, u: usize, tu: bool, v: usize, tv: bool) -> f64 {
         let fu = self.ring.flipped(u) ^ (tu && self.ring.flippable(u));
         let fv = self.ring.flipped(v) ^ (tv && self.ring.flippable(v));
         self.cost_o(u, fu, v, fv)
     }
 
     /// Cost of the edge into path position `k` (0 at the start).
+    #[inline]
     pub(super) fn edge_into(&self, k: usize) -> f64 {
         if k == 0 || k >= self.len() {
             0.0
@@ -150,6 +181,7 @@ impl<'p> Engine<'p> {
 
     /// Exact change of cost from reversing positions `i..=j`, with the new cost of the edge into
     /// `i` and out of `j` (0 where the path ends).
+    #[inline]
     pub(super) fn reversal_delta(&self, i: usize, j: usize) -> (f64, f64, f64) {
         let (a, b) = (self.ring.at(i), self.ring.at(j));
         let mut d = self.prob.lambda * (self.prob.nodes[b].p - self.prob.nodes[a].p);

@@ -107,16 +107,18 @@ pub const DIVIDED_KICKS_MIN: usize = 200;
 /// Kicks per node of the default budget.
 const KICKS_PER_NODE: usize = 2;
 
-/// Most kicks of the default budget: about 0.15 s of search on 1,000 uniform points (a kick and
-/// its repair take about 50 µs there), +0.6–0.9 % above LKH.
-const KICKS_MAX: usize = 1500;
+/// Most kicks of the default budget (reached from 2,000 nodes on). 1,000 uniform points get
+/// 2,000 kicks: 0.12–0.15 s of search on this project's 2-core machine (a kick and its repair
+/// take about 55 µs there), a median of +0.8 % above LKH on five sets (best of two seeds;
+/// 1,500 kicks gave +0.85 %, 3,000 +0.6 %; BENCHMARKS, issue 24).
+const KICKS_MAX: usize = 4000;
 
 /// Bound on `kicks · n` of the default budget, so that a huge path (whose construction and first
-/// descent dominate) gets fewer kicks: 1,500 up to 13,333 nodes, 200 at 10⁵. Raised from 10⁷
-/// when a lone field's HHA descent gave way to a Hilbert start: on 10⁴ dots (seeds 1–3) the
-/// time objective's 2,000 kicks give +2.48 / +2.76 / +2.68 % above LKH where the descent and
-/// 1,000 kicks gave +2.57 / +2.65 / +2.72 %, in less time (BENCHMARKS, issue 16).
-const KICK_WORK_MAX: usize = 20_000_000;
+/// descent dominate) gets fewer kicks: 4,000 up to 10⁴ nodes, 400 at 10⁵. Raised from 10⁷
+/// when a lone field's HHA descent gave way to a Hilbert start (issue 16), and from 2 · 10⁷
+/// when the local search got faster: on 10⁴ dots 1,500 kicks gave +2.48 % above LKH, 3,000
+/// +2.07 %, 6,000 +1.56 % (BENCHMARKS, issue 24).
+const KICK_WORK_MAX: usize = 40_000_000;
 
 /// Kicks of the default budget for a path of `n` nodes: `KICKS_PER_NODE` per node, at least 32,
 /// at most `KICKS_MAX` and `KICK_WORK_MAX`` / n` (at least 8).

@@ -126,6 +126,12 @@ impl Engine<'_> {
             if t3 == t1 || t3 == t2 {
                 continue;
             }
+            // between points the added edge t2–t3 costs their distance whatever the step:
+            // the gain criterion below, checked before the step is worked out (same chains,
+            // a third of the search time on 1,000 uniform points)
+            if self.plain_points() && open_gain - self.edge(t2, t3) <= IMPROVE_EPS {
+                continue;
+            }
             let Some(mut s) = self.chain_step(t1, t2, t3, forward) else {
                 continue;
             };
