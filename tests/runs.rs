@@ -70,20 +70,35 @@ fn job_s(plan: &Plan) -> f64 {
 
 #[test]
 fn a_cross_fill_planned_by_runs_is_as_fast_as_stroke_by_stroke() {
+    // border loops and the second family's sweeps are runs
+    planned_by_runs_as_fast(HatchStyle::Cross, &[RunOrder::Loop, RunOrder::Sweep]);
+}
+
+#[test]
+fn a_lines_fill_planned_by_runs_is_as_fast_as_stroke_by_stroke() {
+    // a disc's lines, one chord each, are one sweep (fails without runs for `lines`)
+    planned_by_runs_as_fast(HatchStyle::Lines, &[RunOrder::Sweep]);
+}
+
+/// A 2 × 2 grid of discs filled with `style`: its strokes form runs of each of `orders`, most
+/// strokes are in one, each run is listed in one stretch and marked in one go, and the plan is
+/// as fast as planning the same strokes one by one.
+fn planned_by_runs_as_fast(style: HatchStyle, orders: &[RunOrder]) {
     let dir = tempfile::tempdir().unwrap();
     let svg = discs_svg(dir.path(), 2, 4.0);
-    let hatch = HatchSettings::new(HatchStyle::Cross, 0.05);
+    let hatch = HatchSettings::new(style, 0.05);
     let mut doc = load(&svg, hatch, MotionMode::Step);
     let by_runs = plan_document(&mut doc, &JobCtx::default()).unwrap();
     common::check_plan(&doc, &by_runs);
-    // border loops and the second family's sweeps are runs, each listed in one stretch
     let found = runs(&doc.geometries);
-    let orders: Vec<RunOrder> = doc
+    let found_orders: Vec<RunOrder> = doc
         .geometries
         .iter()
         .filter_map(|g| g.run.map(|r| r.order))
         .collect();
-    assert!(orders.contains(&RunOrder::Loop) && orders.contains(&RunOrder::Sweep));
+    for order in orders {
+        assert!(found_orders.contains(order), "{style:?}: no {order:?} run");
+    }
     let in_runs: usize = found.values().map(Vec::len).sum();
     assert!(
         in_runs * 10 > doc.geometries.len() * 9,
@@ -180,7 +195,7 @@ fn the_marking_floor_is_below_both_motions() {
 fn fills_cut_on_a_tiling_plan_by_runs_into_valid_jobs() {
     // a field smaller than the shapes: fills are cut at seams, runs split at cells
     let path = common::root().join("tests/data/hatch/apmcm-multi.svg");
-    for style in [HatchStyle::Zigzag, HatchStyle::Cross] {
+    for style in [HatchStyle::Zigzag, HatchStyle::Cross, HatchStyle::Lines] {
         for angle_deg in [0.0, 30.0, 90.0] {
             let settings = SolverSettings {
                 hatch: Some(HatchSettings {

@@ -102,6 +102,22 @@ pub enum StrokeKind {
     Gap,
 }
 
+/// Runs of one stroke made loose (a run is a group of strokes).
+fn lone_runs_loose(strokes: &mut [HatchStroke]) {
+    let mut k = 0;
+    while k < strokes.len() {
+        let id = strokes[k].run.map(|r| r.id);
+        let n = strokes[k..]
+            .iter()
+            .take_while(|st| st.run.map(|r| r.id) == id)
+            .count();
+        if n == 1 {
+            strokes[k].run = None;
+        }
+        k += n.max(1);
+    }
+}
+
 /// One stroke of a hatch.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct HatchStroke {
@@ -242,12 +258,37 @@ pub fn hatch_contours(
             })?;
         ctx.check()?;
         if settings.style == HatchStyle::Lines {
+            // consecutive lines of one chord each, overlapping along the lines, are one sweep:
+            // one run, marked in line order, each chord entered at the end next to the last
+            // (the planner flips open strokes anyway); lines of several chords stay loose
             let sc = &scans[0];
-            for c in sc.lines.iter().flatten() {
-                let (p, q) = sc.ends(*c);
-                out.strokes
-                    .push(stroke(StrokeKind::Line, 0, 0, vec![p, q], false));
+            let along = Pt::new(a.cos(), a.sin());
+            let first = out.strokes.len();
+            let mut run: Option<Run> = None;
+            let mut last: Option<(f64, f64)> = None;
+            for line in &sc.lines {
+                let span = match line.as_slice() {
+                    [c] => {
+                        let (p, q) = sc.ends(*c);
+                        let (u, v) = (p.dot(along), q.dot(along));
+                        Some((u.min(v), u.max(v)))
+                    }
+                    _ => None,
+                };
+                let continues = matches!((last, span), (Some((a0, a1)), Some((b0, b1))) if b0 <= a1 && a0 <= b1);
+                if !continues {
+                    run = span.map(|_| new_run(RunOrder::Sweep));
+                }
+                for c in line {
+                    let (p, q) = sc.ends(*c);
+                    out.strokes.push(HatchStroke {
+                        run: span.and(run),
+                        ..stroke(StrokeKind::Line, 0, 0, vec![p, q], false)
+                    });
+                }
+                last = span;
             }
+            lone_runs_loose(&mut out.strokes[first..]);
             if settings.border {
                 for l in &flat {
                     out.strokes
