@@ -27,8 +27,14 @@ fn opened_oversize() -> (Harness<'static, App>, usize) {
     (h, n)
 }
 
+/// Steps `Harness::run` may take before the UI must have settled.
+const MAX_STEPS: u64 = 16;
+
 fn harness(app: App) -> Harness<'static, App> {
     Harness::builder()
+        // a canvas raster drawn in the background asks for a frame when it is done (to show
+        // it): a few steps more than egui's default of 4 before the UI settles
+        .with_max_steps(MAX_STEPS)
         .with_size(Vec2::new(1500.0, 950.0))
         .build_ui_state(|ui, app: &mut App| app.ui(ui), app)
 }
@@ -591,6 +597,9 @@ fn frame_time_while_solving() {
     let times = std::rc::Rc::new(std::cell::RefCell::new(Vec::new()));
     let t = times.clone();
     let mut h = Harness::builder()
+        // a canvas raster drawn in the background asks for a frame when it is done (to show
+        // it): a few steps more than egui's default of 4 before the UI settles
+        .with_max_steps(MAX_STEPS)
         .with_size(Vec2::new(1500.0, 950.0))
         .build_ui_state(
             move |ui, app: &mut App| {
@@ -1525,6 +1534,9 @@ fn small(path: &Path) -> Harness<'static, App> {
     let mut app = App::default();
     assert!(app.open(path), "{}", app.status());
     let mut h = Harness::builder()
+        // a canvas raster drawn in the background asks for a frame when it is done (to show
+        // it): a few steps more than egui's default of 4 before the UI settles
+        .with_max_steps(MAX_STEPS)
         .with_size(Vec2::new(900.0, 600.0))
         .build_ui_state(|ui, app: &mut App| app.ui(ui), app);
     h.run();

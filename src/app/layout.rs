@@ -435,13 +435,7 @@ impl App {
             }
         }
         if self.has_document() {
-            let closed = self
-                .session
-                .doc
-                .geometries
-                .iter()
-                .filter(|g| g.closed)
-                .count();
+            let closed = self.session.closed;
             ui.label(format!(
                 "{} ({closed} closed, {} open), {}",
                 super::count(self.session.doc.geometries.len(), "geometry", "geometries"),

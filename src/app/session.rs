@@ -33,6 +33,8 @@ pub struct Session {
     pub out_of_reach: Vec<usize>,
     /// (imported, marked) geometries per layer.
     pub layer_counts: Vec<(usize, usize)>,
+    /// Closed geometries (counted once per change, not every frame).
+    pub closed: usize,
     /// Per plan, what changed since it was planned, in words (empty: current).
     pub stale: Vec<Vec<String>>,
     /// A problem with the open document (e.g. fields could not be placed).
@@ -182,6 +184,7 @@ impl Session {
             .filter(|&k| !can_be_covered(&self.doc.geometries[k], &self.doc.profile))
             .collect();
         self.layer_counts = layer_counts(&self.doc);
+        self.closed = self.doc.geometries.iter().filter(|g| g.closed).count();
         self.can_reimport = super::files::can_reimport(&self.doc);
         if self.active.is_some_and(|k| k >= self.doc.plans.len()) {
             self.active = self.doc.plans.len().checked_sub(1);
