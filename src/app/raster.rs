@@ -95,39 +95,55 @@ struct Cache {
 }
 
 impl Cache {
-    /// The cache of layer `id`, with a finished raster taken: shown when it is of `content`,
-    /// dropped otherwise. A job of other content is cancelled.
+    /// The cache of layer `id` (taken out of egui's memory: [`Cache::store`] puts it back),
+    /// with a finished raster taken: shown when it is of `content`, dropped otherwise. A job of
+    /// other content is cancelled.
     fn load(ctx: &Context, id: Id, content: u64) -> Self {
-        let mut cache: Cache = ctx.data(|d| d.get_temp(id)).unwrap_or_default();
-        let Some(job) = cache.job.as_ref() else {
+        let mut cache: Cache = ctx.data_mut(|d| d.remove_temp(id)).unwrap_or_default();
+        let Some(job) = cache.job.take() else {
             return cache;
         };
         if job.key.content != content {
             // the content changed while a raster of the old one is drawn: not wanted any more
             job.cancel.store(true, Ordering::Relaxed);
         }
-        let Some(done) = job.done.get() else {
+        if job.done.get().is_none() {
+            cache.job = Some(job);
             return cache;
+        }
+        let (key, local, count) = (job.key, job.local, job.count);
+        // the image is moved out when the drawing thread has let go of the job (it does before
+        // it asks for the frame), else copied
+        let done = match Arc::try_unwrap(job) {
+            Ok(job) => job.done.into_inner().flatten(),
+            Err(job) => job.done.get().and_then(Option::as_ref).map(|d| Drawn {
+                image: d.image.clone(),
+                pixmap: d.pixmap.clone(),
+            }),
         };
-        if let (Some(done), true) = (done, job.key.content == content) {
+        if let (Some(done), true) = (done, key.content == content) {
             let options = egui::TextureOptions::LINEAR;
             let texture = match cache.shown.take() {
                 Some(mut shown) => {
-                    shown.texture.set(done.image.clone(), options);
+                    shown.texture.set(done.image, options);
                     shown.texture
                 }
-                None => ctx.load_texture("canvas raster", done.image.clone(), options),
+                None => ctx.load_texture("canvas raster", done.image, options),
             };
             cache.shown = Some(Shown {
-                key: job.key,
-                local: job.local,
-                count: job.count,
+                key,
+                local,
+                count,
                 texture,
-                pixmap: done.pixmap.clone(),
+                pixmap: done.pixmap,
             });
         }
-        cache.job = None;
         cache
+    }
+
+    /// Puts the cache back into egui's memory under `id`.
+    fn store(self, ctx: &Context, id: Id) {
+        ctx.data_mut(|d| d.insert_temp(id, self));
     }
 
     /// The view of `rect` as a raster key of `content`.
@@ -157,22 +173,23 @@ pub(super) fn paint(
     let id = id.with("raster");
     let mut cache = Cache::load(ctx, id, content);
     let want = Cache::want(ctx, content, view, rect);
-    let current = cache.shown.as_ref().filter(|s| s.key.content == content);
+    let shown_key = cache.shown.as_ref().map(|s| s.key);
+    let current = shown_key.is_some_and(|k| k.content == content);
     let mut direct = None;
-    if cache.job.is_none() && current.map(|s| s.key) != Some(want) {
+    if cache.job.is_none() && shown_key != Some(want) {
         if let Some(local) = image_rect(rect.size(), want.pixels_per_point, ctx) {
             let drawn = shapes(local.translate(rect.min.to_vec2()));
-            if current.is_none() {
+            if !current {
                 direct = Some(drawn.clone());
             }
             cache.job = start(ctx, want, local, rect.min, drawn, None, 0);
         }
     }
-    match cache.shown.as_ref().filter(|s| s.key.content == content) {
+    match cache.shown.as_ref().filter(|_| current) {
         Some(shown) => shown.paint(painter, view, rect),
         None => painter.extend(direct.unwrap_or_else(|| shapes(rect))),
     }
-    ctx.data_mut(|d| d.insert_temp(id, cache));
+    cache.store(ctx, id);
 }
 
 /// Draws a layer of `count` items that grows at its end (the marks of a playback, `content`
@@ -216,7 +233,7 @@ pub(super) fn paint_prefix(
         }
         None => painter.extend(shapes(0..count, rect)),
     }
-    ctx.data_mut(|d| d.insert_temp(id, cache));
+    cache.store(ctx, id);
 }
 
 /// The rectangle a raster of a canvas of `size` covers, relative to its corner, points: the
@@ -281,6 +298,8 @@ fn start(
             });
             // a second set cannot happen: this thread is the only writer
             let _unused = job_ref.done.set(drawn);
+            // let go of the job before the frame that takes it (so it can move the image out)
+            drop(job_ref);
             ctx.request_repaint();
         });
     // no thread: the canvas keeps drawing its shapes directly

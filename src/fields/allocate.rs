@@ -5,9 +5,9 @@
 //! are marked together; when none of its fields holds anything yet, the field with the nearest
 //! centre. A uniform grid over the allocated centroids keeps the nearest search local.
 
-use super::grid::{expand, BucketGrid, SCAN_MAX_ITEMS};
 use super::INSIDE_EPS_MM;
 use crate::document::{Geometry, ScanField};
+use crate::geom::grid::{expand, BucketGrid, SCAN_MAX_ITEMS};
 use crate::geom::{BBox, Pt};
 use std::collections::HashMap;
 

@@ -16,8 +16,8 @@
 //! 3. a lower bound: rectangles that pairwise do not meet need one field each (a greedy maximal
 //!    set of such rectangles, taken in two orders, the larger counts).
 
-use super::grid::{expand, BucketGrid, Range1, SCAN_MAX_ITEMS};
 use super::reach::Span;
+use crate::geom::grid::{expand, BucketGrid, Range1, SCAN_MAX_ITEMS};
 use crate::job::{Cancelled, JobCtx};
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;

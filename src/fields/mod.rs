@@ -9,7 +9,6 @@ pub mod auto;
 pub mod cover;
 mod edit;
 mod greedy;
-mod grid;
 pub mod paper;
 pub mod position;
 mod reach;

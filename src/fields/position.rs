@@ -8,7 +8,7 @@
 //! least-overlap positions, the one nearest the centre of the field's geometries is found too.
 
 use super::cover::FRect;
-use super::grid::{expand, BucketGrid, SCAN_MAX_ITEMS};
+use crate::geom::grid::{expand, BucketGrid, SCAN_MAX_ITEMS};
 use crate::geom::Pt;
 use crate::job::{Cancelled, JobCtx};
 

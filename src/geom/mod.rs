@@ -3,6 +3,7 @@
 //! All coordinates are millimetres in machine coordinates (x right, y down, as in SVG).
 
 mod flatten;
+pub(crate) mod grid;
 pub mod seam;
 pub mod tiling;
 

