@@ -10,7 +10,8 @@
 //! 3. **Tracked route** (first choice without a seed 001 route, [`tracking`]): each axis follows
 //!    that tube through its
 //!    exact reachable sets at the axis' speed and acceleration limits ([`super::track`]); the
-//!    tool is slowed only where no admissible stage motion keeps up with it. Job time is what
+//!    tool is slowed only where no admissible stage motion keeps up with it, by two rules
+//!    tracked side by side, the shorter job kept ([`tracking::FixRule`]). Job time is what
 //!    this minimises: nothing is slowed to keep a route short or its corners small.
 //! 4. **Taut route** (where tracking does not settle within its fix budget: a reach too small
 //!    for motion and marking to overlap): through the tube the **taut string** is the shortest
@@ -193,10 +194,10 @@ pub fn lower_on_the_fly(
     // seed 001's routes are followed on the taut route, as measured for the paper's benchmark
     // (docs/BENCHMARKS.md); tracking inside their ±1 mm band is not measured
     if follow.is_none() {
-        let tracked =
-            tracking::lower_tracked(pieces.clone(), &mut path, profile, reach_mm, clock_s, ctx)?;
-        if tracked.is_some() {
-            return Ok(path);
+        if let Some(tracked) =
+            lower_tracked_faster(&pieces, &path, profile, reach_mm, clock_s, ctx)?
+        {
+            return Ok(tracked);
         }
     }
     let full_speed = [
@@ -252,6 +253,55 @@ pub fn lower_on_the_fly(
     let y = AxisRoute::smooth(ry, profile.axis_y.max_accel_mm_s2);
     install(&mut path, &run, x, y, clock_s);
     Ok(path)
+}
+
+/// The tracked lowering of `pieces`, the shorter job of the two [`tracking::FixRule`]s (in
+/// parallel; on a tie the window rule's): `None` when neither settles. The wait-first rule
+/// gives up once it has added more than the window rule's slowing.
+fn lower_tracked_faster(
+    pieces: &[Piece],
+    path: &Toolpath,
+    profile: &MachineProfile,
+    reach_mm: f64,
+    clock_s: Option<f64>,
+    ctx: &JobCtx,
+) -> Result<Option<Toolpath>, OtfError> {
+    let by = |rule, cap: &tracking::SlowingCap| -> Result<Option<Toolpath>, OtfError> {
+        let mut path = path.clone();
+        let tracked = tracking::lower_tracked(
+            pieces.to_vec(),
+            &mut path,
+            profile,
+            reach_mm,
+            clock_s,
+            rule,
+            cap,
+            ctx,
+        )?;
+        Ok(tracked.map(|()| path))
+    };
+    let (no_cap, cap) = (tracking::SlowingCap::none(), tracking::SlowingCap::none());
+    // LinuxCNC times its own program, and its timing of the wait-first rule's long jumps
+    // departs from the toolpath's (oversize.svg: 26.764 s against 26.736 s): not used there
+    if profile.controller.kind != crate::document::ControllerKind::Ideal {
+        return by(tracking::FixRule::Window, &no_cap);
+    }
+    let tool_s: f64 = pieces.iter().map(|p| p.duration_s).sum();
+    let (window, wait_first) = rayon::join(
+        || {
+            let window = by(tracking::FixRule::Window, &no_cap);
+            if let Ok(Some(w)) = &window {
+                cap.set_s(w.duration_s() - tool_s);
+            }
+            window
+        },
+        || by(tracking::FixRule::WaitFirst, &cap),
+    );
+    Ok(match (window?, wait_first?) {
+        (Some(w), Some(f)) if f.duration_s() < w.duration_s() => Some(f),
+        (Some(w), _) => Some(w),
+        (None, f) => f,
+    })
 }
 
 /// The pieces as run: on the controller clock when there is one.

@@ -194,10 +194,10 @@ impl Reachable {
             .map(|&[x, v]| [x + v * dt_s, v])
             .collect();
         let mut set = sum_with_segment(&sheared, d);
-        set = clip(&set, 0, lower_mm, true);
-        set = clip(&set, 0, upper_mm, false);
-        set = clip(&set, 1, -limits.v_max_mm_s, true);
-        set = clip(&set, 1, limits.v_max_mm_s, false);
+        set = clip(set, 0, lower_mm, true);
+        set = clip(set, 0, upper_mm, false);
+        set = clip(set, 1, -limits.v_max_mm_s, true);
+        set = clip(set, 1, limits.v_max_mm_s, false);
         if set.is_empty() {
             return Err(Unreachable { sample });
         }
@@ -246,7 +246,7 @@ fn slowest(set: &[State]) -> State {
     let lo = set.iter().map(|s| s[1]).fold(f64::INFINITY, f64::min);
     let hi = set.iter().map(|s| s[1]).fold(f64::NEG_INFINITY, f64::max);
     if lo <= 0.0 && hi >= 0.0 {
-        let chord = clip(&clip(set, 1, 0.0, true), 1, 0.0, false);
+        let chord = clip(clip(set.to_vec(), 1, 0.0, true), 1, 0.0, false);
         let xs = chord.iter().map(|s| s[0]);
         let (a, b) = xs.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
             (a.min(x), b.max(x))
@@ -412,8 +412,9 @@ fn convex_hull(mut points: Vec<State>) -> Vec<State> {
 }
 
 /// The part of `poly` (convex, in order) with coordinate `axis` at least `bound` (`keep_above`)
-/// or at most `bound` (Sutherland–Hodgman against one line).
-fn clip(poly: &[State], axis: usize, bound: f64, keep_above: bool) -> Vec<State> {
+/// or at most `bound` (Sutherland–Hodgman against one line); `poly` itself where it lies
+/// inside (most steps: no copy).
+fn clip(poly: Vec<State>, axis: usize, bound: f64, keep_above: bool) -> Vec<State> {
     let inside = |p: &State| {
         if keep_above {
             p[axis] >= bound
@@ -422,7 +423,7 @@ fn clip(poly: &[State], axis: usize, bound: f64, keep_above: bool) -> Vec<State>
         }
     };
     if poly.iter().all(inside) {
-        return poly.to_vec();
+        return poly;
     }
     let n = poly.len();
     let mut out = Vec::with_capacity(n + 2);
@@ -569,10 +570,10 @@ mod tests {
             [0.5, 0.5],
         ]);
         assert_eq!(hull.len(), 4);
-        let half = clip(&hull, 0, 0.5, true);
+        let half = clip(hull.clone(), 0, 0.5, true);
         assert!(half.iter().all(|p| p[0] >= 0.5));
         assert_eq!(half.len(), 4);
-        let seg = clip(&[[0.0, 0.0], [2.0, 0.0]], 0, 1.0, false);
+        let seg = clip(vec![[0.0, 0.0], [2.0, 0.0]], 0, 1.0, false);
         assert_eq!(seg, vec![[0.0, 0.0], [1.0, 0.0]]);
         let mut many: Vec<State> = (0..40)
             .map(|k| {

@@ -3,14 +3,27 @@
 //!
 //! The tube is sampled at every knot of the tool (piece ends, stroke vertices) and at least
 //! every [`MAX_STEP_S`] of nominal time; between samples the tool moves straight. Where the
-//! stage cannot follow (an empty set at sample `j`, time `t_j`), the window `[t_j − W, t_j]` is
-//! made [`FIX_FACTOR`] times longer, the time added to its laser-off waits (the scanner waits
-//! for the stage between marks) where it has any, else to all its pieces (marks run slower),
-//! and the sets are propagated again from the first of them (the sets before are unchanged:
-//! they depend only on earlier pieces). `W`
-//! starts at the longest time an axis takes to reach full speed and grows by half each time the
-//! same spot fails again. Job time is what this spends, and only near spots where the stage
-//! cannot keep up, in steps of [`FIX_FACTOR`]; route length and corners cost nothing.
+//! stage cannot follow (an empty set at sample `j`, time `t_j`), the tool is slowed before
+//! `j` and the sets are propagated again from the first piece slowed (the sets before are
+//! unchanged: they depend only on earlier pieces). Two rules ([`FixRule`]) say where:
+//!
+//! * **window**: the window `[t_j − W, t_j]` is made [`FIX_FACTOR`] times longer, the time
+//!   added to its laser-off waits (the scanner waits for the stage between marks) where it has
+//!   any, else to all its pieces (marks run slower). `W` starts at the longest time an axis
+//!   takes to reach full speed and grows by half each time the same spot fails again.
+//! * **wait first**: the scanner waits on the last jump before `j`, from 1 ms and
+//!   [`WAIT_GROWTH`] times more each time the spot fails again (a spot just after one fixed on
+//!   the same jump goes on from there). Where a wait of [`WAIT_CAP_WINDOWS`] windows does not
+//!   get the stage past, it is taken back and the jump before is tried, up to [`WAIT_DEPTH`]
+//!   jumps back, then the window rule. Its jumps are sampled at least [`JUMP_SAMPLES`] times,
+//!   so that a long wait does not cap the stage's acceleration.
+//!
+//! The window rule spreads the slowing over the tool's laser-off time; where a small reach
+//! makes the scanner wait at every cell, that adds more than the tool's own time before the
+//! stage gets through (texture.toml: the taut fallback, slower than step-and-scan), and the
+//! wait-first rule spends the time only where the stage needs it. Neither wins everywhere, so
+//! the caller tracks with both and keeps the shorter job. Job time is what this spends, and
+//! only near spots where the stage cannot keep up; route length and corners cost nothing.
 
 use super::TUBE_SLACK;
 use super::{clocked, install, overshoots, piece_knots, Piece};
@@ -21,16 +34,36 @@ use crate::motion::track::{Limits, Reachable, TrackedAxis};
 use crate::motion::{SegmentKind, Toolpath};
 
 use super::OtfError;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 /// Longest nominal time between two samples of the tube, s. The acceleration between samples
 /// narrows the tube by `a·Δt²/8` (2.5 µm at 5,000 mm/s² and 2 ms).
 const MAX_STEP_S: f64 = 2e-3;
+
+/// Least samples on a jump under [`FixRule::WaitFirst`]: a jump the scanner waits on is
+/// longer than its nominal time, and a long step between samples caps the acceleration
+/// ([`Limits::accel_mm_s2`]); 16 samples keep the full acceleration up to a wait of 0.2 s in
+/// a 2 mm reach at 900 mm/s².
+const JUMP_SAMPLES: usize = 16;
 
 /// Samples closer than this are one, s.
 const MIN_GAP_S: f64 = 1e-9;
 
 /// How much one fix slows the pieces before a sample the stage cannot reach.
 const FIX_FACTOR: f64 = 1.1;
+
+/// The first wait a spot the stage cannot reach adds to the jump before it, s.
+const WAIT_STEP_S: f64 = 1e-3;
+
+/// How much the wait on that jump grows each time the spot fails again.
+const WAIT_GROWTH: f64 = 1.25;
+
+/// The longest wait tried on one jump, in fix windows (the time an axis takes to reach full
+/// speed): enough for any rest-to-rest move across the reach.
+const WAIT_CAP_WINDOWS: f64 = 0.5;
+
+/// Jumps back from a spot tried for the wait.
+const WAIT_DEPTH: usize = 4;
 
 /// How much the fix window grows when the same spot fails again.
 const WINDOW_GROWTH: f64 = 1.5;
@@ -39,12 +72,21 @@ const WINDOW_GROWTH: f64 = 1.5;
 /// 1,265, texture-10's band sweep).
 const MAX_FIXES: usize = 5_000;
 
+/// Fixes before [`FixRule::WaitFirst`] gives up: its waits grow from a millisecond, so a spot
+/// takes some ten fixes where the window rule takes one or two.
+const MAX_WAIT_FIXES: usize = 1_000_000;
+
 /// Most time the fixes may add (summed over fixes), as a share of the tool's time when
 /// tracking starts: beyond it the stage is crawling from spot to spot (texture.toml's 2 mm
 /// reach gets there after about 1,000 fixes), and the taut route, which waits where it must,
 /// is the better bet. The benchmarks that track add at most 0.96 of it (texture-10's band
 /// sweep), most add less than 0.3.
 const SLOWING_BUDGET: f64 = 1.0;
+
+/// [`SLOWING_BUDGET`] of [`FixRule::WaitFirst`]: its waits are spent only where the stage
+/// needs them, and on texture.toml's 2 mm reach it settles after adding 1.6 times the tool's
+/// time, a job of 0.61 times its step-and-scan time (BENCHMARKS, issue 26).
+const WAIT_SLOWING_BUDGET: f64 = 3.0;
 
 /// Rounds of clock alignment and checking before tracking gives up.
 const ROUNDS: usize = 8;
@@ -84,6 +126,7 @@ impl Samples {
         path: &Toolpath,
         profile: &MachineProfile,
         tube_mm: f64,
+        least_jump_samples: usize,
     ) -> Result<Self, OtfError> {
         let mut samples: Vec<Sample> = Vec::new();
         let mut first = Vec::with_capacity(pieces.len());
@@ -95,7 +138,11 @@ impl Samples {
                 let fill = match k.checked_sub(1).map(|i| knots[i]) {
                     Some((u0, _)) => {
                         let span_s = (u - u0) * piece.nominal_s.max(piece.duration_s);
-                        ((span_s / MAX_STEP_S).ceil() as usize).max(1)
+                        let least = match piece.kind {
+                            SegmentKind::Jump => least_jump_samples,
+                            _ => 1,
+                        };
+                        ((span_s / MAX_STEP_S).ceil() as usize).max(least)
                     }
                     None => 1,
                 };
@@ -161,36 +208,134 @@ fn bounds(
     Ok((lower, upper))
 }
 
+/// How a spot the stage cannot reach is fixed. Both are tried, and the faster job is kept
+/// ([`super::lower_on_the_fly`]): neither wins everywhere (BENCHMARKS, issue 26).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum FixRule {
+    /// The window before the spot is made [`FIX_FACTOR`] times longer, its laser-off time
+    /// first (the module documentation).
+    Window,
+    /// The scanner waits on the last jump before the spot, longer each time the spot fails
+    /// again; where that does not get the stage past, on each of the [`WAIT_DEPTH`] jumps
+    /// before it in turn; then the window rule.
+    WaitFirst,
+}
+
+/// The most time a tracking may add before it gives up, shared between threads: the
+/// wait-first rule runs beside the window rule and stops once it has added more than the
+/// window rule's whole slowing (a job it could then only make slower). Durations only grow
+/// with fixes, so the cap ends only runs that would lose: the job kept does not depend on
+/// which thread finishes first.
+#[derive(Debug)]
+pub(super) struct SlowingCap(AtomicU64);
+
+impl SlowingCap {
+    /// No cap.
+    pub(super) fn none() -> Self {
+        Self(AtomicU64::new(f64::INFINITY.to_bits()))
+    }
+
+    /// The cap, s.
+    fn get_s(&self) -> f64 {
+        f64::from_bits(self.0.load(Ordering::Relaxed))
+    }
+
+    /// Sets the cap to `cap_s`.
+    pub(super) fn set_s(&self, cap_s: f64) {
+        self.0.store(cap_s.to_bits(), Ordering::Relaxed);
+    }
+}
+
+impl FixRule {
+    /// Fixes before tracking gives up.
+    fn max_fixes(self) -> usize {
+        match self {
+            Self::Window => MAX_FIXES,
+            Self::WaitFirst => MAX_WAIT_FIXES,
+        }
+    }
+
+    /// Most time the fixes may add, as a share of the tool's time.
+    fn slowing_budget(self) -> f64 {
+        match self {
+            Self::Window => SLOWING_BUDGET,
+            Self::WaitFirst => WAIT_SLOWING_BUDGET,
+        }
+    }
+}
+
 /// The slowing of the pieces before spots the stage cannot reach (see the module
 /// documentation), within its budget.
 struct Fixes {
+    rule: FixRule,
+    /// The controller clock's period, s: waits are whole ticks, so that the marks after them
+    /// stay on their ticks.
+    tick_s: Option<f64>,
+    /// Fixes made by the window rule (they move marks off their ticks).
+    window_count: usize,
     base_window_s: f64,
     window_s: f64,
     last_fail_s: f64,
     count: usize,
     added_s: f64,
     budget_s: f64,
+    /// The spot being fixed: the first sample found unreachable there, and the wait tried.
+    spot: Option<Spot>,
+}
+
+/// A spot the stage could not reach, and how it is being fixed.
+#[derive(Debug, Clone, Copy)]
+struct Spot {
+    /// The first sample found unreachable there.
+    sample: usize,
+    /// The jump the scanner waits on for the stage; `None` once waiting has not helped (the
+    /// window before is slowed instead).
+    wait: Option<Wait>,
+    /// How many jumps back from the spot the wait is.
+    depth: usize,
+}
+
+/// A wait on a jump for the stage.
+#[derive(Debug, Clone, Copy)]
+struct Wait {
+    /// The jump's piece.
+    piece: usize,
+    /// Its duration before this spot's wait, s (restored exactly where the wait is taken
+    /// back).
+    before_s: f64,
+    /// Time added to it for this spot, s.
+    waited_s: f64,
+    /// The next time to add, s: from [`WAIT_STEP_S`], times [`WAIT_GROWTH`] each time the
+    /// spot fails again; a spot just after one fixed on the same jump goes on from its step.
+    step_s: f64,
 }
 
 impl Fixes {
-    fn new(limits: &[Limits; 2], pieces: &[Piece]) -> Self {
+    fn new(limits: &[Limits; 2], pieces: &[Piece], rule: FixRule, tick_s: Option<f64>) -> Self {
         let base_window_s = limits
             .iter()
             .map(|l| l.v_max_mm_s / l.a_max_mm_s2)
             .fold(0.0, f64::max);
         let tool_s: f64 = pieces.iter().map(|p| p.duration_s).sum();
         Self {
+            rule,
+            tick_s,
+            window_count: 0,
             base_window_s,
             window_s: base_window_s,
             last_fail_s: f64::NEG_INFINITY,
             count: 0,
             added_s: 0.0,
-            budget_s: SLOWING_BUDGET * tool_s,
+            budget_s: rule.slowing_budget() * tool_s,
+            spot: None,
         }
     }
 
-    /// Slows the pieces in the window before sample `k` (reached at `t_s[k]`); returns the
-    /// sample to propagate again from, `None` past the budget.
+    /// Slows the tool before sample `k` (reached at `t_s[k]`); returns the sample to
+    /// propagate again from, `None` past the budget. A new spot first makes the scanner wait
+    /// longer on the last jump before it (growing by [`WAIT_GROWTH`] each time the spot fails
+    /// again); where that reaches [`WAIT_CAP_WINDOWS`] windows without getting past, the wait
+    /// is taken back and the window before the spot is slowed instead.
     fn slow(
         &mut self,
         pieces: &mut [Piece],
@@ -199,9 +344,94 @@ impl Fixes {
         k: usize,
     ) -> Option<usize> {
         self.count += 1;
-        if self.count > MAX_FIXES || self.added_s > self.budget_s {
+        if self.count > self.rule.max_fixes() || self.added_s > self.budget_s {
             return None;
         }
+        if self.rule == FixRule::Window {
+            return Some(self.slow_window(pieces, samples, t_s, k));
+        }
+        let spot = match self.spot {
+            Some(spot) if k <= spot.sample => spot,
+            previous => {
+                let piece = last_jump(pieces, samples, t_s, k, self.base_window_s);
+                let step_s = previous
+                    .and_then(|p| p.wait)
+                    .filter(|w| Some(w.piece) == piece)
+                    .map_or(WAIT_STEP_S, |w| w.step_s);
+                Spot {
+                    sample: k,
+                    wait: piece.map(|piece| Wait {
+                        piece,
+                        before_s: pieces[piece].duration_s,
+                        waited_s: 0.0,
+                        step_s,
+                    }),
+                    depth: 0,
+                }
+            }
+        };
+        self.spot = Some(spot);
+        if let Some(wait) = spot.wait {
+            if wait.waited_s < WAIT_CAP_WINDOWS * self.base_window_s {
+                let add_s = self.on_ticks(wait.step_s);
+                pieces[wait.piece].duration_s += add_s;
+                self.added_s += add_s;
+                self.spot = Some(Spot {
+                    wait: Some(Wait {
+                        waited_s: wait.waited_s + add_s,
+                        step_s: wait.step_s * WAIT_GROWTH,
+                        ..wait
+                    }),
+                    ..spot
+                });
+                return Some(samples.first[wait.piece]);
+            }
+            // waiting there does not get the stage past: take it back, wait on the jump before
+            pieces[wait.piece].duration_s = wait.before_s;
+            self.added_s -= wait.waited_s;
+            let from = samples.first[wait.piece];
+            let before = (0..wait.piece)
+                .rev()
+                .find(|&j| pieces[j].kind == SegmentKind::Jump);
+            if let Some(before) = before.filter(|_| spot.depth < WAIT_DEPTH) {
+                let (before_s, add_s) = (pieces[before].duration_s, self.on_ticks(WAIT_STEP_S));
+                pieces[before].duration_s += add_s;
+                self.added_s += add_s;
+                self.spot = Some(Spot {
+                    wait: Some(Wait {
+                        piece: before,
+                        before_s,
+                        waited_s: add_s,
+                        step_s: WAIT_STEP_S * WAIT_GROWTH,
+                    }),
+                    depth: spot.depth + 1,
+                    ..spot
+                });
+                return Some(samples.first[before]);
+            }
+            self.spot = Some(Spot { wait: None, ..spot });
+            let window_from = self.slow_window(pieces, samples, t_s, k);
+            return Some(from.min(window_from));
+        }
+        Some(self.slow_window(pieces, samples, t_s, k))
+    }
+
+    /// A wait of `wait_s`, rounded up to whole ticks on a clock.
+    fn on_ticks(&self, wait_s: f64) -> f64 {
+        self.tick_s
+            .map_or(wait_s, |p| super::ceil_to_tick(wait_s, p).max(p))
+    }
+
+    /// Makes the window before sample `k` [`FIX_FACTOR`] times longer; returns the sample to
+    /// propagate again from.
+    fn slow_window(
+        &mut self,
+        pieces: &mut [Piece],
+        samples: &Samples,
+        t_s: &[f64],
+        k: usize,
+    ) -> usize {
+        self.window_count += 1;
         let fail_s = t_s[k];
         self.window_s = if fail_s <= self.last_fail_s + self.base_window_s {
             (self.window_s * WINDOW_GROWTH).min(fail_s.max(self.base_window_s))
@@ -212,8 +442,25 @@ impl Fixes {
         let from = t_s[..=k].partition_point(|&t| t < fail_s - self.window_s);
         let first_piece = samples.samples[from.min(k)].piece;
         self.added_s += add_time(&mut pieces[first_piece..=samples.samples[k].piece]);
-        Some(samples.first[first_piece])
+        samples.first[first_piece]
     }
+}
+
+/// The last jump at or before sample `k` that starts within `window_s` of it: where the
+/// scanner can wait for the stage just before the spot it cannot reach.
+fn last_jump(
+    pieces: &[Piece],
+    samples: &Samples,
+    t_s: &[f64],
+    k: usize,
+    window_s: f64,
+) -> Option<usize> {
+    let last = samples.samples[k].piece;
+    let jump = (0..=last)
+        .rev()
+        .find(|&j| pieces[j].kind == SegmentKind::Jump)?;
+    let starts_s = t_s[samples.first[jump]];
+    (starts_s >= t_s[k] - window_s).then_some(jump)
 }
 
 /// Makes `window` last [`FIX_FACTOR`] times longer, the added time given to what it does
@@ -271,12 +518,16 @@ fn step_both(
     reached
 }
 
-/// The tracked routes of `pieces` (slowing them where needed), with the number of fixes; `None`
+/// The tracked routes of `pieces` (slowing them where needed), with the number of fixes that
+/// moved marks off their ticks (the window rule's: waits on a clock are whole ticks); `None`
 /// past the fix budget.
 fn track(
     pieces: &mut [Piece],
     samples: &Samples,
     limits: [Limits; 2],
+    rule: FixRule,
+    cap: &SlowingCap,
+    tick_s: Option<f64>,
     ctx: &JobCtx,
 ) -> Result<Option<(usize, [TrackedAxis; 2])>, OtfError> {
     let n = samples.samples.len();
@@ -285,7 +536,7 @@ fn track(
     };
     let mut sets = [Reachable::default(), Reachable::default()];
     let mut t_s = vec![0.0; n];
-    let mut fixes = Fixes::new(&limits, pieces);
+    let mut fixes = Fixes::new(&limits, pieces, rule, tick_s);
     let mut k = 0;
     while k < n {
         if k == 0 {
@@ -295,7 +546,8 @@ fn track(
                 }
             }
         } else if !step_both(&mut sets, samples, pieces, &limits, &mut t_s, k) {
-            let Some(from) = fixes.slow(pieces, samples, &t_s, k) else {
+            let capped = fixes.added_s > cap.get_s();
+            let Some(from) = fixes.slow(pieces, samples, &t_s, k).filter(|_| !capped) else {
                 return Ok(None);
             };
             if fixes.count % 64 == 0 {
@@ -317,19 +569,23 @@ fn track(
         .collect();
     let [sx, sy] = &sets;
     Ok(Some((
-        fixes.count,
+        fixes.window_count,
         [sx.route(&dt, limits[0]), sy.route(&dt, limits[1])],
     )))
 }
 
-/// Lowers `pieces` with tracked stage routes into `path`: `None` when tracking did not settle
-/// (the caller falls back on the taut route).
+/// Lowers `pieces` with tracked stage routes into `path`, fixing spots the stage cannot reach
+/// by `rule`, giving up once its fixes add more than `cap` (besides the rule's budget): `None`
+/// when tracking did not settle (the caller falls back on the taut route).
+#[allow(clippy::too_many_arguments)]
 pub(super) fn lower_tracked(
     mut pieces: Vec<Piece>,
     path: &mut Toolpath,
     profile: &MachineProfile,
     reach_mm: f64,
     clock_s: Option<f64>,
+    rule: FixRule,
+    cap: &SlowingCap,
     ctx: &JobCtx,
 ) -> Result<Option<()>, OtfError> {
     let tube_mm = reach_mm * (1.0 - TUBE_SLACK);
@@ -338,12 +594,18 @@ pub(super) fn lower_tracked(
         ctx.check()?;
         let mut run = clocked(&pieces, path, clock_s);
         let before: Vec<f64> = run.iter().map(|p| p.duration_s).collect();
-        let samples = Samples::new(&run, path, profile, tube_mm)?;
-        let Some((fixes, [x, y])) = track(&mut run, &samples, limits, ctx)? else {
+        let least_jump_samples = match rule {
+            FixRule::Window => 1,
+            FixRule::WaitFirst => JUMP_SAMPLES,
+        };
+        let samples = Samples::new(&run, path, profile, tube_mm, least_jump_samples)?;
+        // fixes that move marks off their ticks (waits are whole ticks)
+        let Some((off_tick, [x, y])) = track(&mut run, &samples, limits, rule, cap, clock_s, ctx)?
+        else {
             return Ok(None);
         };
         // on a clock, fixes move marks off their ticks: carry them back and align again
-        if fixes == 0 || clock_s.is_none() {
+        if off_tick == 0 || clock_s.is_none() {
             let (x, y) = (AxisRoute::Tracked(x), AxisRoute::Tracked(y));
             install(path, &run, x, y, clock_s);
             let over = overshoots(path, reach_mm, profile.stroke_mm);
