@@ -59,7 +59,8 @@ const WAIT_STEP_S: f64 = 1e-3;
 const WAIT_GROWTH: f64 = 1.25;
 
 /// The longest wait tried on one jump, in fix windows (the time an axis takes to reach full
-/// speed): enough for any rest-to-rest move across the reach.
+/// speed): 0.12 s on seed 002's axes, about a rest-to-rest move across texture.toml's 4 mm
+/// field. Longer waits there only meant the stage had to brake before the jump.
 const WAIT_CAP_WINDOWS: f64 = 0.5;
 
 /// Jumps back from a spot tried for the wait.
@@ -68,19 +69,18 @@ const WAIT_DEPTH: usize = 4;
 /// How much the fix window grows when the same spot fails again.
 const WINDOW_GROWTH: f64 = 1.5;
 
-/// Fixes before tracking gives up and the taut route takes over (the benchmarks need at most
-/// 1,265, texture-10's band sweep).
+/// Fixes before the window rule gives up (the benchmarks need at most 1,265, texture-10's band
+/// sweep).
 const MAX_FIXES: usize = 5_000;
 
 /// Fixes before [`FixRule::WaitFirst`] gives up: its waits grow from a millisecond, so a spot
 /// takes some ten fixes where the window rule takes one or two.
 const MAX_WAIT_FIXES: usize = 1_000_000;
 
-/// Most time the fixes may add (summed over fixes), as a share of the tool's time when
-/// tracking starts: beyond it the stage is crawling from spot to spot (texture.toml's 2 mm
-/// reach gets there after about 1,000 fixes), and the taut route, which waits where it must,
-/// is the better bet. The benchmarks that track add at most 0.96 of it (texture-10's band
-/// sweep), most add less than 0.3.
+/// Most time the window rule's fixes may add (summed over fixes), as a share of the tool's
+/// time when tracking starts: beyond it the stage is crawling from spot to spot (texture.toml's
+/// 2 mm reach gets there after about 1,000 fixes). The benchmarks that track add at most 0.96
+/// of it (texture-10's band sweep), most add less than 0.3.
 const SLOWING_BUDGET: f64 = 1.0;
 
 /// [`SLOWING_BUDGET`] of [`FixRule::WaitFirst`]: its waits are spent only where the stage
@@ -222,10 +222,10 @@ pub(super) enum FixRule {
 }
 
 /// The most time a tracking may add before it gives up, shared between threads: the
-/// wait-first rule runs beside the window rule and stops once it has added more than the
-/// window rule's whole slowing (a job it could then only make slower). Durations only grow
-/// with fixes, so the cap ends only runs that would lose: the job kept does not depend on
-/// which thread finishes first.
+/// wait-first rule runs beside the window rule and stops once the time it has added for good
+/// ([`Fixes::kept_s`]) exceeds the window rule's whole slowing (a job it could then only make
+/// slower). That time never decreases, so the cap ends only runs that would lose: the job
+/// kept does not depend on which thread finishes first.
 #[derive(Debug)]
 pub(super) struct SlowingCap(AtomicU64);
 
@@ -260,6 +260,14 @@ impl FixRule {
         match self {
             Self::Window => SLOWING_BUDGET,
             Self::WaitFirst => WAIT_SLOWING_BUDGET,
+        }
+    }
+
+    /// Least samples on a jump (the window rule's jumps keep their nominal sampling).
+    fn least_jump_samples(self) -> usize {
+        match self {
+            Self::Window => 1,
+            Self::WaitFirst => JUMP_SAMPLES,
         }
     }
 }
@@ -331,11 +339,8 @@ impl Fixes {
         }
     }
 
-    /// Slows the tool before sample `k` (reached at `t_s[k]`); returns the sample to
-    /// propagate again from, `None` past the budget. A new spot first makes the scanner wait
-    /// longer on the last jump before it (growing by [`WAIT_GROWTH`] each time the spot fails
-    /// again); where that reaches [`WAIT_CAP_WINDOWS`] windows without getting past, the wait
-    /// is taken back and the window before the spot is slowed instead.
+    /// Slows the tool before sample `k` (reached at `t_s[k]`) by the rule; returns the sample
+    /// to propagate again from, `None` past the budget.
     fn slow(
         &mut self,
         pieces: &mut [Piece],
@@ -350,6 +355,43 @@ impl Fixes {
         if self.rule == FixRule::Window {
             return Some(self.slow_window(pieces, samples, t_s, k));
         }
+        let spot = self.spot_at(pieces, samples, t_s, k);
+        let Some(wait) = spot.wait else {
+            return Some(self.slow_window(pieces, samples, t_s, k));
+        };
+        if wait.waited_s < WAIT_CAP_WINDOWS * self.base_window_s {
+            return Some(self.wait_longer(pieces, samples, spot, wait));
+        }
+        // waiting there does not get the stage past: take it back, wait on the jump before
+        pieces[wait.piece].duration_s = wait.before_s;
+        self.added_s -= wait.waited_s;
+        let before = (0..wait.piece)
+            .rev()
+            .find(|&j| pieces[j].kind == SegmentKind::Jump)
+            .filter(|_| spot.depth < WAIT_DEPTH);
+        if let Some(before) = before {
+            let earlier = Spot {
+                wait: Some(Wait {
+                    piece: before,
+                    before_s: pieces[before].duration_s,
+                    waited_s: 0.0,
+                    step_s: WAIT_STEP_S,
+                }),
+                depth: spot.depth + 1,
+                ..spot
+            };
+            let from = self.wait_longer(pieces, samples, earlier, earlier.wait?);
+            return Some(from);
+        }
+        self.spot = Some(Spot { wait: None, ..spot });
+        let window_from = self.slow_window(pieces, samples, t_s, k);
+        Some(samples.first[wait.piece].min(window_from))
+    }
+
+    /// The spot sample `k` belongs to: the one being fixed where `k` is not past it, else a
+    /// new spot waiting on the last jump before `k` (going on from the step of the spot before
+    /// where that waited on the same jump).
+    fn spot_at(&mut self, pieces: &[Piece], samples: &Samples, t_s: &[f64], k: usize) -> Spot {
         let spot = match self.spot {
             Some(spot) if k <= spot.sample => spot,
             previous => {
@@ -371,49 +413,40 @@ impl Fixes {
             }
         };
         self.spot = Some(spot);
-        if let Some(wait) = spot.wait {
-            if wait.waited_s < WAIT_CAP_WINDOWS * self.base_window_s {
-                let add_s = self.on_ticks(wait.step_s);
-                pieces[wait.piece].duration_s += add_s;
-                self.added_s += add_s;
-                self.spot = Some(Spot {
-                    wait: Some(Wait {
-                        waited_s: wait.waited_s + add_s,
-                        step_s: wait.step_s * WAIT_GROWTH,
-                        ..wait
-                    }),
-                    ..spot
-                });
-                return Some(samples.first[wait.piece]);
-            }
-            // waiting there does not get the stage past: take it back, wait on the jump before
-            pieces[wait.piece].duration_s = wait.before_s;
-            self.added_s -= wait.waited_s;
-            let from = samples.first[wait.piece];
-            let before = (0..wait.piece)
-                .rev()
-                .find(|&j| pieces[j].kind == SegmentKind::Jump);
-            if let Some(before) = before.filter(|_| spot.depth < WAIT_DEPTH) {
-                let (before_s, add_s) = (pieces[before].duration_s, self.on_ticks(WAIT_STEP_S));
-                pieces[before].duration_s += add_s;
-                self.added_s += add_s;
-                self.spot = Some(Spot {
-                    wait: Some(Wait {
-                        piece: before,
-                        before_s,
-                        waited_s: add_s,
-                        step_s: WAIT_STEP_S * WAIT_GROWTH,
-                    }),
-                    depth: spot.depth + 1,
-                    ..spot
-                });
-                return Some(samples.first[before]);
-            }
-            self.spot = Some(Spot { wait: None, ..spot });
-            let window_from = self.slow_window(pieces, samples, t_s, k);
-            return Some(from.min(window_from));
-        }
-        Some(self.slow_window(pieces, samples, t_s, k))
+        spot
+    }
+
+    /// Adds the next step of `wait` (on whole ticks) to its jump and makes `spot` wait so;
+    /// returns the sample to propagate again from.
+    fn wait_longer(
+        &mut self,
+        pieces: &mut [Piece],
+        samples: &Samples,
+        spot: Spot,
+        wait: Wait,
+    ) -> usize {
+        let add_s = self.on_ticks(wait.step_s);
+        pieces[wait.piece].duration_s += add_s;
+        self.added_s += add_s;
+        self.spot = Some(Spot {
+            wait: Some(Wait {
+                waited_s: wait.waited_s + add_s,
+                step_s: wait.step_s * WAIT_GROWTH,
+                ..wait
+            }),
+            ..spot
+        });
+        samples.first[wait.piece]
+    }
+
+    /// The time added that no later fix takes back, s: all but the wait being tried at the
+    /// current spot. It never decreases, and the job ends at least this much above the tool's
+    /// time, so a cap on it ends only runs that would lose (a cap on all the time added could
+    /// end a run just before a wait is taken back, and which run it ends would then depend on
+    /// when the other thread sets the cap).
+    fn kept_s(&self) -> f64 {
+        let trying_s = self.spot.and_then(|s| s.wait).map_or(0.0, |w| w.waited_s);
+        self.added_s - trying_s
     }
 
     /// A wait of `wait_s`, rounded up to whole ticks on a clock.
@@ -546,8 +579,10 @@ fn track(
                 }
             }
         } else if !step_both(&mut sets, samples, pieces, &limits, &mut t_s, k) {
-            let capped = fixes.added_s > cap.get_s();
-            let Some(from) = fixes.slow(pieces, samples, &t_s, k).filter(|_| !capped) else {
+            if fixes.kept_s() > cap.get_s() {
+                return Ok(None);
+            }
+            let Some(from) = fixes.slow(pieces, samples, &t_s, k) else {
                 return Ok(None);
             };
             if fixes.count % 64 == 0 {
@@ -594,11 +629,7 @@ pub(super) fn lower_tracked(
         ctx.check()?;
         let mut run = clocked(&pieces, path, clock_s);
         let before: Vec<f64> = run.iter().map(|p| p.duration_s).collect();
-        let least_jump_samples = match rule {
-            FixRule::Window => 1,
-            FixRule::WaitFirst => JUMP_SAMPLES,
-        };
-        let samples = Samples::new(&run, path, profile, tube_mm, least_jump_samples)?;
+        let samples = Samples::new(&run, path, profile, tube_mm, rule.least_jump_samples())?;
         // fixes that move marks off their ticks (waits are whole ticks)
         let Some((off_tick, [x, y])) = track(&mut run, &samples, limits, rule, cap, clock_s, ctx)?
         else {
