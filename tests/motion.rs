@@ -670,3 +670,29 @@ fn on_the_fly_beats_step_and_scan_in_a_small_reach() {
     let clocked = galvoplan::pipeline::lower_plan_on(&doc, &plan, Some(1e-3)).unwrap();
     assert_on_the_fly_feasible(&doc, &clocked);
 }
+
+#[test]
+fn on_the_fly_marks_a_cell_with_the_stage_centred_for_its_outer_ring() {
+    // each cell's rings need the stage within 1.5, 1 and 0.5 mm of its centre: the outer ring
+    // goes in the middle, while the stage stands nearest; the middle ring first, as it
+    // arrives; the inner ring last, as it leaves (1.0 / 1.5 / 0.5 mm: a shorter job than the
+    // distance ordering's, which marks the outer ring first or last)
+    let mut doc = texture_cells(16.0);
+    doc.settings.motion = galvoplan::document::MotionMode::OnTheFly;
+    let plan = plan_document(&mut doc, &JobCtx::default()).unwrap();
+    let radius = |g: usize| {
+        let b = doc.geometries[g].bbox();
+        ((b.max_x - b.min_x) / 2.0 * 2.0).round() / 2.0
+    };
+    let cells: Vec<Vec<f64>> = plan
+        .order
+        .chunk_by(|a, b| a.field == b.field)
+        .map(|run| run.iter().map(|s| radius(s.geometry)).collect())
+        .collect();
+    assert!(cells.len() >= 20);
+    for rings in &cells {
+        assert_eq!(rings, &vec![1.0, 1.5, 0.5], "rings in marking order");
+    }
+    let clocked = galvoplan::pipeline::lower_plan_on(&doc, &plan, Some(1e-3)).unwrap();
+    assert_on_the_fly_feasible(&doc, &clocked);
+}

@@ -7,6 +7,7 @@ pub mod cost;
 pub mod hga;
 pub mod hha;
 pub mod metrics;
+mod nested;
 pub mod objective;
 mod passes;
 pub mod time;
@@ -478,11 +479,19 @@ fn faster_on_the_fly(
     let field_mm = lower.inputs.profile.field_mm;
     let band_mm = field_mm[0].min(field_mm[1]);
     let bands = bands::band_order(lower.geometries, lower.fields, band_mm, lower.ctx)?;
-    if bands.steps == ordering.steps {
-        return Ok((ordering, by_fields));
+    let mut best = (ordering, by_fields);
+    if bands.steps != best.0.steps {
+        let by_bands = lower.toolpath(&bands)?;
+        best = faster(best, (bands, by_bands));
     }
-    let by_bands = lower.toolpath(&bands)?;
-    Ok(faster((ordering, by_fields), (bands, by_bands)))
+    let profile = &lower.inputs.profile;
+    let reach_mm = field_mm[0].min(field_mm[1]) / 2.0 - profile.otf_margin_mm;
+    let centred = nested::nested_centred(&best.0, lower.geometries, reach_mm);
+    if let Some(centred) = centred.filter(|_| !lower.ctx.is_cancelled()) {
+        let by_centred = lower.toolpath(&centred)?;
+        best = faster(best, (centred, by_centred));
+    }
+    Ok(best)
 }
 
 /// The fields of `order` (ids) in that order.
