@@ -150,8 +150,11 @@ fn cancel_returns_the_best_plan_so_far_quickly() {
         .unwrap()
         .expect("a cancelled HGA still returns its best plan");
     let latency = done.saturating_duration_since(asked);
+    // the GA checks for a cancel between generations and its lowerings (a few ms alone); the
+    // bound is loose because the whole suite shares two cores here, and a run that ignored the
+    // cancel would go on for seconds (it passed 200 ms alone, failed it under the full suite)
     assert!(
-        latency < Duration::from_millis(200),
+        latency < Duration::from_millis(1_000),
         "cancel took {latency:?}"
     );
     common::check_plan(&doc, &plan);
