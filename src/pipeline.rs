@@ -420,6 +420,7 @@ fn relower(doc: &Document, plan: &mut Plan) -> Result<Toolpath, PipelineError> {
         solve_s: std::mem::take(&mut plan.metrics.solve_s),
         fields_lower_bound: plan.metrics.fields_lower_bound,
         motion_note: plan.metrics.motion_note.take(),
+        motion_regions: toolpath.motion_regions(),
         ..m
     };
     Ok(toolpath)
@@ -630,7 +631,7 @@ fn whole_or_cut(
         .push(choice_warning(format!("{CHOICE_PREFIX}{note}")));
     made.0.geometry_rev = doc.geometry_rev;
     made.0.settings.motion = doc.settings.motion;
-    made.0.name = doc.settings.plan_title_as(made.0.motion);
+    made.0.name = doc.settings.title_of(&made.0);
     Ok((lower_bound, reusable.then_some(made)))
 }
 

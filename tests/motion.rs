@@ -696,3 +696,106 @@ fn on_the_fly_marks_a_cell_with_the_stage_centred_for_its_outer_ring() {
     let clocked = galvoplan::pipeline::lower_plan_on(&doc, &plan, Some(1e-3)).unwrap();
     assert_on_the_fly_feasible(&doc, &clocked);
 }
+
+#[test]
+fn a_mixed_job_holds_the_stage_still_while_its_step_and_scan_fields_are_marked() {
+    // demo.svg on the fly, with every other field of its order (those whose strokes one stage
+    // position reaches) marked step-and-scan (issue 26 item 3)
+    let settings = SolverSettings {
+        motion: galvoplan::document::MotionMode::OnTheFly,
+        ..SolverSettings::default()
+    };
+    let (doc, mut plan) = plan_example("demo.svg", MachineProfile::default(), settings);
+    let reach_mm = galvoplan::motion::still_reach_mm(&plan.profile).unwrap();
+    let fits = |field: usize| {
+        let boxes = plan.order.iter().filter(|s| s.field == field);
+        let (lo, hi) = boxes.fold(([f64::MAX; 2], [f64::MIN; 2]), |(lo, hi), s| {
+            let b = doc.geometries[s.geometry].bbox();
+            (
+                [lo[0].min(b.min_x), lo[1].min(b.min_y)],
+                [hi[0].max(b.max_x), hi[1].max(b.max_y)],
+            )
+        });
+        hi[0] - lo[0] < 1.9 * reach_mm && hi[1] - lo[1] < 1.9 * reach_mm
+    };
+    let chosen: Vec<usize> = plan
+        .fields
+        .iter()
+        .map(|f| f.id)
+        .filter(|&f| fits(f))
+        .step_by(2)
+        .collect();
+    assert!(chosen.len() >= 2, "{chosen:?}");
+    let flying = lower_plan(&doc, &plan).unwrap();
+    plan.step_fields = chosen.clone();
+    let path = lower_plan(&doc, &plan).unwrap();
+    assert_eq!(path.strokes.len(), flying.strokes.len());
+    let mut sorted = chosen.clone();
+    sorted.sort_unstable();
+    assert_eq!(
+        path.still_fields, sorted,
+        "the toolpath names its still fields"
+    );
+    assert!(flying.still_fields.is_empty());
+    let regions = path.motion_regions();
+    let still: Vec<_> = regions
+        .iter()
+        .filter(|r| r.motion == galvoplan::document::Motion::Step)
+        .collect();
+    assert!(still.len() >= chosen.len(), "{regions:?}");
+    assert!(regions
+        .iter()
+        .any(|r| r.motion == galvoplan::document::Motion::OnTheFly));
+    assert!((regions.last().unwrap().end_s - path.duration_s()).abs() < 1e-9);
+    // the step rule in every step-and-scan stretch: the stage does not move while the laser is
+    // on (sampled every 0.1 ms, strictly inside: the region starts where the mark before it
+    // ends, and that instant belongs to the mark)
+    let mut samples_on = 0;
+    for r in &still {
+        let mut at: Option<Pt> = None;
+        let n = ((r.end_s - r.start_s) / 1e-4).ceil() as usize;
+        for k in 0..n {
+            let m = path.state_at(r.start_s + (k as f64 + 0.5) * (r.end_s - r.start_s) / n as f64);
+            if !m.laser {
+                continue;
+            }
+            samples_on += 1;
+            let first = *at.get_or_insert(m.stage);
+            assert!(
+                m.stage.dist(first) < 1e-6,
+                "field {:?}: the stage moved {} mm while marking",
+                r.fields,
+                m.stage.dist(first)
+            );
+        }
+    }
+    assert!(samples_on > 100);
+    // the jumps into and out of them are the scanner's own, at most at jump speed
+    for seg in &path.segments {
+        if let galvoplan::motion::ScanMotion::Line { from, to, move_s } = seg.scan {
+            let speed = from.dist(to) / move_s;
+            assert!(
+                speed <= plan.profile.scanner.jump_speed_mm_s * (1.0 + 1e-5),
+                "{speed}"
+            );
+        }
+    }
+    // every on-the-fly limit on the controller clock (sampled every millisecond, the
+    // unclocked job's short jumps between marks would fall between samples); the trajectory
+    // is left in the temp folder for
+    // ../shared/tools/check_trajectory.py (demo.svg, assets/profiles/seed000.toml, --mode otf)
+    let clocked = galvoplan::pipeline::lower_plan_on(&doc, &plan, Some(1e-3)).unwrap();
+    assert_on_the_fly_feasible(&doc, &clocked);
+    let csv = trajectory_csv(&clocked, 1e-3);
+    assert!(csv.starts_with(TRAJECTORY_HEADER));
+    std::fs::write(std::env::temp_dir().join("galvoplan-mixed-demo.csv"), csv).unwrap();
+    // the G-code says how each field runs
+    let gcode = write_gcode(&path, &plan, doc.page_mm[1], "t").unwrap();
+    let step_comments = gcode
+        .lines()
+        .filter(|l| l.ends_with("step-and-scan (the stage at rest)"));
+    assert!(step_comments.count() >= chosen.len());
+    assert!(gcode
+        .lines()
+        .any(|l| l.starts_with("; field") && l.ends_with(", on the fly")));
+}

@@ -98,6 +98,7 @@ pub fn run(a: &PlanArgs) -> Result<()> {
         plan.metrics.job_time_s = Some(toolpath.duration_s());
         plan.metrics.job_time_breakdown_s = Some(toolpath.breakdown());
         plan.metrics.motion = Some(toolpath.motion_figures(p));
+        plan.metrics.motion_regions = toolpath.motion_regions();
         trajectory_csv(&toolpath, p)
     });
     let waypoints = a.waypoints.as_ref().map(|_| waypoints_csv(&toolpath));

@@ -26,8 +26,8 @@ pub use pens::{
     PensError, DEFAULT_LAYER, MAX_PASSES, PENS_VERSION,
 };
 pub use plan::{
-    GenerationRecord, Metrics, MotionFigures, ObjectiveKind, Plan, ScanField, StageTimes, Step,
-    TimeBreakdown,
+    GenerationRecord, Metrics, MotionFigures, MotionRegion, ObjectiveKind, Plan, ScanField,
+    StageTimes, Step, TimeBreakdown,
 };
 pub use profile::{
     AxisLimits, Controller, ControllerKind, GcodeDialect, GcodeMode, LaserTiming, MachineProfile,

@@ -141,6 +141,22 @@ pub struct MotionFigures {
     pub scan_peak_offset_mm: f64,
 }
 
+/// A stretch of a mixed job run in one motion: consecutive strokes of one field marked
+/// step-and-scan, or the strokes between such fields marked on the fly.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MotionRegion {
+    /// How it runs.
+    pub motion: Motion,
+    /// The ids of its fields, in visiting order.
+    pub fields: Vec<usize>,
+    /// Its strokes in marking order: `[first, end)` (indices into the report's `order`).
+    pub strokes: [usize; 2],
+    /// When it starts (the end of the mark before it; 0 for the first), s.
+    pub start_s: f64,
+    /// When it ends (the end of its last mark; the job's end for the last), s.
+    pub end_s: f64,
+}
+
 /// Metrics of a plan (definitions in DESIGN.md and `order::metrics`).
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct Metrics {
@@ -168,6 +184,10 @@ pub struct Metrics {
     /// The stage's route, its speeds and the scanner's reach, sampled every millisecond.
     #[serde(default)]
     pub motion: Option<MotionFigures>,
+    /// A mixed job's stretches, each in its motion, in job order (empty: the whole job runs
+    /// the plan's one motion).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub motion_regions: Vec<MotionRegion>,
     /// Wall time per stage, s.
     pub solve_s: StageTimes,
     /// Why a solve that may choose its motion planned only this one (none: it planned every
@@ -276,6 +296,11 @@ pub struct Plan {
     /// current setting (projects from before on-the-fly marking are step-and-scan).
     #[serde(default)]
     pub motion: Motion,
+    /// Mixed motion (on the fly only): the ids of the fields marked step-and-scan inside the
+    /// on-the-fly job, the stage at rest while their strokes are marked and moving between
+    /// them (issue 26). Empty: the whole job runs [`Plan::motion`].
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub step_fields: Vec<usize>,
     /// On the fly with seed 001's routes (`lsa`, `cetsp-ga`): the stage route the lowering
     /// follows (none: the taut string, computed by the lowering itself).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -323,6 +348,7 @@ impl Plan {
             metrics: Metrics::default(),
             history: Vec::new(),
             motion,
+            step_fields: Vec::new(),
             stage_route: None,
             layers: inputs.layers.clone(),
             profile: inputs.profile.clone(),
@@ -330,6 +356,17 @@ impl Plan {
             geometry_rev: inputs.geometry_rev,
             tiling: None,
             seams: Default::default(),
+        }
+    }
+    /// How the plan runs, in words: its motion, and for a mixed job how many of its fields
+    /// are marked step-and-scan.
+    pub fn motion_words(&self) -> String {
+        match (self.motion, self.step_fields.len()) {
+            (Motion::OnTheFly, n) if n > 0 => format!(
+                "mixed: on the fly, {n} of {} fields step-and-scan",
+                self.fields.len()
+            ),
+            (motion, _) => motion.words().to_string(),
         }
     }
     /// The pen of geometry `g` in this plan (none: the profile's settings).

@@ -56,10 +56,19 @@ impl SolverSettings {
     /// [`MotionMode::Auto`] it says which motion the solve chose, e.g.
     /// `HHA · job time · auto: on the fly · seed 1`.
     pub fn plan_title_as(&self, motion: Motion) -> String {
-        self.title_with(Some(motion))
+        self.title_with(Some(self.motion_words(motion)))
     }
 
-    fn title_with(&self, chosen: Option<Motion>) -> String {
+    /// The title of `plan` made with these settings: [`Self::plan_title_as`] its motion, a
+    /// mixed job's in its own words ([`super::Plan::motion_words`]).
+    pub fn title_of(&self, plan: &super::Plan) -> String {
+        match plan.step_fields.is_empty() {
+            true => self.plan_title_as(plan.motion),
+            false => self.title_with(Some(plan.motion_words())),
+        }
+    }
+
+    fn title_with(&self, chosen: Option<String>) -> String {
         let algo = match self.algo {
             Algo::AsIs => "As-is",
             Algo::Baseline => "Baseline",
@@ -75,7 +84,7 @@ impl SolverSettings {
         };
         let cost = words("cost_model");
         let motion = match (self.motion, chosen) {
-            (MotionMode::Auto, Some(m)) => format!("auto: {}", self.motion_words(m)),
+            (MotionMode::Auto, Some(m)) => format!("auto: {m}"),
             (MotionMode::Auto, None) => words("motion"),
             (MotionMode::Step, _) => self.motion_words(Motion::Step),
             (MotionMode::OnTheFly, _) => self.motion_words(Motion::OnTheFly),

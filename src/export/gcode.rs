@@ -204,7 +204,21 @@ pub fn write_gcode_to(
                 Some(n) => n.to_string(),
                 None => format!("[id {}]", stroke.field),
             };
-            let _ = writeln!(out, "; field {label} centre {} {}", w.num(c.x), w.num(c.y));
+            // a mixed job says how each field runs
+            let how = match (
+                plan.step_fields.is_empty(),
+                plan.step_fields.contains(&stroke.field),
+            ) {
+                (true, _) => "",
+                (false, true) => ", step-and-scan (the stage at rest)",
+                (false, false) => ", on the fly",
+            };
+            let _ = writeln!(
+                out,
+                "; field {label} centre {} {}{how}",
+                w.num(c.x),
+                w.num(c.y)
+            );
             if stage_scanner {
                 let _ = writeln!(out, "G0 {}", w.xy(["X", "Y"], c));
             }

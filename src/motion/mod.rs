@@ -32,7 +32,7 @@ pub use axis::{AxisMove, StageDynamics, StageMove};
 pub use blend::CornerBlends;
 pub use clock::ticks_covering;
 pub use lower::{lower, LowerError, REACH_TOLERANCE_MM};
-pub use otf::{lower_on_the_fly, OtfError};
+pub use otf::{lower_on_the_fly, still_reach_mm, OtfError};
 pub use route::{AxisRoute, SmoothedAxis, StageRoute};
 pub use seed_routes::plan_stage_route;
 pub use toolpath::{

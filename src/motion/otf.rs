@@ -133,6 +133,15 @@ pub enum OtfError {
         /// `x` or `y`.
         axis: char,
     },
+    /// A mixed job (fields marked step-and-scan inside it) whose stage could not be tracked:
+    /// only the tracked route stops the stage for a field.
+    #[error(
+        "the stage cannot be tracked through the job with {fields} fields marked step-and-scan"
+    )]
+    MixedNotTracked {
+        /// How many fields the plan marks step-and-scan.
+        fields: usize,
+    },
     /// The route could not be computed.
     #[error("stage route: {0}")]
     Route(#[from] TautError),
@@ -157,12 +166,30 @@ enum Tool {
     },
 }
 
+/// What the stage may do during a piece: a mixed job marks some fields step-and-scan
+/// ([`Plan::step_fields`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+enum PieceStage {
+    /// On its route, keeping the tool within the scanner's reach.
+    #[default]
+    Moving,
+    /// At rest: a piece of a field marked step-and-scan (its laser delays, marks, the jumps
+    /// between its strokes and the settle after the stage stopped).
+    Still,
+    /// A jump into or out of a still stretch, in the scanner's own frame as step-and-scan
+    /// jumps while the stage moves: only its ends are tied to the tool, the scanner moves
+    /// straight between its offsets there, at most at jump speed.
+    FreeJump,
+}
+
 /// A piece of the tool's time law.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Piece {
     kind: SegmentKind,
     duration_s: f64,
     tool: Tool,
+    /// What the stage may do meanwhile.
+    stage: PieceStage,
     geometry: usize,
     /// Half-width of the route's tube at this piece's knots, mm.
     tube_mm: f64,
@@ -190,6 +217,12 @@ pub fn lower_on_the_fly(
     let corner_mm = CORNER_SHARE * reach_mm;
     let tube_mm = reach_mm * (1.0 - TUBE_SLACK);
     let mut pieces = tool_pieces(geometries, plan, profile, tube_mm, &mut path)?;
+    let mixed = pieces.iter().any(|p| p.stage != PieceStage::Moving);
+    if mixed {
+        path.still_fields = plan.step_fields.clone();
+        path.still_fields.sort_unstable();
+        path.still_fields.dedup();
+    }
     let follow = plan.stage_route.as_ref();
     // seed 001's routes are followed on the taut route, as measured for the paper's benchmark
     // (docs/BENCHMARKS.md); tracking inside their ±1 mm band is not measured
@@ -199,6 +232,11 @@ pub fn lower_on_the_fly(
         {
             return Ok(tracked);
         }
+    }
+    if mixed {
+        return Err(OtfError::MixedNotTracked {
+            fields: plan.step_fields.len(),
+        });
     }
     let full_speed = [
         profile.axis_x.max_velocity_mm_s,
@@ -298,6 +336,9 @@ fn lower_tracked_faster(
         || by(tracking::FixRule::WaitFirst, &cap),
     );
     Ok(match (window?, wait_first?) {
+        // nothing slowed: the wait-first rule stops as soon as it sees that, and whether it
+        // had finished first must not decide the job (a rounding difference could)
+        (Some(w), _) if w.duration_s() - tool_s <= tracking::NO_SLOWING_S => Some(w),
         (Some(w), Some(f)) if f.duration_s() < w.duration_s() => Some(f),
         (Some(w), _) => Some(w),
         (None, f) => f,
@@ -475,6 +516,13 @@ fn reach_mm(profile: &MachineProfile) -> Result<f64, OtfError> {
     }
 }
 
+/// Half-width of the box the tool may cover on each axis while the stage stands still on the
+/// fly (a field marked step-and-scan in a mixed job), mm: the tracked route's tube. None: the
+/// profile leaves no reach.
+pub fn still_reach_mm(profile: &MachineProfile) -> Option<f64> {
+    reach_mm(profile).ok().map(|r| r * (1.0 - TUBE_SLACK))
+}
+
 /// The fastest route speed whose smoothing departs at most `allowance_mm`: `v² / (2a) ≤ δ`.
 fn speed_cap_mm_s(axis: &AxisLimits, allowance_mm: f64) -> f64 {
     axis.max_velocity_mm_s
@@ -482,7 +530,10 @@ fn speed_cap_mm_s(axis: &AxisLimits, allowance_mm: f64) -> f64 {
 }
 
 /// The tool's time law: per stroke a jump (from the second on), the jump delay, the laser-on
-/// delay, the mark, the laser-off delay. Adds the strokes to `path`.
+/// delay, the mark, the laser-off delay. Adds the strokes to `path`. The strokes of
+/// [`Plan::step_fields`] are [`PieceStage::Still`] (with the profile's settle time after the
+/// jump into each stretch of them), the jumps into and out of such a stretch
+/// [`PieceStage::FreeJump`].
 fn tool_pieces(
     geometries: &[Geometry],
     plan: &Plan,
@@ -493,6 +544,9 @@ fn tool_pieces(
     let (laser, scanner) = (&profile.laser, &profile.scanner);
     let mut pieces = Vec::new();
     let mut last_end: Option<Pt> = None;
+    // the field of the stroke before, and whether it was marked still
+    let mut last_still: Option<(usize, bool)> = None;
+    let settle_s = profile.axis_x.settle_s.max(profile.axis_y.settle_s);
     for (k, step) in plan.order.iter().enumerate() {
         let geometry = step.geometry;
         let g = geometries
@@ -503,7 +557,21 @@ fn tool_pieces(
             continue;
         };
         let stroke = path.push_stroke(k, geometry, step.field, Pt::default(), &points);
-        let mut piece = |kind, duration_s: f64, tool| {
+        let still = plan.step_fields.contains(&step.field);
+        let stage = if still {
+            PieceStage::Still
+        } else {
+            PieceStage::Moving
+        };
+        // the jump to this stroke: within a still field still, into or out of one free
+        let jump_stage = match last_still {
+            Some((field, true)) if still && field == step.field => PieceStage::Still,
+            Some((_, was_still)) if was_still || still => PieceStage::FreeJump,
+            _ => stage,
+        };
+        let entering = still && last_end.is_some() && jump_stage != PieceStage::Still;
+        last_still = Some((step.field, still));
+        let mut piece = |kind, duration_s: f64, tool, stage| {
             if duration_s > 0.0 {
                 let nominal_start_s = pieces
                     .last()
@@ -512,6 +580,7 @@ fn tool_pieces(
                     kind,
                     duration_s,
                     tool,
+                    stage,
                     geometry,
                     tube_mm,
                     origin: pieces.len(),
@@ -522,17 +591,26 @@ fn tool_pieces(
         };
         if let Some(from) = last_end {
             let jump_s = from.dist(start) / scanner.jump_speed_mm_s;
-            piece(SegmentKind::Jump, jump_s, Tool::Line(from, start));
             piece(
-                SegmentKind::JumpDelay,
-                laser.jump_delay_s,
-                Tool::Hold(start),
+                SegmentKind::Jump,
+                jump_s,
+                Tool::Line(from, start),
+                jump_stage,
             );
+        }
+        if entering {
+            // the stage settles where it stopped, as step-and-scan's does after a move
+            piece(SegmentKind::Settle, settle_s, Tool::Hold(start), stage);
+        }
+        if last_end.is_some() {
+            let hold = Tool::Hold(start);
+            piece(SegmentKind::JumpDelay, laser.jump_delay_s, hold, stage);
         }
         piece(
             SegmentKind::LaserOnDelay,
             laser.on_delay_s,
             Tool::Hold(start),
+            stage,
         );
         let mark_speed_mm_s = plan.mark_speed_mm_s(g, profile);
         for (start_frac, end_frac) in stroke_parts(path, stroke) {
@@ -542,12 +620,13 @@ fn tool_pieces(
                 start_frac,
                 end_frac,
             };
-            piece(SegmentKind::Mark, part_mm / mark_speed_mm_s, tool);
+            piece(SegmentKind::Mark, part_mm / mark_speed_mm_s, tool, stage);
         }
         piece(
             SegmentKind::LaserOffDelay,
             laser.off_delay_s,
             Tool::Hold(end),
+            stage,
         );
         last_end = Some(end);
     }
@@ -950,6 +1029,16 @@ fn push_segments(path: &mut Toolpath, pieces: &[Piece], pad_s: f64) {
     for piece in pieces {
         let scan = match piece.tool {
             Tool::Hold(p) => ScanMotion::TcpHold(p),
+            // in the scanner's frame: straight between the offsets at its ends
+            Tool::Line(from, to) if piece.stage == PieceStage::FreeJump => {
+                let stage_at =
+                    |t: f64| path.route.as_ref().map_or(Pt::default(), |r| r.position(t));
+                ScanMotion::Line {
+                    from: from.minus(stage_at(t_s)),
+                    to: to.minus(stage_at(t_s + piece.duration_s)),
+                    move_s: piece.duration_s,
+                }
+            }
             Tool::Line(from, to) => ScanMotion::TcpLine {
                 from,
                 to,

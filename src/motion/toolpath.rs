@@ -4,7 +4,7 @@
 use super::axis::StageMove;
 use super::clock::MarkClock;
 use super::route::StageRoute;
-use crate::document::{MotionFigures, TimeBreakdown};
+use crate::document::{Motion, MotionFigures, MotionRegion, TimeBreakdown};
 use crate::geom::Pt;
 use std::ops::Range;
 
@@ -157,6 +157,9 @@ pub struct Toolpath {
     /// The controller runs this on-the-fly job this many times slower than it was planned
     /// ([`Toolpath::stretched`]); none: as planned.
     pub stretch: Option<f64>,
+    /// A mixed job (on the fly): the ids of the fields whose strokes are marked with the stage
+    /// at rest, ascending ([`crate::document::Plan::step_fields`]); empty: one motion.
+    pub still_fields: Vec<usize>,
     /// Tool-centre points of all strokes, concatenated.
     points: Vec<Pt>,
     /// Arc length from each stroke's first point to each point, mm (parallel to `points`).
@@ -220,6 +223,7 @@ impl Toolpath {
             strokes: self.strokes.clone(),
             route: None,
             stretch: None,
+            still_fields: self.still_fields.clone(),
             points: self.points.clone(),
             arc_mm: self.arc_mm.clone(),
         };
@@ -340,6 +344,63 @@ impl Toolpath {
             last = Some((m.stage, speed_mm_s));
         }
         f
+    }
+
+    /// Whether the strokes of field `id` are marked with the stage at rest inside an
+    /// on-the-fly job (a mixed job's step-and-scan field).
+    pub fn marks_still(&self, id: usize) -> bool {
+        self.still_fields.binary_search(&id).is_ok()
+    }
+
+    /// The stretches of a mixed job ([`Toolpath::still_fields`] marked step-and-scan, the rest
+    /// on the fly), in job order; empty when it runs one motion.
+    pub fn motion_regions(&self) -> Vec<MotionRegion> {
+        if self.still_fields.is_empty() {
+            return Vec::new();
+        }
+        let mut ends_s = vec![0.0; self.strokes.len()];
+        for seg in &self.segments {
+            if let ScanMotion::Mark { stroke, .. } = seg.scan {
+                if let Some(e) = ends_s.get_mut(stroke) {
+                    *e = seg.end_s();
+                }
+            }
+        }
+        let mut regions: Vec<MotionRegion> = Vec::new();
+        for (k, stroke) in self.strokes.iter().enumerate() {
+            let motion = match self.marks_still(stroke.field) {
+                true => Motion::Step,
+                false => Motion::OnTheFly,
+            };
+            // a still field is a region of its own; strokes on the fly run together
+            let joins = regions.last().is_some_and(|r| {
+                r.motion == motion
+                    && (motion == Motion::OnTheFly || r.fields.last() == Some(&stroke.field))
+            });
+            match regions.last_mut() {
+                Some(r) if joins => {
+                    if r.fields.last() != Some(&stroke.field) {
+                        r.fields.push(stroke.field);
+                    }
+                    r.strokes[1] = k + 1;
+                    r.end_s = ends_s[k];
+                }
+                _ => {
+                    let start_s = regions.last().map_or(0.0, |r| r.end_s);
+                    regions.push(MotionRegion {
+                        motion,
+                        fields: vec![stroke.field],
+                        strokes: [k, k + 1],
+                        start_s,
+                        end_s: ends_s[k],
+                    });
+                }
+            }
+        }
+        if let Some(last) = regions.last_mut() {
+            last.end_s = self.duration_s();
+        }
+        regions
     }
 
     /// The index of the segment running at `t_s` (the last one starting at or before it;

@@ -174,13 +174,16 @@ impl Reachable {
     }
 
     /// Adds the set after `dt_s` more, inside `[lower, upper]` (already narrowed for the
-    /// parabola between samples).
+    /// parabola between samples); `still`: at rest there (the set is clipped to speed zero:
+    /// from one still sample to the next the acceleration is zero too, so the axis does not
+    /// move at all between them).
     pub fn step(
         &mut self,
         dt_s: f64,
         lower_mm: f64,
         upper_mm: f64,
         limits: Limits,
+        still: bool,
     ) -> Result<(), Unreachable> {
         let sample = self.len();
         let Some(last) = self.len().checked_sub(1) else {
@@ -196,8 +199,9 @@ impl Reachable {
         let mut set = sum_with_segment(&sheared, d);
         set = clip(set, 0, lower_mm, true);
         set = clip(set, 0, upper_mm, false);
-        set = clip(set, 1, -limits.v_max_mm_s, true);
-        set = clip(set, 1, limits.v_max_mm_s, false);
+        let v_max_mm_s = if still { 0.0 } else { limits.v_max_mm_s };
+        set = clip(set, 1, -v_max_mm_s, true);
+        set = clip(set, 1, v_max_mm_s, false);
         if set.is_empty() {
             return Err(Unreachable { sample });
         }
@@ -491,7 +495,7 @@ mod tests {
         sets.start(centre(0.0) - h + eps, centre(0.0) + h - eps)?;
         for k in 1..n {
             let c = centre(k as f64 * dt);
-            sets.step(dt, c - h + eps, c + h - eps, LIMITS)?;
+            sets.step(dt, c - h + eps, c + h - eps, LIMITS, false)?;
         }
         Ok(sets.route(&vec![dt; n - 1], LIMITS))
     }

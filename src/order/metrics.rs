@@ -58,6 +58,7 @@ pub fn compute(
         job_time_s: Some(toolpath.duration_s()),
         job_time_breakdown_s: Some(toolpath.breakdown()),
         motion: Some(motion),
+        motion_regions: Vec::new(),
         solve_s: Default::default(),
         motion_note: None,
     }

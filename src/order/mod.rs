@@ -7,6 +7,7 @@ pub mod cost;
 pub mod hga;
 pub mod hha;
 pub mod metrics;
+mod mixed;
 mod nested;
 pub mod objective;
 mod passes;
@@ -71,6 +72,8 @@ pub fn order_plan(
     let t0 = std::time::Instant::now();
     let mut detail = Vec::new();
     let mut best: Option<Made> = None;
+    // under auto, the on-the-fly plan when step-and-scan was faster (a mixed job starts from it)
+    let mut flying: Option<Made> = None;
     let mut motion_note = None;
     // HGA under auto: the motion is chosen on finished HHA plans, the GA then runs in it alone
     let hga_after = settings.algo == Algo::Hga && motions.len() > 1;
@@ -104,14 +107,19 @@ pub fn order_plan(
             Err(e) => return Err(e),
         };
         note_stages(&mut detail, motion, motions.len() > 1, stages);
+        let made = Made {
+            motion,
+            ordering: made.0,
+            toolpath: made.1,
+            history: made.2,
+            step_fields: Vec::new(),
+        };
         best = Some(match best {
-            Some(b) if b.toolpath.duration_s() <= made.1.duration_s() => b,
-            _ => Made {
-                motion,
-                ordering: made.0,
-                toolpath: made.1,
-                history: made.2,
-            },
+            Some(b) if b.toolpath.duration_s() <= made.toolpath.duration_s() => {
+                flying = Some(made).filter(|m| m.motion == Motion::OnTheFly);
+                b
+            }
+            _ => made,
         });
     }
     let mut best = best.ok_or(OrderError::Unallocated(0, 0))?;
@@ -128,11 +136,39 @@ pub fn order_plan(
             ordering,
             toolpath,
             history,
+            step_fields: Vec::new(),
         };
+    }
+    // auto: fields of the on-the-fly plan marked step-and-scan, where that is faster
+    if motions.len() > 1 {
+        let t = std::time::Instant::now();
+        let from = match (&best, &flying) {
+            (b, _) if b.motion == Motion::OnTheFly => Some(b),
+            (_, f) => f.as_ref(),
+        };
+        let mixed = match from {
+            Some(from) => match mixed::faster_mixed(&nodes, inputs, from, ctx) {
+                Ok(m) => m.map(|(fields, toolpath)| Made {
+                    motion: Motion::OnTheFly,
+                    ordering: from.ordering.clone(),
+                    toolpath,
+                    history: from.history.clone(),
+                    step_fields: fields,
+                }),
+                Err(OrderError::Cancelled(_)) => None,
+                Err(e) => return Err(e),
+            },
+            None => None,
+        };
+        detail.push(("mixed".into(), t.elapsed().as_secs_f64()));
+        if let Some(m) = mixed.filter(|m| m.toolpath.duration_s() < best.toolpath.duration_s()) {
+            best = m;
+        }
     }
     let order_s = t0.elapsed().as_secs_f64();
     let lower = Candidates::new(&nodes, inputs, best.motion, ctx);
     let mut plan = lower.plan(&best.ordering);
+    plan.step_fields = best.step_fields;
     let mut m = metrics::compute(
         geometries,
         &plan.fields,
@@ -142,8 +178,9 @@ pub fn order_plan(
     );
     m.solve_s.order = order_s;
     m.solve_s.order_detail = detail;
-    plan.name = settings.plan_title_as(best.motion);
+    plan.name = settings.title_of(&plan);
     m.motion_note = motion_note;
+    m.motion_regions = best.toolpath.motion_regions();
     plan.metrics = m;
     plan.history = best.history;
     Ok((plan, best.toolpath))
@@ -184,12 +221,14 @@ fn flying_cannot_gain(nodes: &Nodes, inputs: &PlanInputs, step_s: f64) -> Option
     })
 }
 
-/// A finished candidate plan: its motion, ordering, toolpath and GA history.
+/// A finished candidate plan: its motion, ordering, toolpath and GA history, and on the fly
+/// the fields it marks step-and-scan ([`Plan::step_fields`]).
 struct Made {
     motion: Motion,
     ordering: Ordering,
     toolpath: Toolpath,
     history: Vec<GenerationRecord>,
+    step_fields: Vec<usize>,
 }
 
 /// Adds one motion's stage times to the solve's detail (named after the motion when a solve
@@ -431,13 +470,24 @@ impl<'a> Candidates<'a> {
     /// gets its toolpath; a cancel during the lowering itself (on the fly, seconds on large
     /// jobs) stops it.
     fn toolpath(&self, ordering: &Ordering) -> Result<Toolpath, OrderError> {
+        self.toolpath_with(ordering, &[])
+    }
+    /// The toolpath of an ordering with `step_fields` marked step-and-scan (on the fly: a
+    /// mixed job; [`Plan::step_fields`]).
+    fn toolpath_with(
+        &self,
+        ordering: &Ordering,
+        step_fields: &[usize],
+    ) -> Result<Toolpath, OrderError> {
+        let mut plan = self.plan(ordering);
+        plan.step_fields = step_fields.to_vec();
         let finish = JobCtx::default();
         let ctx = if self.ctx.is_cancelled() {
             &finish
         } else {
             self.ctx
         };
-        match lower_motion(self.real, &self.plan(ordering), None, ctx) {
+        match lower_motion(self.real, &plan, None, ctx) {
             Err(MotionError::OnTheFly(OtfError::Cancelled(c))) => Err(OrderError::Cancelled(c)),
             other => Ok(other?),
         }
@@ -469,27 +519,54 @@ fn run_algorithm(
     })
 }
 
-/// On the fly: the algorithm's ordering or the sweep of field-wide bands
-/// ([`bands::band_order`]), whichever runs faster on the taut route, with that toolpath.
+/// On the fly: the algorithm's ordering, the sweep of field-wide bands
+/// ([`bands::band_order`]) or either with its nested rings centred
+/// ([`nested::nested_centred`]), whichever runs faster on the taut route, with that toolpath.
 fn faster_on_the_fly(
     lower: &Candidates,
     ordering: Ordering,
 ) -> Result<(Ordering, Toolpath), OrderError> {
-    let by_fields = lower.toolpath(&ordering)?;
     let field_mm = lower.inputs.profile.field_mm;
     let band_mm = field_mm[0].min(field_mm[1]);
     let bands = bands::band_order(lower.geometries, lower.fields, band_mm, lower.ctx)?;
-    let mut best = (ordering, by_fields);
-    if bands.steps != best.0.steps {
-        let by_bands = lower.toolpath(&bands)?;
-        best = faster(best, (bands, by_bands));
+    let bands = (bands.steps != ordering.steps).then_some(bands);
+    let reach_mm = band_mm / 2.0 - lower.inputs.profile.otf_margin_mm;
+    let nest = |o: &Ordering| nested::nested_centred(o, lower.geometries, reach_mm);
+    let lowered = |o: Option<Ordering>| -> Result<Option<(Ordering, Toolpath)>, OrderError> {
+        match o.filter(|_| !lower.ctx.is_cancelled()) {
+            Some(o) => lower.toolpath(&o).map(|t| Some((o, t))),
+            None => Ok(None),
+        }
+    };
+    let centred = nest(&ordering);
+    // the lowerings side by side where the stage stops and goes (texture.toml: the wait-first
+    // tracking leaves the second core idle once the window rule has given up; 23.6 -> 17.6 s,
+    // 1.1 GB at the peak against 0.7): the algorithm's ordering, the bands and each one's rings
+    // centred. One after another elsewhere (side by side, the patterns' whole and cut
+    // candidates, already in parallel, took longer) and on large jobs, with the rings centred
+    // on the faster of the two orderings only.
+    if centred.is_some() && lower.real.len() < FLY_SKIP_STROKES_MIN {
+        let centred_bands = bands.as_ref().and_then(nest);
+        let ((by_fields, by_bands), (by_centred, by_centred_bands)) = rayon::join(
+            || rayon::join(|| lower.toolpath(&ordering), || lowered(bands)),
+            || rayon::join(|| lowered(centred), || lowered(centred_bands)),
+        );
+        let mut best = (ordering, by_fields?);
+        for candidate in [by_bands?, by_centred?, by_centred_bands?]
+            .into_iter()
+            .flatten()
+        {
+            best = faster(best, candidate);
+        }
+        return Ok(best);
     }
-    let profile = &lower.inputs.profile;
-    let reach_mm = field_mm[0].min(field_mm[1]) / 2.0 - profile.otf_margin_mm;
-    let centred = nested::nested_centred(&best.0, lower.geometries, reach_mm);
-    if let Some(centred) = centred.filter(|_| !lower.ctx.is_cancelled()) {
-        let by_centred = lower.toolpath(&centred)?;
-        best = faster(best, (centred, by_centred));
+    let by_fields = lower.toolpath(&ordering)?;
+    let mut best = (ordering, by_fields);
+    if let Some(by_bands) = lowered(bands)? {
+        best = faster(best, by_bands);
+    }
+    if let Some(by_centred) = lowered(nest(&best.0))? {
+        best = faster(best, by_centred);
     }
     Ok(best)
 }

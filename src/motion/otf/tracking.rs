@@ -26,7 +26,7 @@
 //! only near spots where the stage cannot keep up; route length and corners cost nothing.
 
 use super::TUBE_SLACK;
-use super::{clocked, install, overshoots, piece_knots, Piece};
+use super::{clocked, install, overshoots, piece_knots, Piece, PieceStage};
 use crate::document::MachineProfile;
 use crate::job::JobCtx;
 use crate::motion::route::AxisRoute;
@@ -91,14 +91,16 @@ const WAIT_SLOWING_BUDGET: f64 = 3.0;
 /// Rounds of clock alignment and checking before tracking gives up.
 const ROUNDS: usize = 8;
 
-/// One sample of the tube: a point of piece `piece` at fraction `u` of its duration, and the
-/// interval each axis must keep there, mm.
+/// One sample of the tube: a point of piece `piece` at fraction `u` of its duration, the
+/// interval each axis must keep there, mm, and whether the stage must be at rest there (a
+/// field marked step-and-scan in a mixed job).
 #[derive(Debug, Clone, Copy)]
 struct Sample {
     piece: usize,
     u: f64,
     lower: [f64; 2],
     upper: [f64; 2],
+    still: bool,
 }
 
 /// The samples of the whole tool, with the sample each piece starts at.
@@ -158,12 +160,25 @@ impl Samples {
                     if joins || repeats {
                         continue;
                     }
-                    let (lower, upper) = bounds(piece, ps, tube_mm, profile)?;
+                    // a jump into or out of a still stretch is tied to the tool at its ends
+                    // only (the scanner jumps in its own frame meanwhile)
+                    let free = piece.stage == PieceStage::FreeJump && us < 1.0;
+                    let (lower, upper) = if free {
+                        ([0.0; 2], profile.stroke_mm)
+                    } else {
+                        bounds(piece, ps, tube_mm, profile)?
+                    };
+                    // the last sample of a piece is the first of the next
+                    let next_still = us >= 1.0
+                        && pieces
+                            .get(j + 1)
+                            .is_some_and(|p| p.stage == PieceStage::Still);
                     samples.push(Sample {
                         piece: j,
                         u: us,
                         lower,
                         upper,
+                        still: piece.stage == PieceStage::Still || next_still,
                     });
                 }
             }
@@ -220,6 +235,15 @@ pub(super) enum FixRule {
     /// before it in turn; then the window rule.
     WaitFirst,
 }
+
+/// A window-rule job at most this much longer than the tool's time slowed nothing (the rest is
+/// rounding in the sums of durations), s: the wait-first rule stops and its job is not
+/// compared ([`super::lower_tracked_faster`]).
+pub(super) const NO_SLOWING_S: f64 = 1e-9;
+
+/// How often (in samples) a tracking that slows nothing looks whether the window rule's
+/// tracking beside it has finished without slowing anything.
+const CAP_CHECK_SAMPLES: usize = 1_024;
 
 /// The most time a tracking may add before it gives up, shared between threads: the
 /// wait-first rule runs beside the window rule and stops once the time it has added for good
@@ -545,7 +569,7 @@ fn step_both(
         let l = limits[axis];
         let eps = l.narrowing_mm(dt).max(l.narrowing_mm(next));
         reached &= set
-            .step(dt, s.lower[axis] + eps, s.upper[axis] - eps, l)
+            .step(dt, s.lower[axis] + eps, s.upper[axis] - eps, l, s.still)
             .is_ok();
     }
     reached
@@ -597,6 +621,10 @@ fn track(
         if k % 65_536 == 0 {
             ctx.check()?;
         }
+        // the window rule kept up without slowing anything: nothing can be shorter
+        if k % CAP_CHECK_SAMPLES == 0 && cap.get_s() <= NO_SLOWING_S {
+            return Ok(None);
+        }
         k += 1;
     }
     let dt: Vec<f64> = (0..n.saturating_sub(1))
@@ -640,8 +668,13 @@ pub(super) fn lower_tracked(
             let (x, y) = (AxisRoute::Tracked(x), AxisRoute::Tracked(y));
             install(path, &run, x, y, clock_s);
             let over = overshoots(path, reach_mm, profile.stroke_mm);
-            if over.is_empty() {
+            let fast = fast_free_jumps(path, &run, profile.scanner.jump_speed_mm_s);
+            if over.is_empty() && fast.is_empty() {
                 return Ok(Some(()));
+            }
+            // a jump into or out of a still stretch the scanner cannot make in its time
+            for (j, factor) in fast {
+                run[j].duration_s *= factor;
             }
             // rounding at the edge of the reach: slow the pieces there a little, track again
             let starts = super::piece_starts(&run);
@@ -655,6 +688,38 @@ pub(super) fn lower_tracked(
         carry_back(&mut pieces, &run, &before);
     }
     Ok(None)
+}
+
+/// Relative slack of the scanner's speed on a free jump (rounding in the route's positions).
+const JUMP_SPEED_SLACK: f64 = 1e-6;
+
+/// The free jumps ([`PieceStage::FreeJump`]) of `path`, laid out from `pieces`, on which the
+/// scanner moves faster than `jump_speed_mm_s` (the stage moved against the jump): each
+/// piece's index and how much longer it must last (with a little to spare, as the stage's
+/// route changes with it).
+fn fast_free_jumps(path: &Toolpath, pieces: &[Piece], jump_speed_mm_s: f64) -> Vec<(usize, f64)> {
+    // the segments are the pieces, after the wait while the stage gets under way
+    let first = path.segments.len().saturating_sub(pieces.len());
+    let mut out = Vec::new();
+    for (j, piece) in pieces.iter().enumerate() {
+        if piece.stage != PieceStage::FreeJump {
+            continue;
+        }
+        let Some(seg) = path.segments.get(first + j) else {
+            continue;
+        };
+        if let crate::motion::ScanMotion::Line { from, to, move_s } = seg.scan {
+            let speed_mm_s = if move_s > 0.0 {
+                from.dist(to) / move_s
+            } else {
+                f64::INFINITY
+            };
+            if speed_mm_s > jump_speed_mm_s * (1.0 + JUMP_SPEED_SLACK) && move_s > 0.0 {
+                out.push((j, speed_mm_s / jump_speed_mm_s * (1.0 + 1e-3)));
+            }
+        }
+    }
+    out
 }
 
 /// Carries the slowing of `run` (durations `before` it) to the pieces it came from.
