@@ -78,6 +78,8 @@ struct Row {
     value: fn(&Plan) -> Option<f64>,
     decimals: usize,
     kind: RowKind,
+    /// Shown only when a plan has the figure.
+    only_some: bool,
 }
 
 fn part(m: &Metrics, pick: fn(&TimeBreakdown) -> f64) -> Option<f64> {
@@ -92,6 +94,7 @@ const ROWS: &[Row] = &[
         value: |p| p.metrics.job_time_s,
         decimals: 3,
         kind: RowKind::Decides,
+        only_some: false,
     },
     Row {
         label: "Stage moves (s)",
@@ -99,6 +102,7 @@ const ROWS: &[Row] = &[
         value: |p| part(&p.metrics, |b| b.stage),
         decimals: 2,
         kind: RowKind::Part,
+        only_some: false,
     },
     Row {
         label: "Stage settling (s)",
@@ -106,6 +110,7 @@ const ROWS: &[Row] = &[
         value: |p| part(&p.metrics, |b| b.settle),
         decimals: 2,
         kind: RowKind::Part,
+        only_some: false,
     },
     Row {
         label: "Scanner jumps (s)",
@@ -113,6 +118,7 @@ const ROWS: &[Row] = &[
         value: |p| part(&p.metrics, |b| b.jump),
         decimals: 2,
         kind: RowKind::Part,
+        only_some: false,
     },
     Row {
         label: "Marking (s)",
@@ -120,6 +126,7 @@ const ROWS: &[Row] = &[
         value: |p| part(&p.metrics, |b| b.mark),
         decimals: 2,
         kind: RowKind::Part,
+        only_some: false,
     },
     Row {
         label: "Laser delays (s)",
@@ -127,6 +134,26 @@ const ROWS: &[Row] = &[
         value: |p| part(&p.metrics, |b| b.laser_delays),
         decimals: 2,
         kind: RowKind::Part,
+        only_some: false,
+    },
+    Row {
+        label: "In step-and-scan fields (s)",
+        help: "a mixed job (on the fly, some fields marked with the stage at rest): the time of \
+               its step-and-scan stretches, from the end of the mark before each to its last \
+               mark; the rest of the job runs on the fly",
+        value: |p| {
+            let regions = &p.metrics.motion_regions;
+            (!regions.is_empty()).then(|| {
+                regions
+                    .iter()
+                    .filter(|r| r.motion == crate::document::Motion::Step)
+                    .map(|r| r.end_s - r.start_s)
+                    .sum()
+            })
+        },
+        decimals: 2,
+        kind: RowKind::Info,
+        only_some: true,
     },
     Row {
         label: "Idle travel (mm)",
@@ -134,6 +161,7 @@ const ROWS: &[Row] = &[
         value: |p| Some(p.metrics.idle_mm),
         decimals: 1,
         kind: RowKind::Ranked,
+        only_some: false,
     },
     Row {
         label: "Stage travel (mm)",
@@ -142,6 +170,7 @@ const ROWS: &[Row] = &[
         value: |p| Some(p.metrics.base_mm),
         decimals: 1,
         kind: RowKind::Ranked,
+        only_some: false,
     },
     Row {
         label: "Stage route (mm)",
@@ -150,6 +179,7 @@ const ROWS: &[Row] = &[
         value: |p| p.metrics.motion.map(|f| f.stage_route_mm),
         decimals: 1,
         kind: RowKind::Ranked,
+        only_some: false,
     },
     Row {
         label: "Peak stage speed (mm/s)",
@@ -157,6 +187,7 @@ const ROWS: &[Row] = &[
         value: |p| p.metrics.motion.map(|f| f.stage_peak_speed_mm_s),
         decimals: 0,
         kind: RowKind::Ranked,
+        only_some: false,
     },
     Row {
         label: "Stage speed variation (mm/s)",
@@ -165,6 +196,7 @@ const ROWS: &[Row] = &[
         value: |p| p.metrics.motion.map(|f| f.stage_speed_variation_mm_s),
         decimals: 0,
         kind: RowKind::Ranked,
+        only_some: false,
     },
     Row {
         label: "Peak scanner offset (mm)",
@@ -172,6 +204,7 @@ const ROWS: &[Row] = &[
         value: |p| p.metrics.motion.map(|f| f.scan_peak_offset_mm),
         decimals: 1,
         kind: RowKind::Info,
+        only_some: false,
     },
     Row {
         label: "Fields or regions",
@@ -180,6 +213,7 @@ const ROWS: &[Row] = &[
         value: |p| Some(p.metrics.fields as f64),
         decimals: 0,
         kind: RowKind::Ranked,
+        only_some: false,
     },
     Row {
         label: "Seams",
@@ -188,6 +222,7 @@ const ROWS: &[Row] = &[
         value: |p| Some(p.seams.seams() as f64),
         decimals: 0,
         kind: RowKind::Ranked,
+        only_some: false,
     },
     Row {
         label: "Seam length (mm)",
@@ -195,6 +230,7 @@ const ROWS: &[Row] = &[
         value: |p| Some(p.seams.length_mm()),
         decimals: 1,
         kind: RowKind::Ranked,
+        only_some: false,
     },
     Row {
         label: "Split strokes",
@@ -202,6 +238,7 @@ const ROWS: &[Row] = &[
         value: |p| Some(p.seams.split_strokes as f64),
         decimals: 0,
         kind: RowKind::Ranked,
+        only_some: false,
     },
     Row {
         label: "Direction changes",
@@ -209,6 +246,7 @@ const ROWS: &[Row] = &[
         value: |p| Some(p.metrics.direction_changes as f64),
         decimals: 0,
         kind: RowKind::Ranked,
+        only_some: false,
     },
     Row {
         label: "Marked length (mm)",
@@ -216,6 +254,7 @@ const ROWS: &[Row] = &[
         value: |p| Some(p.metrics.marked_mm),
         decimals: 1,
         kind: RowKind::Info,
+        only_some: false,
     },
     Row {
         label: "Solve time (s)",
@@ -223,6 +262,7 @@ const ROWS: &[Row] = &[
         value: |p| Some(p.metrics.solve_s.total),
         decimals: 3,
         kind: RowKind::Effort,
+        only_some: false,
     },
 ];
 
@@ -265,7 +305,11 @@ pub fn metrics_table(ui: &mut egui::Ui, id: &str, a: &Plan, b: Option<&Plan>) {
                 ui.label(RichText::new("Value").strong().color(colour::PATH_A));
             }
             ui.end_row();
-            for row in ROWS {
+            // a figure no plan shown has (a mixed job's) is left out, not shown as dashes
+            let shown = |row: &&Row| {
+                !row.only_some || (row.value)(a).is_some() || b.and_then(row.value).is_some()
+            };
+            for row in ROWS.iter().filter(shown) {
                 metrics_row(ui, row, a, b);
                 ui.end_row();
             }

@@ -904,9 +904,11 @@ impl App {
                     format!("job time {t:.2} s")
                 });
                 let stage = match (plan.motion, m.motion) {
-                    (Motion::OnTheFly, Some(f)) => {
-                        format!("on the fly, stage route {:.1} mm", f.stage_route_mm)
-                    }
+                    (Motion::OnTheFly, Some(f)) => format!(
+                        "{}, stage route {:.1} mm",
+                        plan.motion_words(),
+                        f.stage_route_mm
+                    ),
                     _ => format!("stage travel {:.1} mm, {} scan fields", m.base_mm, m.fields),
                 };
                 let msg = format!(

@@ -30,6 +30,9 @@ pub mod colour {
     pub const SEAM: Color32 = Color32::from_rgb(153, 27, 27);
     /// The selected field.
     pub const SELECTED: Color32 = Color32::from_rgb(245, 158, 11);
+    /// A mixed job's step-and-scan fields (the stage at rest while they are marked): their
+    /// fill, and the caption's words about them.
+    pub const STILL_FIELD: Color32 = Color32::from_rgb(13, 148, 136);
     /// Idle moves of a single plan, and plan A when two are overlaid.
     pub const PATH_A: Color32 = Color32::from_rgb(234, 88, 12);
     /// Idle moves of plan B when two are overlaid.
@@ -297,11 +300,25 @@ fn field_stroke(c: &Canvas<'_>, f: &crate::document::ScanField) -> Stroke {
     }
 }
 
+/// The toolpath of the first plan drawn, when it is a mixed job (its fields tinted by motion).
+fn mixed_toolpath<'a>(c: &Canvas<'a>) -> Option<&'a crate::motion::Toolpath> {
+    let first = c.paths.first()?.lowered.ok()?;
+    (!first.toolpath.still_fields.is_empty()).then_some(&first.toolpath)
+}
+
 fn field_shapes(shapes: &mut Vec<Shape>, c: &Canvas<'_>, view: &View, rect: Rect, clip: Rect) {
     let fill = Color32::from_rgba_unmultiplied(79, 70, 229, 16);
+    let [r, g, b, _] = colour::STILL_FIELD.to_array();
+    let still_fill = Color32::from_rgba_unmultiplied(r, g, b, 48);
+    let mixed = mixed_toolpath(c);
     for f in c.fields {
         if let Some(r) = field_on_screen(f, view, rect, clip) {
-            shapes.push(Shape::rect_filled(r, 0.0, fill));
+            let still = mixed.is_some_and(|t| t.marks_still(f.id));
+            shapes.push(Shape::rect_filled(
+                r,
+                0.0,
+                if still { still_fill } else { fill },
+            ));
         }
     }
     for f in c.fields {
@@ -649,6 +666,15 @@ fn caption(c: &Canvas<'_>, playback_room: bool) -> Vec<(String, Color32)> {
             (Ok(_), None) => {}
         }
     }
+    if let Some(t) = mixed_toolpath(c).filter(|_| c.layers.fields) {
+        lines.push((
+            format!(
+                "tinted green: {} marked step-and-scan (the stage at rest), the rest on the fly",
+                super::count(t.still_fields.len(), "field", "fields")
+            ),
+            colour::STILL_FIELD,
+        ));
+    }
     if let Some(first) = c.stale.first() {
         let more = match c.stale.len() {
             1 => String::new(),
@@ -816,15 +842,13 @@ mod tests {
     use crate::pipeline::order_document_lowered;
     use std::sync::atomic::AtomicBool;
 
-    /// Every shape of the heavy layers (fields, halos, out-of-reach dashes, artwork, stage
-    /// path, idle moves with arrows) has a raster form, and the raster of the demo's plan
-    /// covers the canvas where the artwork is.
-    #[test]
-    fn heavy_layers_rasterise_whole() {
-        let doc = super::super::session::tests::demo().doc;
-        let (plan, toolpath) = order_document_lowered(&doc, &JobCtx::default()).unwrap();
-        let lowered = Lowered::new(toolpath);
-        let canvas = Canvas {
+    /// The demo's canvas with one plan drawn.
+    fn demo_canvas<'a>(
+        doc: &'a crate::document::Document,
+        plan: &'a crate::document::Plan,
+        lowered: &'a Lowered,
+    ) -> Canvas<'a> {
+        Canvas {
             label: "test",
             geometries: &doc.geometries,
             profile: &doc.profile,
@@ -836,8 +860,8 @@ mod tests {
             colours: None,
             out_of_reach: &[1],
             paths: vec![PathLayer {
-                plan: &plan,
-                lowered: Ok(&lowered),
+                plan,
+                lowered: Ok(lowered),
                 colour: colour::PATH_A,
             }],
             uncovered: &[0, 1],
@@ -848,7 +872,18 @@ mod tests {
             stale: &[],
             playback_t_s: None,
             revision: 0,
-        };
+        }
+    }
+
+    /// Every shape of the heavy layers (fields, halos, out-of-reach dashes, artwork, stage
+    /// path, idle moves with arrows) has a raster form, and the raster of the demo's plan
+    /// covers the canvas where the artwork is.
+    #[test]
+    fn heavy_layers_rasterise_whole() {
+        let doc = super::super::session::tests::demo().doc;
+        let (plan, toolpath) = order_document_lowered(&doc, &JobCtx::default()).unwrap();
+        let lowered = Lowered::new(toolpath);
+        let canvas = demo_canvas(&doc, &plan, &lowered);
         let rect = Rect::from_min_size(Pos2::new(10.0, 20.0), Vec2::new(400.0, 300.0));
         let mut view = View::default();
         view.fit(rect, Pt::new(0.0, 0.0), Pt::new(300.0, 300.0));
@@ -873,5 +908,59 @@ mod tests {
             ..canvas
         };
         assert_ne!(content_key(&unselected), key);
+    }
+
+    /// A mixed job's caption says how many fields run step-and-scan, in their tint, and the
+    /// playback says which motion the stroke marked runs in; a one-motion job says neither.
+    /// (The words only: tests/motion.rs lowers a real mixed job.)
+    #[test]
+    fn a_mixed_job_names_its_step_and_scan_fields() {
+        let doc = super::super::session::tests::demo().doc;
+        let (plan, toolpath) = order_document_lowered(&doc, &JobCtx::default()).unwrap();
+        let first_field = toolpath.strokes[0].field;
+        let other = toolpath.strokes.iter().position(|s| s.field != first_field);
+        let mid_mark_s = |tp: &crate::motion::Toolpath, stroke: usize| {
+            let seg = tp.segments.iter().find(|seg| {
+                seg.kind == crate::motion::SegmentKind::Mark
+                    && matches!(seg.scan, crate::motion::ScanMotion::Mark { stroke: k, .. } if k == stroke)
+            });
+            seg.map(|seg| seg.start_s + seg.duration_s / 2.0).unwrap()
+        };
+        let single = Lowered::new(toolpath.clone());
+        let tinted = |c: &Canvas<'_>| {
+            caption(c, false)
+                .into_iter()
+                .filter(|(text, colour)| {
+                    text.starts_with("tinted green") && *colour == colour::STILL_FIELD
+                })
+                .map(|(text, _)| text)
+                .collect::<Vec<_>>()
+        };
+        assert!(tinted(&demo_canvas(&doc, &plan, &single)).is_empty());
+        let t0 = mid_mark_s(&single.toolpath, 0);
+        assert!(!playback::state_text(&single, t0).contains("step-and-scan"));
+
+        let mut mixed = toolpath;
+        mixed.still_fields = vec![first_field];
+        let mixed = Lowered::new(mixed);
+        let canvas = demo_canvas(&doc, &plan, &mixed);
+        assert_eq!(
+            tinted(&canvas),
+            vec!["tinted green: 1 field marked step-and-scan (the stage at rest), the rest on the fly"]
+        );
+        let text = playback::state_text(&mixed, mid_mark_s(&mixed.toolpath, 0));
+        assert!(text.starts_with("marking stroke 1 of"), "{text}");
+        assert!(
+            text.contains("(step-and-scan field: the stage stops for it)"),
+            "{text}"
+        );
+        if let Some(k) = other {
+            let text = playback::state_text(&mixed, mid_mark_s(&mixed.toolpath, k));
+            assert!(text.contains(" (on the fly);"), "{text}");
+        }
+        // the fields layer hidden: no words about its tint
+        let mut hidden = demo_canvas(&doc, &plan, &mixed);
+        hidden.layers.fields = false;
+        assert!(tinted(&hidden).is_empty());
     }
 }

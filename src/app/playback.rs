@@ -101,8 +101,15 @@ pub fn state_text(l: &Lowered, t_s: f64) -> String {
         SegmentKind::LaserOnDelay => format!("laser-on delay before stroke {next}"),
         SegmentKind::LaserOffDelay => "laser-off delay".into(),
     };
+    // a mixed job says which motion the stroke being marked (or next) runs in
+    let how = match tp.strokes.get(next.saturating_sub(1)) {
+        _ if tp.still_fields.is_empty() || t_s >= l.duration_s() => "",
+        Some(s) if tp.marks_still(s.field) => " (step-and-scan field: the stage stops for it)",
+        Some(_) => " (on the fly)",
+        None => "",
+    };
     format!(
-        "{doing}; stage ({:.1}, {:.1}) mm; laser {}",
+        "{doing}{how}; stage ({:.1}, {:.1}) mm; laser {}",
         state.stage.x,
         state.stage.y,
         if state.laser { "on" } else { "off" }
