@@ -352,12 +352,9 @@ impl Toolpath {
         self.still_fields.binary_search(&id).is_ok()
     }
 
-    /// The stretches of a mixed job ([`Toolpath::still_fields`] marked step-and-scan, the rest
-    /// on the fly), in job order; empty when it runs one motion.
-    pub fn motion_regions(&self) -> Vec<MotionRegion> {
-        if self.still_fields.is_empty() {
-            return Vec::new();
-        }
+    /// When each stroke's last mark ends, s (strokes in marking order; a stroke with no mark,
+    /// none in practice, ends where the one before did).
+    pub fn mark_ends_s(&self) -> Vec<f64> {
         let mut ends_s = vec![0.0; self.strokes.len()];
         for seg in &self.segments {
             if let ScanMotion::Mark { stroke, .. } = seg.scan {
@@ -366,6 +363,19 @@ impl Toolpath {
                 }
             }
         }
+        for k in 1..ends_s.len() {
+            ends_s[k] = ends_s[k].max(ends_s[k - 1]);
+        }
+        ends_s
+    }
+
+    /// The stretches of a mixed job ([`Toolpath::still_fields`] marked step-and-scan, the rest
+    /// on the fly), in job order; empty when it runs one motion.
+    pub fn motion_regions(&self) -> Vec<MotionRegion> {
+        if self.still_fields.is_empty() {
+            return Vec::new();
+        }
+        let ends_s = self.mark_ends_s();
         let mut regions: Vec<MotionRegion> = Vec::new();
         for (k, stroke) in self.strokes.iter().enumerate() {
             let motion = match self.marks_still(stroke.field) {

@@ -19,7 +19,7 @@ use super::{Candidates, Made, Nodes, OrderError};
 use crate::document::{ControllerKind, Motion, PlanInputs, StageRouteKind};
 use crate::geom::Pt;
 use crate::job::JobCtx;
-use crate::motion::{still_reach_mm, MotionError, OtfError, ScanMotion, Toolpath, TIME_EPS_S};
+use crate::motion::{still_reach_mm, MotionError, OtfError, Toolpath, TIME_EPS_S};
 
 /// Jobs of more strokes than this are not tried mixed (the step-and-scan lowering of the
 /// on-the-fly order, and up to two more on-the-fly lowerings; the large fills this skips run
@@ -93,7 +93,7 @@ fn field_gains(
     if step.strokes.len() != n {
         return Vec::new();
     }
-    let (fly_end, step_end) = (mark_ends_s(flying), mark_ends_s(step));
+    let (fly_end, step_end) = (flying.mark_ends_s(), step.mark_ends_s());
     let mut by_field: std::collections::BTreeMap<usize, (f64, bool)> = Default::default();
     let mut first = 0;
     while first < n {
@@ -122,25 +122,6 @@ fn field_gains(
         .collect();
     gains.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
     gains
-}
-
-/// When each stroke's last mark ends, s (strokes in marking order).
-fn mark_ends_s(path: &Toolpath) -> Vec<f64> {
-    let mut ends = vec![0.0; path.strokes.len()];
-    for seg in &path.segments {
-        if let ScanMotion::Mark { stroke, .. } = seg.scan {
-            if let Some(e) = ends.get_mut(stroke) {
-                *e = seg.end_s();
-            }
-        }
-    }
-    // a stroke with no mark (none in practice) ends where the one before did
-    for k in 1..ends.len() {
-        if ends[k] < ends[k - 1] {
-            ends[k] = ends[k - 1];
-        }
-    }
-    ends
 }
 
 /// Whether one stage position inside `[0, stroke_mm]` keeps every point within `reach_mm` on

@@ -709,12 +709,8 @@ fn fast_free_jumps(path: &Toolpath, pieces: &[Piece], jump_speed_mm_s: f64) -> V
             continue;
         };
         if let crate::motion::ScanMotion::Line { from, to, move_s } = seg.scan {
-            let speed_mm_s = if move_s > 0.0 {
-                from.dist(to) / move_s
-            } else {
-                f64::INFINITY
-            };
-            if speed_mm_s > jump_speed_mm_s * (1.0 + JUMP_SPEED_SLACK) && move_s > 0.0 {
+            let speed_mm_s = from.dist(to) / move_s;
+            if move_s > 0.0 && speed_mm_s > jump_speed_mm_s * (1.0 + JUMP_SPEED_SLACK) {
                 out.push((j, speed_mm_s / jump_speed_mm_s * (1.0 + 1e-3)));
             }
         }
