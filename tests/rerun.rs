@@ -1,4 +1,5 @@
-//! `--rerun`: HHA and HGA runs write a non-empty, decodable .rrd (feature `rerun`).
+//! `--record` (alias `--rerun`): HHA and HGA runs write a non-empty, decodable .rrd (feature
+//! `rerun`, on in the shipped build).
 #![cfg(feature = "rerun")]
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
@@ -7,13 +8,13 @@ mod common;
 use rerun::external::re_log_encoding::DecoderApp;
 use std::process::Command;
 
-fn record(algo: &str, dir: &std::path::Path) -> std::path::PathBuf {
+fn record(algo: &str, flag: &str, dir: &std::path::Path) -> std::path::PathBuf {
     let rrd = dir.join(format!("{algo}.rrd"));
     let demo = common::root().join("assets/examples/demo.svg");
     let out = Command::new(env!("CARGO_BIN_EXE_galvoplan"))
         .args(["plan", &demo.display().to_string(), "-o"])
         .arg(dir.join(format!("{algo}.gcode")))
-        .args(["--algo", algo, "--time-limit", "3", "--rerun"])
+        .args(["--algo", algo, "--time-limit", "3", flag])
         .arg(&rrd)
         .output()
         .unwrap();
@@ -46,8 +47,8 @@ fn decoded_messages(path: &std::path::Path) -> usize {
 #[test]
 fn hha_and_hga_recordings_are_written_and_readable() {
     let dir = tempfile::tempdir().unwrap();
-    let hha = decoded_messages(&record("hha", dir.path()));
-    let hga = decoded_messages(&record("hga", dir.path()));
+    let hha = decoded_messages(&record("hha", "--record", dir.path()));
+    let hga = decoded_messages(&record("hga", "--rerun", dir.path()));
     assert!(hha >= 4, "artwork, fields, marks, idle: {hha} messages");
     assert!(
         hga > hha,

@@ -421,8 +421,8 @@ struct PlanArgs {
     #[arg(long)]
     preview: Option<PathBuf>,
     /// Record the run (geometry, fields, path, GA convergence) as a rerun .rrd file
-    /// (needs a build with `--features rerun`).
-    #[arg(long, value_name = "OUT.rrd")]
+    /// (`--rerun` is the same option; builds without the `rerun` feature refuse it).
+    #[arg(long = "record", visible_alias = "rerun", value_name = "OUT.rrd")]
     rerun: Option<PathBuf>,
     /// Write exactly the geometry to be marked as an SVG in mm.
     #[arg(long)]
