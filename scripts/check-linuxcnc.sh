@@ -104,6 +104,8 @@ job ISW-1017 tests/data/linuxcnc/ISW-1017.svg step
 job two-layers assets/examples/two-layers.svg step --pens assets/examples/two-layers.pens.toml
 job oversize assets/examples/oversize.svg on-the-fly
 job lissajous tests/data/linuxcnc/lissajous.svg on-the-fly
+# a production job: a 2 × 2 tray of parts, each with its serial number as text
+job tray-2x2 assets/examples/part.svg step --array 2x2@40,32 --serial 1001 --date 2026-12-07
 if [ -n "$SHARED" ]; then
   for f in "$SHARED"/instances/*.svg; do
     n=$(basename "$f" .svg)

@@ -26,6 +26,7 @@ pub mod order;
 pub mod pipeline;
 #[cfg(feature = "rerun")]
 pub mod record;
+pub mod tray;
 
 #[cfg(feature = "gui")]
 pub mod app;

@@ -1,9 +1,9 @@
 //! The whole pipeline on a [`Document`]: import → fields → order → metrics, with stage times.
 
 use crate::document::{
-    is_hatch_output, sync_layers, ArtworkImport, DerivedKey, Document, MachineProfile, Motion,
-    MotionMode, Pen, PenLibrary, Plan, PlanInputs, ScanField, SolverSettings, StageRouteKind,
-    Warning,
+    is_hatch_output, sync_layers, ArtworkImport, DerivedKey, Document, Geometry, MachineProfile,
+    Motion, MotionMode, Pen, PenLibrary, Plan, PlanInputs, Production, ScanField, SolverSettings,
+    StageRouteKind, Stamp, TraySettings, Warning,
 };
 use crate::fields::{
     check_artwork, cut_hatch_at_tiling, place_fields, split_oversize, FieldError, Placement,
@@ -72,6 +72,14 @@ pub enum PipelineError {
         /// The document's source file.
         file: String,
     },
+    /// The production job (tray, serials, texts with fields, data) cannot be made.
+    #[error("{file}: {source}")]
+    Production {
+        /// The document's source file.
+        file: String,
+        /// The cause.
+        source: crate::document::ProductionError,
+    },
     /// Hatching failed.
     #[error("{file}: {source}")]
     Hatch {
@@ -135,12 +143,26 @@ pub struct Loaded {
     pub moved_mm: [f64; 2],
 }
 
-/// [`load_svg`] with the import's skipped layers and placement offset.
+/// [`load_svg`] with the import's skipped layers and placement offset. A drawing whose texts
+/// hold fields is a production job of one part: its artwork is made by `tray::expand`.
 pub fn load_artwork(
     path: &Path,
     profile: MachineProfile,
     settings: SolverSettings,
     opts: &ImportOptions,
+) -> Result<Loaded, PipelineError> {
+    load_production(path, profile, settings, opts, &TraySettings::default())
+}
+
+/// [`load_artwork`] as a production job: with any of `tray`'s options, they are set on the
+/// document's production (made of its artwork when it has none); a production's tray is then
+/// expanded into the artwork.
+pub fn load_production(
+    path: &Path,
+    profile: MachineProfile,
+    settings: SolverSettings,
+    opts: &ImportOptions,
+    tray: &TraySettings,
 ) -> Result<Loaded, PipelineError> {
     let t0 = Instant::now();
     let mut opts = opts.clone();
@@ -151,7 +173,15 @@ pub fn load_artwork(
     let imported = import_file(path, &opts)?;
     let mut layers = Vec::new();
     sync_layers(&mut layers, &imported.geometries, &settings.default_pen());
-    let doc = Document {
+    let templates = !imported.templates.is_empty();
+    let production = (templates || tray.is_set()).then(|| {
+        Production::of_part(
+            unplaced(&imported.geometries, imported.moved_mm),
+            imported.templates.clone(),
+            opts.chord_tol_mm,
+        )
+    });
+    let mut doc = Document {
         source: Some(path.display().to_string()),
         page_mm: imported.page_mm,
         artwork: imported.geometries.clone(),
@@ -165,13 +195,47 @@ pub fn load_artwork(
             hidden_layers: imported.skipped_layers.clone(),
             included: Vec::new(),
         },
+        production,
         ..Document::default()
     };
+    if let Some(p) = doc.production.as_mut() {
+        tray.apply(p).map_err(|source| PipelineError::Production {
+            file: path.display().to_string(),
+            source,
+        })?;
+        expand_production(&mut doc)?;
+    }
     Ok(Loaded {
         doc,
         import_s: t0.elapsed().as_secs_f64(),
         skipped_layers: imported.skipped_layers,
         moved_mm: imported.moved_mm,
+    })
+}
+
+/// Geometries moved back by a placement's offset: in the file's coordinates again.
+fn unplaced(geometries: &[Geometry], moved_mm: [f64; 2]) -> Vec<Geometry> {
+    let back = crate::geom::Pt::new(-moved_mm[0], -moved_mm[1]);
+    geometries
+        .iter()
+        .map(|g| {
+            let mut g = g.clone();
+            for p in &mut g.points {
+                *p = p.plus(back);
+            }
+            g
+        })
+        .collect()
+}
+
+/// Makes the document's artwork from its production (`tray::expand`, the date and time now
+/// where the production fixes none); the error names the document's file. The geometries are
+/// made from the new artwork by the next [`derive_geometries`] (every solve and placement
+/// starts with it).
+pub fn expand_production(doc: &mut Document) -> Result<(), PipelineError> {
+    crate::tray::expand(doc, Stamp::now()).map_err(|source| PipelineError::Production {
+        file: doc.source.clone().unwrap_or_default(),
+        source,
     })
 }
 
@@ -749,6 +813,7 @@ fn complete_plan(
     plan.metrics.solve_s.total = plan.metrics.solve_s.order;
     plan.tiling = doc.tiling.clone();
     plan.seams = doc.seams.clone();
+    plan.parts = doc.parts.clone();
     if plan_seed_route(doc, &mut plan, ctx)? {
         toolpath = relower(doc, &mut plan)?;
     }

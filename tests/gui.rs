@@ -1698,3 +1698,181 @@ fn convergence_plot_speaks_the_tables_figures_and_names_say_what_a_plan_is() {
     assert!(last.finished && (last.best - ta).abs() <= 1e-9 * ta);
     h.get_by_label_contains("B: population mean");
 }
+
+/// A hostile file (a fuzzer's edit of demo.svg: a path starting at x = 4.7·10⁶⁰, which took
+/// 24 GB before the bounds) dropped on a window with unsaved edits: refused at once, the error
+/// shown, the document and its edits still there and still unsaved.
+#[test]
+fn a_hostile_file_leaves_the_open_document_and_its_edits() {
+    let mut h = opened(&demo());
+    let id = h.state().session.doc.fields[0].id;
+    h.state_mut()
+        .execute(Command::SetLocked { id, locked: true })
+        .unwrap();
+    h.run();
+    let before = h.state().session.doc.clone();
+    let hostile = common::root().join("tests/data/hostile/demo-huge-coordinate.svg");
+    h.input_mut()
+        .dropped_files
+        .push(std::sync::Arc::new(Dropped(hostile)));
+    h.step();
+    h.run();
+    // the edits are unsaved: the operator is asked first, and goes on without saving
+    h.get_by_label("Discard changes").click();
+    h.run();
+    wait_idle(&mut h, Duration::from_secs(30));
+    let status = h.state().status().to_string();
+    assert!(
+        status.contains("demo-huge-coordinate.svg") && status.contains("<path> (line 124)"),
+        "{status}"
+    );
+    h.get_by_label_contains("<path> (line 124)");
+    assert!(h.state().session.doc == before, "the document changed");
+    assert!(h.state().has_unsaved_changes(), "the edits count as saved");
+}
+
+fn part_svg() -> PathBuf {
+    common::root().join("assets/examples/part.svg")
+}
+
+/// Opens part.svg and sets a tray in the Tray section, a value at a time (each makes the tray
+/// again in the background).
+fn tray(cols: &str, rows: &str, first_serial: &str) -> Harness<'static, App> {
+    let mut h = opened(&part_svg());
+    section(&mut h, "Tray");
+    for (label, text) in [
+        ("Pitch X (mm)", "40"),
+        ("Pitch Y (mm)", "32"),
+        ("First serial", first_serial),
+        ("Columns", cols),
+        ("Rows", rows),
+    ] {
+        enter_nth(&mut h, label, 0, text);
+        wait_idle(&mut h, Duration::from_secs(60));
+        assert!(
+            !h.state().status().starts_with("cannot"),
+            "{}",
+            h.state().status()
+        );
+    }
+    h
+}
+
+/// Hovers the canvas over part `n` and returns the frame's tooltip lines.
+fn hover_part(h: &mut Harness<'_, App>, n: u32) {
+    let at = h.state().part_screen_pos(n).unwrap();
+    h.hover_at(at);
+    h.step();
+    h.run();
+}
+
+#[test]
+fn a_three_by_two_tray_shows_six_numbered_parts_and_their_serials() {
+    let mut h = tray("3", "2", "1001");
+    let doc = &h.state().session.doc;
+    assert_eq!(doc.parts.len(), 6);
+    let serials: Vec<i64> = doc.parts.iter().map(|p| p.serial).collect();
+    assert_eq!(serials, [1001, 1002, 1003, 1004, 1005, 1006]);
+    h.get_by_label_contains("a tray of 6 parts, numbered 1 to 6");
+    h.get_by_label("6 parts");
+    h.get_by_label("Next tray starts at 1007");
+    // hovering part 4 tells its serial and what it will carry
+    hover_part(&mut h, 4);
+    h.get_by_label_contains("part 4 (cell 4, row 2, column 1): serial 1004");
+    h.get_by_label_contains("“SN 01004”");
+}
+
+/// Right-clicks tray cell `cell` on the canvas and clicks `item` in its context menu; waits
+/// for the tray to be made again.
+fn cell_menu(h: &mut Harness<'_, App>, cell: u32, item: &str) {
+    let at = h.state().cell_screen_pos(cell).unwrap();
+    h.hover_at(at);
+    h.step();
+    for pressed in [true, false] {
+        h.event(Event::PointerButton {
+            pos: at,
+            button: PointerButton::Secondary,
+            pressed,
+            modifiers: Modifiers::NONE,
+        });
+    }
+    h.run();
+    h.get_by_label(item).click();
+    h.step();
+    wait_idle(h, Duration::from_secs(60));
+}
+
+#[test]
+fn a_part_is_skipped_and_marked_again_from_its_context_menu() {
+    let mut h = tray("3", "2", "1");
+    cell_menu(&mut h, 2, "Skip this part");
+    let doc = &h.state().session.doc;
+    assert_eq!(doc.parts.len(), 5);
+    assert!(doc.parts.iter().all(|p| p.cell != 2));
+    // the skipped cell takes no serial: cell 3 is part 2
+    assert_eq!((doc.parts[1].cell, doc.parts[1].serial), (3, 2));
+    h.get_by_label_contains("(1 skipped: cells 2)");
+    // its context menu marks it again
+    cell_menu(&mut h, 2, "Mark this part");
+    assert_eq!(h.state().session.doc.parts.len(), 6);
+}
+
+#[test]
+fn export_and_advance_logs_the_parts_moves_the_serial_on_and_cannot_be_undone() {
+    let mut h = tray("3", "2", "1001");
+    h.get_by_label("Run HHA").click();
+    h.step();
+    wait_idle(&mut h, Duration::from_secs(120));
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("parts.csv");
+    let program = dir.path().join("tray.gcode");
+    enter_nth(&mut h, "Parts log", 0, &log.display().to_string());
+    h.run();
+    h.get_by_label("Export and advance").click();
+    h.run();
+    // no file dialog in the tests: the path is typed
+    // (the next tray's texts are made in the background: no settling before it ends)
+    enter_nth(&mut h, "File path", 0, &program.display().to_string());
+    wait_idle(&mut h, Duration::from_secs(60));
+    assert!(program.exists(), "{}", h.state().status());
+    let rows = std::fs::read_to_string(&log).unwrap();
+    assert_eq!(rows.lines().count(), 7, "{rows}");
+    assert!(
+        rows.lines().last().unwrap().ends_with(",6,1006,SN 01006"),
+        "{rows}"
+    );
+    let p = h.state().session.doc.production.clone().unwrap();
+    assert_eq!((p.serial.start, p.logged_through), (1007, Some(1006)));
+    // the next tray's texts are made: part 1 now says 1007
+    assert_eq!(h.state().session.doc.parts[0].texts[0], "SN 01007");
+    h.get_by_label("Next tray starts at 1013");
+    // undo takes back the remade texts, then refuses to hand out the logged serials again
+    h.key_press_modifiers(ctrl(), Key::Z);
+    h.run();
+    h.key_press_modifiers(ctrl(), Key::Z);
+    h.run();
+    let status = h.state().status().to_string();
+    assert!(
+        status.contains("cannot undo") && status.contains("1001 … 1006 are in the parts log"),
+        "{status}"
+    );
+    assert_eq!(
+        h.state()
+            .session
+            .doc
+            .production
+            .as_ref()
+            .unwrap()
+            .serial
+            .start,
+        1007
+    );
+    // nor can the tray be set back onto them
+    enter_nth(&mut h, "First serial", 0, "1003");
+    h.run();
+    assert!(
+        h.state().status().contains("never handed out again"),
+        "{}",
+        h.state().status()
+    );
+}

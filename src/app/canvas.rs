@@ -111,6 +111,8 @@ pub struct CanvasState {
     /// Fit to the reach of the machine on the next frame.
     pub fit_requested: bool,
     drag: Drag,
+    /// The tray cell the context menu is open for: (cell, it is skipped).
+    context_cell: Option<(u32, bool)>,
 }
 
 /// What the operator did on an editable canvas.
@@ -129,6 +131,13 @@ pub enum CanvasAction {
     EndDrag,
     /// Asked for a new field there (add tool click or double-click).
     Add(Pt),
+    /// Left a tray cell out (`skip`), or marked it again, from its context menu.
+    SkipCell {
+        /// The cell (row by row from 1).
+        cell: u32,
+        /// Leave it out.
+        skip: bool,
+    },
     /// Moved a seam (at the end of its drag).
     MoveSeam {
         /// 0: a vertical seam (x), 1: a horizontal one (y).
@@ -190,6 +199,8 @@ pub struct Canvas<'a> {
     pub stale: &'a [String],
     /// Playback time: the machine is drawn at this job time (`None`: the planned path only).
     pub playback_t_s: Option<f64>,
+    /// The tray's cells: numbered, skipped ones greyed, each part's serial on hover.
+    pub parts: &'a [super::tray_panel::PartBox],
     /// Changes whenever the artwork, its colours or coverage change: the canvas keeps a raster
     /// of what it draws while this (and what it compares by value) stays the same.
     pub revision: u64,
@@ -239,7 +250,10 @@ impl Canvas<'_> {
     ) -> (egui::Response, Vec<CanvasAction>) {
         let size = size.unwrap_or_else(|| ui.available_size());
         let (rect, response) = ui.allocate_exact_size(size, Sense::click_and_drag());
-        let label = self.label.to_string();
+        let label = match self.parts.iter().filter(|b| b.part.is_some()).count() {
+            0 => self.label.to_string(),
+            n => format!("{}: a tray of {n} parts, numbered 1 to {n}", self.label),
+        };
         response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Canvas, true, &label));
         let mut actions = Vec::new();
         if let Some(old) = state.rect {
@@ -262,6 +276,8 @@ impl Canvas<'_> {
         self.interact(ui, &response, rect, state, &mut actions);
         let painter = ui.painter_at(rect);
         paint::paint(&painter, self, &state.view, rect, response.id);
+        self.paint_parts(&painter, &state.view, rect);
+        self.part_menu(&response, rect, state, &mut actions);
         if let Drag::Seam { axis, at_mm, .. } = state.drag {
             // the seam being moved, across the work area
             let (lo, hi) = Canvas::reach(self.profile);
@@ -466,6 +482,82 @@ impl Canvas<'_> {
         index.nearest(self.geometries, p, tol_mm)
     }
 
+    /// The tray cell at `p`, mm.
+    fn part_at(&self, p: Pt) -> Option<&super::tray_panel::PartBox> {
+        self.parts.iter().find(|b| b.bbox.contains_pt(p, 0.0))
+    }
+
+    /// Each marked part's number at its top-left corner; skipped cells greyed.
+    fn paint_parts(&self, painter: &egui::Painter, view: &View, rect: Rect) {
+        for b in self.parts {
+            let s = |x: f64, y: f64| view.to_screen(rect, Pt::new(x, y));
+            let r =
+                Rect::from_two_pos(s(b.bbox.min_x, b.bbox.min_y), s(b.bbox.max_x, b.bbox.max_y));
+            match b.part {
+                None => {
+                    painter.rect_filled(r, 2.0, Color32::from_black_alpha(60));
+                    if r.width() > 40.0 {
+                        painter.text(
+                            r.center(),
+                            egui::Align2::CENTER_CENTER,
+                            format!("cell {} skipped", b.cell),
+                            egui::FontId::proportional(11.0),
+                            Color32::from_gray(70),
+                        );
+                    }
+                }
+                Some(n) if r.width() > 14.0 => {
+                    painter.text(
+                        r.left_top() + Vec2::new(2.0, 1.0),
+                        egui::Align2::LEFT_TOP,
+                        n.to_string(),
+                        egui::FontId::proportional(11.0),
+                        Color32::from_rgb(29, 78, 216),
+                    );
+                }
+                Some(_) => {}
+            }
+        }
+    }
+
+    /// The context menu of a tray cell: *Skip this part* or *Mark this part*.
+    fn part_menu(
+        &self,
+        response: &egui::Response,
+        rect: Rect,
+        state: &mut CanvasState,
+        actions: &mut Vec<CanvasAction>,
+    ) {
+        if !self.editable || self.parts.is_empty() {
+            return;
+        }
+        if response.secondary_clicked() {
+            state.context_cell = response
+                .interact_pointer_pos()
+                .map(|p| state.view.to_mm(rect, p))
+                .and_then(|p| self.part_at(p))
+                .map(|b| (b.cell, b.part.is_none()));
+        }
+        let Some((cell, skipped)) = state.context_cell else {
+            return;
+        };
+        response.context_menu(|ui| {
+            let (button, skip) = if skipped {
+                ("Mark this part", false)
+            } else {
+                ("Skip this part", true)
+            };
+            if ui
+                .button(button)
+                .on_hover_text("a skipped cell takes no part, no serial and no data row")
+                .clicked()
+            {
+                actions.push(CanvasAction::SkipCell { cell, skip });
+                ui.close();
+            }
+        });
+    }
+
     fn hover_info(&self, response: egui::Response, rect: Rect, view: &View) -> egui::Response {
         let Some(pos) = response.hover_pos() else {
             return response;
@@ -474,7 +566,11 @@ impl Canvas<'_> {
         let tol = f64::from(HOVER_PX / view.scale.max(1e-6));
         let geometry = self.geometry_at(&response.ctx, response.id, p, tol);
         let field = self.field_at(p).filter(|_| self.layers.fields);
+        let part = self.part_at(p);
         let mut lines = vec![format!("x {:.2} mm, y {:.2} mm", p.x, p.y)];
+        if let Some(b) = part {
+            lines.extend(b.words.iter().cloned());
+        }
         if let Some(k) = geometry {
             let g = &self.geometries[k];
             lines.push(format!(
@@ -532,7 +628,7 @@ impl Canvas<'_> {
                 ));
             }
         }
-        if geometry.is_none() && field.is_none() {
+        if geometry.is_none() && field.is_none() && part.is_none() {
             return response;
         }
         response.on_hover_ui_at_pointer(|ui| {

@@ -8,7 +8,7 @@
 
 use crate::document::{
     validate_layers, ArtworkImport, DerivedKey, Document, Geometry, GeometryRevision, Layer,
-    MachineProfile, Plan, ScanField, SolverSettings, Warning,
+    MachineProfile, PartRecord, Plan, Production, ScanField, SolverSettings, Warning,
 };
 use crate::fields::{add_field, delete_field, move_field, reallocate, set_locked};
 use crate::geom::seam::SeamStats;
@@ -58,6 +58,14 @@ pub enum Command {
     /// Replaces the layer table when only pens change that do not change the geometries
     /// (speed, power, frequency, passes, colour); refused otherwise.
     SetLayers(Vec<Layer>),
+    /// Starts the next tray at `next` after *Export and advance* logged the serials up to
+    /// `logged_through`: those are never handed out again, so this cannot be undone.
+    AdvanceSerial {
+        /// The first serial of the next tray.
+        next: i64,
+        /// The last serial written to the parts log.
+        logged_through: i64,
+    },
     /// Puts the result of a background job into the document: geometries, layers, fields,
     /// plans and warnings made from this document (re-placement, re-hatching).
     SetContent {
@@ -82,6 +90,7 @@ impl Command {
             Command::SetProfile(_) => "change machine profile".into(),
             Command::SetSettings(_) => "change solver settings".into(),
             Command::SetLayers(_) => "change pens".into(),
+            Command::AdvanceSerial { next, .. } => format!("start the next tray at serial {next}"),
             Command::SetContent { what, .. } => what.clone(),
         }
     }
@@ -156,8 +165,25 @@ pub fn apply(doc: &mut Document, cmd: &Command) -> Result<Outcome, String> {
             doc.layers = layers.clone();
             Ok(uncovered(reallocate(doc)))
         }
+        Command::AdvanceSerial {
+            next,
+            logged_through,
+        } => {
+            let p = doc
+                .production
+                .as_mut()
+                .ok_or("the document is not a tray: nothing to advance")?;
+            p.serial.start = *next;
+            p.logged_through = Some(
+                p.logged_through
+                    .map_or(*logged_through, |l| l.max(*logged_through)),
+            );
+            Ok(Outcome::default())
+        }
         Command::SetContent { doc: new, .. } => {
             new.validate().map_err(|e| e.to_string())?;
+            doc.production = new.production.clone();
+            doc.parts = new.parts.clone();
             doc.artwork = new.artwork.clone();
             doc.page_mm = new.page_mm;
             doc.import = new.import.clone();
@@ -192,6 +218,7 @@ struct Content {
     tiling: Option<Tiling>,
     seams: SeamStats,
     tiling_set: Option<Tiling>,
+    parts: Vec<PartRecord>,
 }
 
 impl Content {
@@ -208,6 +235,7 @@ impl Content {
             tiling: doc.tiling.clone(),
             seams: doc.seams.clone(),
             tiling_set: doc.tiling_set.clone(),
+            parts: doc.parts.clone(),
         }
     }
     /// Puts this content into the document and returns what it replaced.
@@ -224,6 +252,7 @@ impl Content {
             tiling: std::mem::replace(&mut doc.tiling, self.tiling),
             seams: std::mem::replace(&mut doc.seams, self.seams),
             tiling_set: std::mem::replace(&mut doc.tiling_set, self.tiling_set),
+            parts: std::mem::replace(&mut doc.parts, self.parts),
         }
     }
 }
@@ -238,6 +267,10 @@ struct Snapshot {
     derived_with: Option<DerivedKey>,
     /// Geometries, plans and warnings, for commands that can rewrite them.
     content: Option<Content>,
+    /// The production (tray, serials, what was logged).
+    production: Option<Production>,
+    /// Why this entry cannot be undone (serials written to a parts log).
+    refuse_undo: Option<String>,
     what: String,
 }
 
@@ -248,6 +281,14 @@ impl Snapshot {
             Command::ReplaceAutomatically | Command::SetContent { .. }
         );
         let content = rewrites.then(|| Content::of(doc));
+        let refuse_undo = match (cmd, &doc.production) {
+            (Command::AdvanceSerial { logged_through, .. }, Some(p)) => Some(format!(
+                "the serials {} … {logged_through} are in the parts log: they are never handed \
+                 out again",
+                p.serial.start
+            )),
+            _ => None,
+        };
         Self {
             fields: doc.fields.clone(),
             profile: doc.profile.clone(),
@@ -255,6 +296,8 @@ impl Snapshot {
             layers: doc.layers.clone(),
             derived_with: doc.derived_with.clone(),
             content,
+            production: doc.production.clone(),
+            refuse_undo,
             what,
         }
     }
@@ -268,6 +311,8 @@ impl Snapshot {
             layers: std::mem::replace(&mut doc.layers, self.layers),
             derived_with: std::mem::replace(&mut doc.derived_with, self.derived_with),
             content,
+            production: std::mem::replace(&mut doc.production, self.production),
+            refuse_undo: self.refuse_undo,
             what: self.what,
         }
     }
@@ -310,8 +355,16 @@ impl History {
     pub fn close_group(&mut self) {
         self.open_group = None;
     }
-    /// Undoes the newest entry; returns its description.
+    /// Why the newest entry cannot be undone, if it cannot.
+    pub fn undo_refused(&self) -> Option<&str> {
+        self.undo.last()?.refuse_undo.as_deref()
+    }
+    /// Undoes the newest entry; returns its description (`None`: nothing to undo, or the
+    /// entry refuses, see [`History::undo_refused`]).
     pub fn undo(&mut self, doc: &mut Document) -> Option<String> {
+        if self.undo_refused().is_some() {
+            return None;
+        }
         let s = self.undo.pop()?;
         let what = s.what.clone();
         self.redo.push(s.swap(doc));

@@ -655,6 +655,7 @@ pub fn show(
         layers,
         stale: stale_of(k),
         playback_t_s,
+        parts: &[],
         revision,
     };
     // the metrics table's height (20 rows), or less on a small window (it scrolls then)

@@ -162,6 +162,7 @@ impl Job {
             fields: doc.fields.clone(),
             tiling: doc.tiling.clone(),
             seams: doc.seams.clone(),
+            parts: doc.parts.clone(),
             ..Document::default()
         };
         snapshot.settings.algo = algo;

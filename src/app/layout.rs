@@ -388,6 +388,8 @@ impl App {
                 .on_hover_text("Layers and their pens: speed, power, passes, hatch");
             ui.selectable_value(&mut self.view.section, Section::Settings, "Solver settings");
             ui.selectable_value(&mut self.view.section, Section::Profile, "Machine profile");
+            ui.selectable_value(&mut self.view.section, Section::Tray, "Tray")
+                .on_hover_text("Repeat the part over a tray: columns, rows, pitch, serial numbers");
         });
         ui.separator();
         match self.view.section {
@@ -408,6 +410,7 @@ impl App {
                     }
                 }
             }
+            Section::Tray => self.tray_ui(ui),
             Section::Profile => {
                 if let Some(cmd) = self.view.editors.profile_ui(ui, &self.session.doc.profile) {
                     let _ = self.execute(cmd);
@@ -709,6 +712,7 @@ impl App {
             layers: self.view.layers,
             stale: &stale,
             playback_t_s,
+            parts: &self.session.part_boxes,
             revision: self.canvas_revision(),
         };
         let motion = lowered.and_then(Result::ok).and_then(|l| l.motion.as_ref());

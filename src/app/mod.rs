@@ -29,6 +29,7 @@ mod prompts;
 mod raster;
 pub mod session;
 pub mod toolpaths;
+pub mod tray_panel;
 
 pub use canvas::{Canvas, CanvasAction, CanvasState, Layers, View};
 
@@ -129,6 +130,8 @@ pub enum Section {
     Settings,
     /// Machine profile.
     Profile,
+    /// A production job: the part repeated over a tray, serials.
+    Tray,
 }
 
 /// Durations of recent frames.
@@ -205,6 +208,8 @@ struct ViewState {
     frame_log: Option<std::fs::File>,
     /// The layers panel's edit buffers.
     layer_editor: layers::LayerEditor,
+    /// The Tray section.
+    tray: tray_panel::TrayPanel,
     /// The section shown in the left panel.
     section: Section,
     /// Show frame timings in the status bar.
@@ -279,6 +284,7 @@ impl App {
                 title: String::new(),
                 frame_log: None,
                 layer_editor: layers::LayerEditor::default(),
+                tray: tray_panel::TrayPanel::default(),
                 section: Section::Layers,
                 frame_times: prefs.frame_times,
                 prompt: None,
@@ -652,8 +658,9 @@ impl App {
     /// Undoes the last edit.
     pub fn undo(&mut self) {
         match self.session.undo() {
-            Some(w) => self.set_status(format!("undid: {w}"), false),
-            None => self.set_status("nothing to undo", false),
+            Ok(Some(w)) => self.set_status(format!("undid: {w}"), false),
+            Ok(None) => self.set_status("nothing to undo", false),
+            Err(why) => self.set_status(format!("cannot undo: {why}"), true),
         }
         self.refresh_view();
     }
@@ -783,6 +790,27 @@ impl App {
     /// Frame durations.
     pub fn frame_stats(&self) -> &FrameStats {
         &self.view.frames
+    }
+
+    /// Screen position of a tray part's centre on the workbench canvas (after the first frame).
+    pub fn part_screen_pos(&self, part: u32) -> Option<egui::Pos2> {
+        let b = self
+            .session
+            .part_boxes
+            .iter()
+            .find(|b| b.part == Some(part))?;
+        self.cell_screen_pos(b.cell)
+    }
+
+    /// Screen position of a tray cell's centre (marked or skipped) on the workbench canvas.
+    pub fn cell_screen_pos(&self, cell: u32) -> Option<egui::Pos2> {
+        let b = self.session.part_boxes.iter().find(|b| b.cell == cell)?;
+        let rect = self.view.workbench.rect?;
+        let c = crate::geom::Pt::new(
+            (b.bbox.min_x + b.bbox.max_x) / 2.0,
+            (b.bbox.min_y + b.bbox.max_y) / 2.0,
+        );
+        Some(self.view.workbench.view.to_screen(rect, c))
     }
 
     /// Screen position of a field's centre on the workbench canvas (after the first frame).
@@ -996,6 +1024,7 @@ impl App {
                     from_mm,
                     to_mm,
                 } => self.move_seam(axis, from_mm, to_mm, repaint),
+                CanvasAction::SkipCell { cell, skip } => self.skip_cell(cell, skip, repaint),
             }
         }
     }

@@ -871,6 +871,7 @@ mod tests {
             layers: Default::default(),
             stale: &[],
             playback_t_s: None,
+            parts: &[],
             revision: 0,
         }
     }

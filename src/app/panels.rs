@@ -48,7 +48,7 @@ const NARROW_EDIT_PX: f32 = 90.0;
 const MESSAGE_LINES: f32 = 3.0;
 
 /// Text buffers of one form, re-read whenever the value changes from elsewhere (undo, open).
-struct Form<T> {
+pub(super) struct Form<T> {
     specs: Vec<FieldSpec<T>>,
     synced: Option<T>,
     text: Vec<String>,
@@ -58,7 +58,7 @@ struct Form<T> {
 }
 
 impl<T: Clone + PartialEq> Form<T> {
-    fn new(specs: Vec<FieldSpec<T>>) -> Self {
+    pub(super) fn new(specs: Vec<FieldSpec<T>>) -> Self {
         Self {
             specs,
             synced: None,
@@ -70,7 +70,7 @@ impl<T: Clone + PartialEq> Form<T> {
 
     /// Draws the form: its message, the free-text rows (a name) across the panel, then the
     /// other rows in a grid; returns the new value when one was committed and valid.
-    fn ui(
+    pub(super) fn ui(
         &mut self,
         ui: &mut egui::Ui,
         grid_id: &str,
@@ -536,7 +536,7 @@ const STAGE_ROUTE_HELP: &str = "How the stage's route is planned on the fly.\n\
     Used by the next solve.";
 
 /// A labelled combo box, each option with its hover text; returns the combo's response.
-fn combo<T: PartialEq + Copy>(
+pub(super) fn combo<T: PartialEq + Copy>(
     ui: &mut egui::Ui,
     label: &str,
     value: &mut T,

@@ -36,6 +36,8 @@ pub enum PathAction {
     LoadProfile,
     /// Save the machine profile (TOML).
     SaveProfile,
+    /// Write the shown tray plan's G-code, log its parts and start the next tray.
+    ExportAdvance,
 }
 
 impl PathAction {
@@ -56,6 +58,7 @@ impl PathAction {
                 };
                 (title, "Export", ext, filter)
             }
+            PathAction::ExportAdvance => ("Export and advance", "Export", "gcode", "G-code"),
             PathAction::LoadPens => ("Load pens", "Load", "toml", "pens"),
             PathAction::SavePens => ("Save pens", "Save", "toml", "pens"),
             PathAction::LoadProfile => ("Load a machine profile", "Load", "toml", "profile"),
@@ -180,7 +183,9 @@ impl App {
         let linuxcnc = self.session.doc.profile.gcode.mode == crate::document::GcodeMode::Linuxcnc;
         let gcode = matches!(
             action,
-            PathAction::Export(ExportKind::Gcode) | PathAction::ResolveExport(ExportKind::Gcode)
+            PathAction::Export(ExportKind::Gcode)
+                | PathAction::ResolveExport(ExportKind::Gcode)
+                | PathAction::ExportAdvance
         );
         let ext = if gcode && linuxcnc { "ngc" } else { ext };
         let default_name = match action {
@@ -261,6 +266,7 @@ impl App {
                 self.resolve_and_export(kind, &path, ctx);
                 Ok(())
             }
+            PathAction::ExportAdvance => self.export_and_advance(&path, ctx),
             PathAction::LoadPens => PenLibrary::load(&path)
                 .map_err(|e| e.to_string())
                 .map(|lib| {
@@ -307,12 +313,20 @@ impl App {
 
     /// Continues what the unsaved-changes prompt held back.
     fn then(&mut self, then: Then, ctx: &egui::Context) {
-        // the operator has answered for the current changes
-        self.session.saved_revision = self.session.revision;
         match then {
-            Then::Quit => self.request_quit(ctx),
-            Then::Open(p) => self.request_open(p, ctx),
-            Then::New => self.request_new(),
+            // an open replaces the document only once the file has been read: until then (and
+            // when the file is refused) the changes stay, still unsaved
+            Then::Open(Some(p)) => self.open_in_background(&p, ctx),
+            Then::Open(None) => self.choose_path(PathAction::Open, ctx),
+            // the operator has answered for the current changes
+            Then::Quit => {
+                self.session.saved_revision = self.session.revision;
+                self.request_quit(ctx);
+            }
+            Then::New => {
+                self.session.saved_revision = self.session.revision;
+                self.request_new();
+            }
         }
     }
 

@@ -42,6 +42,8 @@ pub struct Session {
     /// The artwork's file is there to be imported again (placement, hidden layers); checked
     /// when the document changes, not every frame.
     pub can_reimport: bool,
+    /// The tray's cells as the canvas shows them (made when the document changes).
+    pub part_boxes: Vec<super::tray_panel::PartBox>,
 }
 
 impl Session {
@@ -119,14 +121,18 @@ impl Session {
         (what, r)
     }
 
-    /// Undoes the last edit; returns its description.
-    pub fn undo(&mut self) -> Option<String> {
+    /// Undoes the last edit; returns its description (`Err`: the edit refuses to be undone,
+    /// and why).
+    pub fn undo(&mut self) -> Result<Option<String>, String> {
+        if let Some(why) = self.history.undo_refused() {
+            return Err(why.to_string());
+        }
         let w = self.history.undo(&mut self.doc);
         if w.is_some() {
             self.changed();
         }
         self.refresh();
-        w
+        Ok(w)
     }
 
     /// Redoes the last undone edit; returns its description.
@@ -186,6 +192,7 @@ impl Session {
         self.layer_counts = layer_counts(&self.doc);
         self.closed = self.doc.geometries.iter().filter(|g| g.closed).count();
         self.can_reimport = super::files::can_reimport(&self.doc);
+        self.part_boxes = super::tray_panel::part_boxes(&self.doc);
         if self.active.is_some_and(|k| k >= self.doc.plans.len()) {
             self.active = self.doc.plans.len().checked_sub(1);
         }
@@ -277,7 +284,7 @@ pub(super) mod tests {
         let l = s.toolpath(k).unwrap().unwrap();
         assert_eq!(Some(l.duration_s()), s.doc.plans[k].metrics.job_time_s);
         // undo brings the document back to the plan's inputs: current again
-        assert!(s.undo().is_some());
+        assert!(s.undo().unwrap().is_some());
         assert!(s.plan_staleness(k).is_empty());
         assert!(s.has_unsaved_changes());
     }

@@ -2,11 +2,11 @@
 
 pub mod hatch;
 
-use crate::document::{MachineProfile, SolverSettings};
+use crate::document::{MachineProfile, SolverSettings, TraySettings};
 use crate::export::{report_json, write_gcode_to};
 use crate::import::ImportOptions;
 use crate::job::JobCtx;
-use crate::pipeline::{load_svg, plan_document_lowered, PipelineError};
+use crate::pipeline::{load_production, plan_document_lowered, PipelineError};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -167,18 +167,19 @@ impl std::io::Write for ByteCount {
     }
 }
 
-/// Runs the pipeline on one SVG for `seeds` consecutive seeds (from the settings' seed), each
-/// `repeat` times (import, fields, order, export: the G-code streamed and counted, the
-/// report in memory).
+/// Runs the pipeline on one SVG (imported with `input`'s options, as a tray with its tray
+/// settings) for `seeds` consecutive seeds (from the settings' seed), each `repeat` times
+/// (import, fields, order, export: the G-code streamed and counted, the report in memory).
 pub fn run_instance(
     path: &Path,
     profile: &MachineProfile,
     settings: &SolverSettings,
-    opts: &ImportOptions,
+    input: (&ImportOptions, &TraySettings),
     seeds: usize,
     repeat: usize,
     ctx: &JobCtx,
 ) -> Result<BenchRow, PipelineError> {
+    let (opts, tray) = input;
     let mut times: [Vec<f64>; 6] = Default::default();
     let mut quality: [Vec<f64>; 11] = Default::default();
     let (mut geometries, mut marked_mm, mut lower, mut job_lb) = (0, 0.0, None, None);
@@ -190,7 +191,8 @@ pub fn run_instance(
         s.seed = settings.seed.wrapping_add(k as u64);
         for r in 0..repeat.max(1) {
             let t_all = Instant::now();
-            let (mut doc, import_s) = load_svg(path, profile.clone(), s.clone(), opts)?;
+            let loaded = load_production(path, profile.clone(), s.clone(), opts, tray)?;
+            let (mut doc, import_s) = (loaded.doc, loaded.import_s);
             let (plan, toolpath) = plan_document_lowered(&mut doc, ctx)?;
             let t0 = Instant::now();
             // the G-code streamed as the CLI writes it, counted rather than kept

@@ -10,6 +10,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     let profile = a.job.profile()?;
     let settings = a.job.settings()?;
     let opts = a.job.import()?;
+    let tray = a.job.tray.settings()?;
     let files = collect_svgs(&a.paths).context("cannot list the benchmark paths")?;
     anyhow::ensure!(!files.is_empty(), "no SVG files in {:?}", a.paths);
     let ctx = JobCtx::default();
@@ -17,7 +18,15 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     let mut failed = Vec::new();
     for f in &files {
         eprintln!("galvoplan: bench {}", f.display());
-        match run_instance(f, &profile, &settings, &opts, a.seeds, a.repeat, &ctx) {
+        match run_instance(
+            f,
+            &profile,
+            &settings,
+            (&opts, &tray),
+            a.seeds,
+            a.repeat,
+            &ctx,
+        ) {
             Ok(row) => rows.push(row),
             Err(e) => {
                 eprintln!("galvoplan: error: {e}");

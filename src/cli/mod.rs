@@ -14,6 +14,7 @@ use galvoplan::document::{
     Algo, CostModel, FieldsMode, MachineProfile, MotionMode, PenLibrary, RouteGaSettings,
     SolverSettings, StageRouteKind, VertexMode,
 };
+use galvoplan::document::{DataTable, Numbering, Serial, Stamp, Tray, TraySettings};
 use galvoplan::geom::seam::SeamForm;
 use galvoplan::hatch::{HatchSettings, OutlineMode};
 use galvoplan::import::{HiddenLayers, ImportOptions, Place};
@@ -223,6 +224,75 @@ struct JobOpts {
     /// default pen's; a pen library sets it per layer (`seam = "..."`).
     #[arg(long, value_name = "FORM", default_value = "straight", value_parser = parse_seam)]
     seam: SeamForm,
+    #[command(flatten)]
+    tray: TrayOpts,
+}
+
+/// A production job: the artwork is a part repeated over a tray, its texts' fields
+/// (`{serial:05}`, `{date}`, `{csv:lot}`, …) filled in per part.
+#[derive(Args, Debug, Clone, Default)]
+struct TrayOpts {
+    /// Repeat the artwork COLSxROWS times, PITCH_X and PITCH_Y mm apart (e.g. 6x8@40,32),
+    /// from where it is placed; the whole tray is one job.
+    #[arg(long, value_name = "COLSxROWS@PITCH_X,PITCH_Y", value_parser = parse_tray)]
+    array: Option<Tray>,
+    /// Cells left out (broken fixture positions): cell numbers row by row from 1 (e.g. 3,17);
+    /// they take no serial and no data row.
+    #[arg(long, value_name = "CELLS", requires = "array", value_parser = parse_skip_arg)]
+    skip: Option<Cells>,
+    /// How the marked parts are numbered: row by row from the top-left, or serpentine.
+    #[arg(long, value_name = "rows|serpentine", requires = "array", value_parser = parse_numbering)]
+    numbering: Option<Numbering>,
+    /// Serial numbers: part k gets START + STEP·(k − 1) (STEP 1 unless given).
+    #[arg(long, value_name = "START[:STEP]", value_parser = parse_serial)]
+    serial: Option<Serial>,
+    /// Data per part: a CSV file with a header row, then row k for part k (`{csv:COLUMN}`).
+    #[arg(long, value_name = "FILE.csv")]
+    data: Option<PathBuf>,
+    /// The date and time `{date}` and `{time}` show (default: now), for reproducible programs.
+    #[arg(long, value_name = "YYYY-MM-DD[THH:MM]", value_parser = parse_date)]
+    date: Option<Stamp>,
+}
+
+impl TrayOpts {
+    /// The options as the library takes them (the data file read here).
+    fn settings(&self) -> Result<TraySettings> {
+        Ok(TraySettings {
+            tray: self.array.clone(),
+            skip: self.skip.as_ref().map(|c| c.0.clone()),
+            numbering: self.numbering,
+            serial: self.serial,
+            stamp: self.date,
+            data: self.data.as_deref().map(DataTable::read).transpose()?,
+        })
+    }
+}
+
+fn parse_tray(s: &str) -> Result<Tray, String> {
+    Tray::parse(s).map_err(|e| e.to_string())
+}
+
+/// Tray cells as `--skip` lists them.
+#[derive(Debug, Clone)]
+struct Cells(Vec<u32>);
+
+fn parse_skip_arg(s: &str) -> Result<Cells, String> {
+    galvoplan::document::production::parse_skip(s)
+        .map(Cells)
+        .map_err(|e| e.to_string())
+}
+
+fn parse_numbering(s: &str) -> Result<Numbering, String> {
+    s.parse()
+        .map_err(|e: galvoplan::document::ProductionError| e.to_string())
+}
+
+fn parse_serial(s: &str) -> Result<Serial, String> {
+    Serial::parse(s).map_err(|e| e.to_string())
+}
+
+fn parse_date(s: &str) -> Result<Stamp, String> {
+    Stamp::parse(s).map_err(|e| e.to_string())
 }
 
 /// Parses `--seam`.
@@ -255,6 +325,7 @@ impl PlanArgs {
     fn inputs(&self) -> Vec<&std::path::Path> {
         let mut v = vec![self.input.as_path()];
         v.extend(self.job.pens.as_deref());
+        v.extend(self.job.tray.data.as_deref());
         let profile = std::path::Path::new(&self.job.profile);
         if profile.exists() {
             v.push(profile);
@@ -271,6 +342,7 @@ impl PlanArgs {
             ("geometry SVG", &self.export_geometry),
             ("trajectory", &self.trajectory),
             ("waypoints", &self.waypoints),
+            ("parts log", &self.parts_log),
         ];
         v.extend(
             optional
@@ -444,6 +516,10 @@ struct PlanArgs {
     /// trajectory's columns: what a controller's canonical moves are checked against.
     #[arg(long, value_name = "OUT.csv")]
     waypoints: Option<PathBuf>,
+    /// Append one row per part marked (date-time, program, part, serial, texts) to this CSV
+    /// file, once the program is written.
+    #[arg(long, value_name = "FILE.csv")]
+    parts_log: Option<PathBuf>,
     #[command(flatten)]
     job: JobOpts,
 }

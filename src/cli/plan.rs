@@ -12,7 +12,9 @@ use galvoplan::import::Place;
 use galvoplan::job::Progress;
 use galvoplan::job::ProgressSink;
 use galvoplan::job::{CancelToken, JobCtx};
-use galvoplan::pipeline::{apply_pen_library, load_artwork, lower_plan_on, plan_document_lowered};
+use galvoplan::pipeline::{
+    apply_pen_library, load_production, lower_plan_on, plan_document_lowered,
+};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -37,7 +39,8 @@ pub fn run(a: &PlanArgs) -> Result<()> {
         })
     };
     import_progress(0);
-    let loaded = load_artwork(&a.input, profile, settings, &opts);
+    let tray = a.job.tray.settings()?;
+    let loaded = load_production(&a.input, profile, settings, &opts, &tray);
     import_progress(1);
     let loaded = loaded?;
     let (mut doc, import_s) = (loaded.doc, loaded.import_s);
@@ -149,6 +152,11 @@ pub fn run(a: &PlanArgs) -> Result<()> {
     if let (Some(p), Some(s)) = (&a.waypoints, &waypoints) {
         write(p, s)?;
     }
+    if let Some(log) = &a.parts_log {
+        let program = a.output.display().to_string();
+        galvoplan::export::append_parts_log(log, &program, &plan.parts, chrono_now())
+            .with_context(|| format!("{}: cannot append to the parts log", log.display()))?;
+    }
     let m = &plan.metrics;
     eprintln!(
         "galvoplan: {}: {}, {}, job time {:.3} s, idle {:.1} mm, base {:.1} mm, marked {:.1} mm, {} direction changes, planned in {:.1} ms",
@@ -163,6 +171,11 @@ pub fn run(a: &PlanArgs) -> Result<()> {
         m.solve_s.total * 1e3
     );
     Ok(())
+}
+
+/// The date-time a parts log records (local time, to the second).
+fn chrono_now() -> String {
+    chrono::Local::now().format("%Y-%m-%dT%H:%M:%S").to_string()
 }
 
 #[cfg(feature = "rerun")]

@@ -15,6 +15,9 @@ pub struct Source {
     /// group holding the element, else its stroke colour as `#rrggbb` (`fill #rrggbb` when it
     /// has only a fill, `none` when neither).
     pub layer: String,
+    /// The tray part it belongs to (from 1; 0: not a tray's part).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub part: u32,
 }
 
 /// One continuous stroke: a polyline in mm.

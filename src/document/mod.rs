@@ -6,6 +6,7 @@ mod hatch;
 mod inputs;
 mod pens;
 mod plan;
+pub mod production;
 mod profile;
 mod project;
 mod route;
@@ -28,6 +29,10 @@ pub use pens::{
 pub use plan::{
     GenerationRecord, Metrics, MotionFigures, MotionRegion, ObjectiveKind, Plan, ScanField,
     StageTimes, Step, TimeBreakdown,
+};
+pub use production::{
+    DataTable, Numbering, PartRecord, PartSlot, Production, ProductionError, Serial, Stamp,
+    TextAlign, TextTemplate, Tray, TraySettings, TraySetup,
 };
 pub use profile::{
     AxisLimits, Controller, ControllerKind, GcodeDialect, GcodeMode, LaserTiming, MachineProfile,
@@ -146,6 +151,14 @@ pub struct Document {
     /// Earlier geometry lists that plans were planned on and still refer to.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub kept_geometries: Vec<GeometryRevision>,
+    /// A production job: the part, its texts with fields and the tray it is repeated over
+    /// (none: the artwork is marked once, as imported). `artwork` is then the whole tray, made
+    /// from it by `crate::tray::expand`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub production: Option<Production>,
+    /// The parts of the tray as `artwork` marks them (number, cell, serial, texts).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub parts: Vec<PartRecord>,
 }
 
 impl Document {
@@ -153,11 +166,20 @@ impl Document {
     /// that fields and plans name geometries the document has. The CLI, the GUI and the project
     /// loader all call it.
     pub fn validate(&self) -> Result<(), validate::InvalidValue> {
+        use crate::geom::{within_reach_bound, MAX_COORD_MM};
         use validate::InvalidValue;
         self.profile.validate()?;
         self.settings.validate()?;
         validate_layers(&self.layers)?;
         for (k, g) in self.artwork.iter().chain(&self.geometries).enumerate() {
+            if let Some(p) = g.points.iter().find(|&&p| !within_reach_bound(p)) {
+                return Err(InvalidValue::new(
+                    format!("A point of geometry {} ({})", k + 1, g.source.element),
+                    "points",
+                    format!("({:e}, {:e}) mm", p.x, p.y),
+                    format!("within ±{MAX_COORD_MM:e} mm"),
+                ));
+            }
             if !self.layers.is_empty() && !self.layers.iter().any(|l| l.name == g.layer) {
                 return Err(InvalidValue::new(
                     format!("The layer of geometry {}", k + 1),
@@ -166,6 +188,14 @@ impl Document {
                     "a layer of the layer table",
                 ));
             }
+        }
+        if let Some(f) = self.fields.iter().find(|f| !within_reach_bound(f.center)) {
+            return Err(InvalidValue::new(
+                format!("The centre of scan field {}", f.id),
+                "center",
+                format!("({:e}, {:e}) mm", f.center.x, f.center.y),
+                format!("within ±{MAX_COORD_MM:e} mm"),
+            ));
         }
         let n = self.geometries.len();
         let held = self

@@ -292,6 +292,9 @@ pub struct Plan {
     /// GA convergence history (empty for other algorithms).
     #[serde(default)]
     pub history: Vec<GenerationRecord>,
+    /// The tray's parts it marks, with what each carries (empty: not a production job).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub parts: Vec<super::PartRecord>,
     /// The motion it was planned for: it is lowered, shown and exported that way whatever the
     /// current setting (projects from before on-the-fly marking are step-and-scan).
     #[serde(default)]
@@ -347,6 +350,7 @@ impl Plan {
             order,
             metrics: Metrics::default(),
             history: Vec::new(),
+            parts: Vec::new(),
             motion,
             step_fields: Vec::new(),
             stage_route: None,

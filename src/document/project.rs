@@ -223,6 +223,7 @@ mod tests {
                 element: "l1".into(),
                 subpath: 0,
                 layer: "#000000".into(),
+                part: 0,
             },
         ));
         d.settings.seed = 42;

@@ -388,6 +388,7 @@ mod tests {
                     element: "disc".into(),
                     subpath: k,
                     layer: "hatch:#000000".into(),
+                    part: 0,
                 };
                 Geometry::new(vec![a(0.0), a(0.25), a(0.5)], false, source).with_run(Some(Run {
                     id,
@@ -484,6 +485,7 @@ mod tests {
                     element: "disc".into(),
                     subpath: k,
                     layer: "hatch:#000000".into(),
+                    part: 0,
                 };
                 Geometry::new(vec![Pt::new(0.0, y), Pt::new(10.0, y)], false, source).with_run(
                     Some(Run {

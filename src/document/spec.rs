@@ -7,6 +7,7 @@ use super::{
     ControllerKind, CostModel, FieldsMode, GcodeMode, HatchSettings, MachineProfile, Motion,
     MotionMode, Pen, SolverSettings, StageRouteKind, MAX_PASSES,
 };
+use crate::geom::MAX_COORD_MM;
 
 /// What a value must be.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -15,6 +16,10 @@ pub enum Rule {
     Positive,
     /// A finite number, 0 or above.
     NonNegative,
+    /// A length above 0 and at most [`crate::geom::MAX_COORD_MM`] (a machine's size).
+    Length,
+    /// A length of 0 or more, at most [`crate::geom::MAX_COORD_MM`] (a machine's travel).
+    Travel,
     /// A number within the bounds (inclusive).
     Range(f64, f64),
     /// A number of at least this.
@@ -85,6 +90,15 @@ impl<T> FieldSpec<T> {
             }
             Rule::NonNegative if !v.is_some_and(|v| v.is_finite() && v >= 0.0) => {
                 Err(bad(NON_NEGATIVE.into()))
+            }
+            Rule::Length if !v.is_some_and(|v| v.is_finite() && v > 0.0) => {
+                Err(bad(POSITIVE.into()))
+            }
+            Rule::Travel if !v.is_some_and(|v| v.is_finite() && v >= 0.0) => {
+                Err(bad(NON_NEGATIVE.into()))
+            }
+            Rule::Length | Rule::Travel if v.is_some_and(|v| v > MAX_COORD_MM) => {
+                Err(bad(format!("at most {MAX_COORD_MM} mm (1 km)")))
             }
             Rule::Range(lo, hi) if !v.is_some_and(|v| (lo..=hi).contains(&v)) => {
                 Err(bad(format!("between {lo} and {hi}")))
@@ -302,7 +316,7 @@ pub fn profile_specs() -> Vec<FieldSpec<MachineProfile>> {
             "mm",
             "stroke_mm[0]",
             "base-stage travel in x: field centres range over [0, stroke]",
-            NonNegative,
+            Rule::Travel,
             |p| p.stroke_mm[0]
         ),
         number!(
@@ -310,7 +324,7 @@ pub fn profile_specs() -> Vec<FieldSpec<MachineProfile>> {
             "mm",
             "stroke_mm[1]",
             "base-stage travel in y",
-            NonNegative,
+            Rule::Travel,
             |p| p.stroke_mm[1]
         ),
         number!(
@@ -318,7 +332,7 @@ pub fn profile_specs() -> Vec<FieldSpec<MachineProfile>> {
             "mm",
             "field_mm[0]",
             "scan-field size in x",
-            Positive,
+            Rule::Length,
             |p| p.field_mm[0]
         ),
         number!(
@@ -326,7 +340,7 @@ pub fn profile_specs() -> Vec<FieldSpec<MachineProfile>> {
             "mm",
             "field_mm[1]",
             "scan-field size in y",
-            Positive,
+            Rule::Length,
             |p| p.field_mm[1]
         ),
         number!(
@@ -895,6 +909,66 @@ pub fn hatch_words(h: Option<&HatchSettings>) -> String {
     }
 }
 
+/// The tray of a production job (the Tray section's rows): counts, pitch, serials. The
+/// numbering is a choice the section offers beside them.
+pub fn tray_specs() -> Vec<FieldSpec<super::TraySetup>> {
+    use super::production::MAX_CELLS;
+    vec![
+        whole!(
+            "Columns",
+            "tray.cols",
+            "parts across (x)",
+            1,
+            MAX_CELLS,
+            u32,
+            |p| p.tray.cols
+        ),
+        whole!(
+            "Rows",
+            "tray.rows",
+            "parts down (y)",
+            1,
+            MAX_CELLS,
+            u32,
+            |p| p.tray.rows
+        ),
+        number!(
+            "Pitch X",
+            "mm",
+            "tray.pitch_mm[0]",
+            "from one part to the next across",
+            Rule::Travel,
+            |p| p.tray.pitch_mm[0]
+        ),
+        number!(
+            "Pitch Y",
+            "mm",
+            "tray.pitch_mm[1]",
+            "from one part to the next down",
+            Rule::Travel,
+            |p| p.tray.pitch_mm[1]
+        ),
+        whole!(
+            "First serial",
+            "serial.start",
+            "the serial number of part 1",
+            0,
+            i64::MAX,
+            i64,
+            |p| p.serial.start
+        ),
+        whole!(
+            "Serial step",
+            "serial.step",
+            "from one part's serial to the next",
+            1,
+            1_000_000_000u64,
+            i64,
+            |p| p.serial.step
+        ),
+    ]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -931,6 +1005,14 @@ mod tests {
             "Field width (mm) must be a positive number, not -1"
         );
         assert_eq!(e.key, "field_mm[0]");
+        // a size beyond any machine is refused too (artwork is bounded the same way)
+        p.field_mm[0] = 2e6;
+        let e = check_all(&specs, &p).unwrap_err();
+        assert!(
+            e.to_string()
+                .ends_with("must be at most 1000000 mm (1 km), not 2000000"),
+            "{e}"
+        );
         let pen = pen_specs();
         let mut a = Pen::default();
         let b = a.clone();

@@ -5,6 +5,7 @@ mod gcode;
 mod guard;
 mod linuxcnc;
 mod linuxcnc_config;
+mod parts_log;
 mod report;
 mod svg_preview;
 mod trajectory;
@@ -12,6 +13,7 @@ mod trajectory;
 pub use gcode::{write_gcode, write_gcode_to, GcodeError};
 pub use guard::{check_outputs, OutputClash};
 pub use linuxcnc_config::{linuxcnc_config, ConfigFile, LIMIT_MARGIN_MM};
+pub use parts_log::{append_parts_log, parts_log_rows, PARTS_LOG_HEADER};
 pub use report::{report_json, Report};
 pub use svg_preview::{geometry_svg, preview_svg};
 pub use trajectory::{

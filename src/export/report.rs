@@ -1,7 +1,7 @@
 //! The JSON report (`--report`): fields, order, metrics, settings, history, warnings.
 
 use crate::document::{
-    GenerationRecord, Layer, MachineProfile, Metrics, Plan, SolverSettings, Warning,
+    GenerationRecord, Layer, MachineProfile, Metrics, PartRecord, Plan, SolverSettings, Warning,
 };
 use serde::Serialize;
 
@@ -63,6 +63,10 @@ pub struct Report<'a> {
     pub history: &'a [GenerationRecord],
     /// Seams: where artwork larger than a field was cut.
     pub seams: ReportSeams<'a>,
+    /// The tray's parts: number, cell, position, serial and every text as marked (absent when
+    /// the job is not a tray).
+    #[serde(skip_serializing_if = "<[_]>::is_empty")]
+    pub parts: &'a [PartRecord],
     /// Import warnings.
     pub warnings: Vec<String>,
 }
@@ -123,6 +127,7 @@ pub fn report_json(source: &str, plan: &Plan, warnings: &[Warning]) -> String {
         profile: &plan.profile,
         pens: &plan.layers,
         history: &plan.history,
+        parts: &plan.parts,
         seams: ReportSeams {
             count: plan.seams.seams(),
             length_mm: plan.seams.length_mm(),

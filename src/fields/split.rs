@@ -187,6 +187,7 @@ pub fn cut_at_tiling(
                         element: format!("{} (piece {k})", g.source.element),
                         subpath: g.source.subpath,
                         layer: g.source.layer.clone(),
+                        part: g.source.part,
                     }
                 };
                 let piece = Geometry::new(points, closed, source).with_layer(&g.layer);

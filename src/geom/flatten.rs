@@ -6,25 +6,55 @@
 //! parameter range into `n` equal steps with `n ≥ sqrt(max‖B''‖ / (8·tol))` therefore keeps every
 //! point of the curve within `tol` of the polyline (a guarantee, not an estimate).
 
+//!
+//! The count depends on the curve's size: with every control point within ±`C` mm, the second
+//! differences are at most `4√2·C`, so `n ≤ sqrt(6·4√2·C / (8·tol)) ≈ 2.06·sqrt(C/tol)`. With the
+//! import's bound `C = 10⁶` mm that is `2,100/√tol` (21,000 chords at 0.01 mm). Callers with a
+//! budget ask [`quad_chords`] / [`cubic_chords`] first and refuse a curve that would exceed it;
+//! [`MAX_CHORDS`] is only the last guard for callers without one.
+
 use super::Pt;
 
-/// Upper bound on the number of chords per segment (guards against absurd inputs).
-const MAX_CHORDS: usize = 100_000;
+/// Last-resort cap on the chords of one segment, above what any curve within ±10⁶ mm needs at
+/// a 10⁻⁶ mm tolerance (2.1·10⁶): bounded input never reaches it, so the tolerance holds.
+pub const MAX_CHORDS: usize = 4_000_000;
 
+/// Chords for a second-derivative bound; `usize::MAX` when it is not finite.
 fn chords_for(second_derivative_bound: f64, tol_mm: f64) -> usize {
     let tol = tol_mm.max(1e-9);
     let n = (second_derivative_bound / (8.0 * tol)).sqrt().ceil();
     if n.is_finite() {
-        (n as usize).clamp(1, MAX_CHORDS)
+        (n as usize).max(1)
     } else {
-        1
+        usize::MAX
     }
+}
+
+/// The chords a flattening makes: one (the end point) for a curve that is not finite, at most
+/// [`MAX_CHORDS`].
+fn capped(n: usize) -> usize {
+    if n == usize::MAX {
+        1
+    } else {
+        n.min(MAX_CHORDS)
+    }
+}
+
+/// Chords [`flatten_quad`] makes for this quadratic (before its [`MAX_CHORDS`] cap).
+pub fn quad_chords(p0: Pt, p1: Pt, p2: Pt, tol_mm: f64) -> usize {
+    chords_for(p0.minus(p1.scale(2.0)).plus(p2).norm() * 2.0, tol_mm)
+}
+
+/// Chords [`flatten_cubic`] makes for this cubic (before its [`MAX_CHORDS`] cap).
+pub fn cubic_chords(p0: Pt, p1: Pt, p2: Pt, p3: Pt, tol_mm: f64) -> usize {
+    let a = p0.minus(p1.scale(2.0)).plus(p2).norm();
+    let b = p1.minus(p2.scale(2.0)).plus(p3).norm();
+    chords_for(6.0 * a.max(b), tol_mm)
 }
 
 /// Appends the flattened quadratic Bézier `p0`–`p1`–`p2` to `out`, excluding `p0`.
 pub fn flatten_quad(p0: Pt, p1: Pt, p2: Pt, tol_mm: f64, out: &mut Vec<Pt>) {
-    let dd = p0.minus(p1.scale(2.0)).plus(p2).norm() * 2.0;
-    let n = chords_for(dd, tol_mm);
+    let n = capped(quad_chords(p0, p1, p2, tol_mm));
     for i in 1..=n {
         let t = i as f64 / n as f64;
         let u = 1.0 - t;
@@ -38,9 +68,7 @@ pub fn flatten_quad(p0: Pt, p1: Pt, p2: Pt, tol_mm: f64, out: &mut Vec<Pt>) {
 
 /// Appends the flattened cubic Bézier `p0`–`p1`–`p2`–`p3` to `out`, excluding `p0`.
 pub fn flatten_cubic(p0: Pt, p1: Pt, p2: Pt, p3: Pt, tol_mm: f64, out: &mut Vec<Pt>) {
-    let a = p0.minus(p1.scale(2.0)).plus(p2).norm();
-    let b = p1.minus(p2.scale(2.0)).plus(p3).norm();
-    let n = chords_for(6.0 * a.max(b), tol_mm);
+    let n = capped(cubic_chords(p0, p1, p2, p3, tol_mm));
     for i in 1..=n {
         out.push(cubic_at(p0, p1, p2, p3, i as f64 / n as f64));
     }

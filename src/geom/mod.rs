@@ -7,9 +7,20 @@ pub(crate) mod grid;
 pub mod seam;
 pub mod tiling;
 
-pub use flatten::{flatten_cubic, flatten_quad};
+pub use flatten::{cubic_chords, flatten_cubic, flatten_quad, quad_chords};
 
 use serde::{Deserialize, Serialize};
+
+/// Largest coordinate (|x| and |y|) galvoplan takes from any file, mm: 1 km, beyond any machine.
+/// The importers (SVG after its transforms, DXF), the project loader and the profile check
+/// refuse a point, radius or size past it, naming where; with it, flattening a curve takes a
+/// number of chords bounded by the tolerance alone ([`flatten`]'s module note).
+pub const MAX_COORD_MM: f64 = 1.0e6;
+
+/// True when both coordinates are within ±[`MAX_COORD_MM`] (and so finite).
+pub fn within_reach_bound(p: Pt) -> bool {
+    p.x.abs() <= MAX_COORD_MM && p.y.abs() <= MAX_COORD_MM
+}
 
 /// A point (or vector) in millimetres.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]

@@ -3,7 +3,7 @@
 //! their outlines. Strokes larger than a field are cut later, on the document's tiling
 //! (`fields::cut_hatch_at_tiling`).
 
-use super::{hatch_contours, HatchError, HatchSettings, OutlineMode};
+use super::{hatch_contours, HatchError, HatchSettings, OutlineMode, MAX_JOB_LINES};
 use crate::document::{FillShapes, Geometry, Layer, Source, Warning};
 use crate::geom::Pt;
 use crate::job::JobCtx;
@@ -111,6 +111,7 @@ pub fn layer_geometries(
 ) -> Result<HatchedGeometries, HatchError> {
     let mut out = HatchedGeometries::default();
     let mut hatched: HashMap<&str, Vec<Geometry>> = HashMap::new();
+    let mut lines = 0.0;
     for l in layers.iter().filter(|l| l.pen.enabled) {
         let Some(settings) = &l.pen.hatch else {
             continue;
@@ -122,6 +123,14 @@ pub fn layer_geometries(
             .collect();
         if members.is_empty() {
             continue;
+        }
+        lines += estimated_lines(&members, settings);
+        if lines > MAX_JOB_LINES {
+            return Err(HatchError::TooManyLines {
+                layer: l.name.clone(),
+                spacing_mm: settings.spacing_mm,
+                lines,
+            });
         }
         let h = hatch_geometries(&members, settings, ctx)?;
         out.warnings.extend(h.warnings);
@@ -141,6 +150,21 @@ pub fn layer_geometries(
         }
     }
     Ok(out)
+}
+
+/// An upper estimate of the lines a hatch makes of `geometries`: per region its bounding box's
+/// diagonal over the spacing, twice (a second family, or rings and gap strokes).
+pub fn estimated_lines(geometries: &[Geometry], settings: &HatchSettings) -> f64 {
+    let spacing = settings.spacing_mm.max(super::MIN_SPACING_MM);
+    fill_regions(geometries, settings.shapes)
+        .iter()
+        .map(|members| {
+            let b = members.iter().fold(crate::geom::BBox::EMPTY, |b, &k| {
+                b.union(crate::geom::BBox::of(&geometries[k].points))
+            });
+            2.0 * (b.width().hypot(b.height()) / spacing).ceil()
+        })
+        .sum()
 }
 
 /// The regions to fill, each a list of closed geometries (indices), in order of first
@@ -240,6 +264,7 @@ fn hatch_region(
                 element: first.source.element.clone(),
                 subpath: k,
                 layer: layer.clone(),
+                part: first.source.part,
             };
             Geometry::new(s.points, s.closed, source)
                 .with_layer(&first.layer)
@@ -261,6 +286,7 @@ mod tests {
                 element: element.into(),
                 subpath: 0,
                 layer: "#000000".into(),
+                part: 0,
             },
         )
     }

@@ -55,6 +55,11 @@ const FLATTEN_TOL_SPACING: f64 = 1e-3;
 const MIN_STROKE_SPACING: f64 = 2e-3;
 /// At most this many lines per family (or rings) per region.
 pub const MAX_LINES: usize = 1_000_000;
+/// At most about this many hatch lines in one job, all layers together (an upper estimate made
+/// before hatching: each region's diagonal over the spacing, twice for two families): ten times
+/// the largest job benchmarked (a million strokes, 1 GB), so no file can take the machine's
+/// memory through its hatch.
+pub const MAX_JOB_LINES: f64 = 1e7;
 
 /// Why a hatch could not be made.
 #[derive(Debug, Error)]
@@ -62,6 +67,19 @@ pub enum HatchError {
     /// The settings are out of range.
     #[error("hatch settings: {0}")]
     Settings(#[from] crate::document::validate::InvalidValue),
+    /// The layers' hatches together would make more lines than one job may have.
+    #[error(
+        "layer '{layer}': hatching its shapes at {spacing_mm} mm would make about {lines:.0} lines \
+         with the layers before it, beyond the {MAX_JOB_LINES:e} of one job; raise the hatch spacing"
+    )]
+    TooManyLines {
+        /// The layer that passes the budget.
+        layer: String,
+        /// Its spacing, mm.
+        spacing_mm: f64,
+        /// Estimated lines so far.
+        lines: f64,
+    },
     /// The spacing is too fine for the region's size.
     #[error(
         "{element}: hatch spacing {spacing_mm} mm would need {lines} lines (at most {MAX_LINES})"

@@ -17,14 +17,16 @@
 use super::curves::{bulge_arc, fit_point_spline, Affine, ConicArc, Nurbs};
 use super::dxf_scan::{self, ScannedEntity};
 use super::dxf_text::{self, TextRun};
+use super::fonts::BUNDLED_CAP_HEIGHT_EM;
 use super::svg::too_many_points;
 use super::svg::Outline;
 use super::{
     guard, normalise, nothing_to_mark, placed, ImportError, ImportOptions, Imported, LayerHidden,
-    SkippedLayer, Warning, LIST_MAX, MAX_POINTS,
+    SkippedLayer, Warning, LIST_MAX, MAX_COORD_MM, MAX_GLYPHS, MAX_POINTS,
 };
-use crate::document::{Geometry, Source};
-use crate::geom::{flatten_cubic, BBox, Pt};
+use crate::document::production::{is_template, parse_template};
+use crate::document::{Geometry, Source, TextAlign, TextTemplate};
+use crate::geom::{cubic_chords, flatten_cubic, BBox, Pt};
 use ::dxf::entities::{Entity, EntityType};
 use ::dxf::enums::Units;
 use ::dxf::{Block, Drawing};
@@ -37,8 +39,6 @@ const MAX_VISITS: usize = 2_000_000;
 const MAX_INSTANCES: usize = 1_000_000;
 /// Deepest block nesting followed (a block inserting itself is caught earlier).
 const MAX_INSERT_DEPTH: usize = 32;
-/// Coordinates beyond 1 km are not artwork (and would make arcs need millions of chords).
-const MAX_COORD_MM: f64 = 1.0e6;
 /// Why an entity off the XY plane is skipped.
 const OFF_PLANE: &str = "not parallel to the XY plane (3D)";
 /// A normal counts as ±Z when its x and y parts are below this (DXF writes unit vectors).
@@ -123,6 +123,9 @@ pub fn import_dxf(bytes: &[u8], file: &str, opts: &ImportOptions) -> Result<Impo
         invisible: 0,
         invisible_listed: Vec::new(),
         inserted: FxHashSet::default(),
+        glyphs: 0,
+        templates: Vec::new(),
+        mtext: scanned.mtext.into_iter().collect(),
     };
     let to_mm = Affine::scale(unit_mm, unit_mm);
     for e in drawing.entities() {
@@ -133,11 +136,12 @@ pub fn import_dxf(bytes: &[u8], file: &str, opts: &ImportOptions) -> Result<Impo
     let Walk {
         raw,
         warnings: walked,
+        templates,
         ..
     } = walk;
     warnings.extend(walked);
     warnings.extend(summaries);
-    if raw.is_empty() {
+    if raw.is_empty() && templates.is_empty() {
         return Err(nothing_to_mark(
             file,
             &warnings,
@@ -145,12 +149,24 @@ pub fn import_dxf(bytes: &[u8], file: &str, opts: &ImportOptions) -> Result<Impo
         ));
     }
     let (geometries, page_mm) = flip(raw);
+    // the templates flipped as the geometries: y_mm = page height − y
+    let flip_y = Affine {
+        m: [1.0, 0.0, 0.0, -1.0, 0.0, page_mm[1]],
+    };
+    let templates = templates
+        .into_iter()
+        .map(|mut t| {
+            t.frame = flip_y.then(Affine { m: t.frame }).m;
+            t
+        })
+        .collect();
     let imported = Imported {
         geometries,
         warnings,
         page_mm,
         skipped_layers,
         moved_mm: [0.0, 0.0],
+        templates,
     };
     placed(imported, file, opts)
 }
@@ -282,6 +298,12 @@ struct Walk<'d> {
     invisible_listed: Vec<String>,
     /// Blocks inserted where the drawing shows them (upper-case names).
     inserted: FxHashSet<String>,
+    /// Characters of text laid out so far (each block instance counted).
+    glyphs: usize,
+    /// Texts holding fields, in the drawing's y-up mm.
+    templates: Vec<TextTemplate>,
+    /// Each MTEXT's text as the file writes it, by handle (see `dxf_scan::Scan::mtext`).
+    mtext: FxHashMap<String, String>,
 }
 
 /// The DXF name of an entity type (its variant name in capitals for the rare ones).
@@ -492,6 +514,7 @@ impl<'d> Walk<'d> {
         let tol = self.opts.chord_tol_mm.max(1e-6);
         match curve_paths(&e.specific, m, tol) {
             Ok(Some(paths)) => return self.push_paths(paths, &element, &layer),
+            Err(why) if why == BEYOND => return Err(self.beyond(&element, &layer)),
             Err(why) => {
                 self.warn(element, &layer, format!("{why}; skipped"));
                 return Ok(());
@@ -504,12 +527,14 @@ impl<'d> Walk<'d> {
             EntityType::Insert(ins) => return self.insert(e, ins, m, &layer),
             EntityType::Text(t) => {
                 let run = dxf_text::text_run(t, self.drawing, self.opts);
-                self.text(run, ocs(&t.normal), m, &element, &layer, &mut paths);
+                self.text(run, ocs(&t.normal), m, &element, &layer, &mut paths)?;
             }
             EntityType::MText(t) => {
-                let run = dxf_text::mtext_run(t, self.drawing, self.opts);
+                let handle = format!("{:X}", e.common.handle.0);
+                let raw = self.mtext.get(&handle).map(String::as_str);
+                let run = dxf_text::mtext_run(t, raw, self.drawing, self.opts);
                 let o = ocs(&t.extrusion_direction);
-                self.text(run, o, m, &element, &layer, &mut paths);
+                self.text(run, o, m, &element, &layer, &mut paths)?;
             }
             EntityType::ModelPoint(_) => {
                 self.warn(element, &layer, "a point has nothing to mark; skipped");
@@ -652,21 +677,34 @@ impl<'d> Walk<'d> {
         element: &str,
         layer: &str,
         paths: &mut Vec<Outline>,
-    ) {
+    ) -> Result<(), ImportError> {
         let Some(o) = ocs else {
             self.warn(element.to_string(), layer, OFF_PLANE);
-            return;
+            return Ok(());
         };
         let frame = m.then(o).then(run.frame);
         let scale = frame_scale(&frame);
         let height_mm = run.height * scale;
         if !height_mm.is_finite() || height_mm > MAX_COORD_MM {
-            self.warn(
-                element.to_string(),
-                layer,
-                format!("text height {height_mm} mm: {BEYOND}; skipped"),
-            );
-            return;
+            return Err(self.beyond(element, layer));
+        }
+        self.glyphs += run
+            .lines
+            .iter()
+            .map(|l| l.chars().filter(|c| !c.is_whitespace()).count())
+            .sum::<usize>();
+        if self.glyphs > MAX_GLYPHS {
+            return Err(ImportError::Bounds {
+                file: self.file.into(),
+                detail: format!(
+                    "{element} on layer {layer}: the drawing's text reaches {} characters, \
+                     beyond the {MAX_GLYPHS} galvoplan lays out in one file",
+                    self.glyphs
+                ),
+            });
+        }
+        if run.lines.iter().any(|l| is_template(l)) {
+            return self.template(&run, &frame, element, layer);
         }
         let tol_local = self.opts.chord_tol_mm.max(1e-6) / scale.max(1e-12);
         let budget = MAX_POINTS.saturating_sub(self.points);
@@ -687,6 +725,54 @@ impl<'d> Walk<'d> {
                 format!("text not laid out: {why}; skipped"),
             ),
         }
+        Ok(())
+    }
+
+    /// A TEXT or MTEXT holding fields (read after MTEXT's own codes are stripped), kept as a
+    /// template in the drawing's y-up mm (`frame`: text frame → mm); the import flips it with
+    /// the geometries.
+    fn template(
+        &mut self,
+        run: &TextRun,
+        frame: &Affine,
+        element: &str,
+        layer: &str,
+    ) -> Result<(), ImportError> {
+        let text = run.lines.join("\n");
+        if let Err(why) = parse_template(&text) {
+            return Err(ImportError::Field {
+                file: self.file.into(),
+                detail: format!("{element} on layer {layer} text \"{text}\": {why}"),
+            });
+        }
+        let (h, v) = run.anchor;
+        self.templates.push(TextTemplate {
+            text,
+            element: element.to_string(),
+            line: None,
+            layer: layer.to_string(),
+            family: run.family.clone(),
+            em: run.height / BUNDLED_CAP_HEIGHT_EM,
+            pitch: run.pitch,
+            align: match h {
+                dxf_text::HAnchor::Start => TextAlign::Start,
+                dxf_text::HAnchor::Middle => TextAlign::Middle,
+                dxf_text::HAnchor::End => TextAlign::End,
+            },
+            first_baseline: dxf_text::first_baseline(run.lines.len(), run.height, run.pitch, v),
+            frame: frame.m,
+        });
+        Ok(())
+    }
+
+    /// The error for an entity beyond [`MAX_COORD_MM`]: the file is refused, naming it.
+    fn beyond(&self, element: &str, layer: &str) -> ImportError {
+        ImportError::Bounds {
+            file: self.file.into(),
+            detail: format!(
+                "{element} on layer {layer}: {BEYOND}; galvoplan reads drawings within it"
+            ),
+        }
     }
 
     fn push_paths(
@@ -700,18 +786,13 @@ impl<'d> Walk<'d> {
             if self.points > MAX_POINTS {
                 return Err(ImportError::TooLarge {
                     file: self.file.into(),
-                    detail: too_many_points(self.opts.chord_tol_mm),
+                    detail: too_many_points(self.opts.chord_tol_mm, element),
                 });
             }
-            let absurd = points
-                .iter()
-                .any(|p| p.x.abs() > MAX_COORD_MM || p.y.abs() > MAX_COORD_MM);
-            let normalised = if absurd {
-                Err("coordinates beyond 1 km")
-            } else {
-                normalise(points, closed)
-            };
-            match normalised {
+            if !points.iter().all(|&p| bounded(p)) {
+                return Err(self.beyond(element, layer));
+            }
+            match normalise(points, closed) {
                 Ok((points, closed)) => self.raw.push(Raw {
                     points,
                     closed,
@@ -719,6 +800,7 @@ impl<'d> Walk<'d> {
                         element: element.to_string(),
                         subpath,
                         layer: layer.to_string(),
+                        part: 0,
                     },
                 }),
                 Err(why) => self.warn(
@@ -816,7 +898,8 @@ fn bulge_path(v: &[(Pt, f64)], closed: bool, m: &Affine, tol: f64) -> Outline {
     for i in 0..segments {
         let (p0, bulge) = v[i];
         let p1 = v[(i + 1) % n].0;
-        // an arc beyond the coordinate limit is not flattened: normalise rejects the path
+        // an arc beyond the coordinate limit is not flattened: its end point is, and the path
+        // is refused with it (`push_paths`) when that end lies beyond the limit too
         match bulge_arc(p0, p1, bulge).and_then(|a| bounded_arc(a.mapped(m)).ok()) {
             Some(arc) => arc.flatten(tol, &mut out),
             None => out.push(m.apply(p1)),
@@ -829,10 +912,11 @@ fn bulge_path(v: &[(Pt, f64)], closed: bool, m: &Affine, tol: f64) -> Outline {
     (out, closed)
 }
 
-const BEYOND: &str = "coordinates beyond 1 km";
+/// Why an entity is refused: a point, radius or text height past [`MAX_COORD_MM`] (1 km).
+const BEYOND: &str = "a coordinate, radius or text height beyond ±1e6 mm (1 km)";
 
 fn bounded(p: Pt) -> bool {
-    p.x.abs() <= MAX_COORD_MM && p.y.abs() <= MAX_COORD_MM
+    crate::geom::within_reach_bound(p)
 }
 
 /// The arc when it lies within the coordinate limit (checked before it is flattened).
@@ -885,6 +969,15 @@ fn spline_paths(s: &::dxf::entities::Spline, m: &Affine, tol: f64) -> Result<Vec
         let mapped: Vec<[Pt; 4]> = spans.iter().map(|b| b.map(|p| m.apply(p))).collect();
         if !mapped.iter().flatten().all(|&p| bounded(p)) {
             return Err(BEYOND.into());
+        }
+        let chords = mapped.iter().fold(0usize, |n, &[p0, p1, p2, p3]| {
+            n.saturating_add(cubic_chords(p0, p1, p2, p3, tol))
+        });
+        if chords > MAX_POINTS {
+            return Err(format!(
+                "flattens to more than {MAX_POINTS} vertices at a chord tolerance of {tol} \
+                 drawing units; raise the chord tolerance"
+            ));
         }
         let mut out = vec![m.apply(fit[0])];
         for [p0, p1, p2, p3] in mapped {

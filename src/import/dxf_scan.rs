@@ -167,6 +167,10 @@ pub struct Scan {
     pub layers: Vec<(String, LayerState)>,
     /// The entities of the ENTITIES and BLOCKS sections whose type the caller asked for.
     pub entities: Vec<ScannedEntity>,
+    /// Each MTEXT's text as written (codes 3 then 1), by handle in upper-case hex: the `dxf`
+    /// crate drops an escape such as `\}` within the last six characters of a value (its
+    /// `\U+XXXX` reader waits for six more), which loses the closing brace of a field.
+    pub mtext: Vec<(String, String)>,
 }
 
 /// One record (the pairs from a code 0 to the next).
@@ -180,6 +184,10 @@ struct Record {
     colour: i32,
     flags: i32,
     invisible: bool,
+    /// Text values (codes 3 and 1), in order.
+    text: String,
+    /// The code 1 value (the last piece of an MTEXT's text).
+    last_text: Option<String>,
 }
 
 /// Scans a DXF file, ASCII or binary, in one pass: the layer table's layers with their state,
@@ -220,6 +228,13 @@ fn scan_pairs<'a>(pairs: impl Iterator<Item = Pair<'a>>, keep: impl Fn(&str) -> 
             "ENTITIES" | "BLOCKS" => match r.kind.as_str() {
                 "BLOCK" => *block = r.name,
                 "ENDBLK" => *block = None,
+                "MTEXT" => {
+                    if let Some(h) = r.handle {
+                        let mut text = r.text;
+                        text.push_str(r.last_text.as_deref().unwrap_or(""));
+                        out.mtext.push((h.to_ascii_uppercase(), text));
+                    }
+                }
                 kind if keep(kind) => out.entities.push(ScannedEntity {
                     kind: r.kind.clone(),
                     handle: r.handle.unwrap_or_else(|| "?".into()),
@@ -277,6 +292,8 @@ fn scan_pairs<'a>(pairs: impl Iterator<Item = Pair<'a>>, keep: impl Fn(&str) -> 
             60 => r.invisible = int() != 0,
             62 => r.colour = int(),
             70 => r.flags = int(),
+            3 if r.kind == "MTEXT" => r.text.push_str(&p.value),
+            1 if r.kind == "MTEXT" => r.last_text = Some(p.value.to_string()),
             _ => {}
         }
     }

@@ -10,6 +10,7 @@ use super::curves::Affine;
 use super::fonts::{database, BUNDLED_CAP_HEIGHT_EM, BUNDLED_FAMILY};
 use super::svg::{text_outlines, Outline, PX_TO_MM};
 use super::{ImportOptions, Warning};
+use crate::document::TextAlign;
 use crate::geom::Pt;
 use ::dxf::entities::{MText, Text};
 use ::dxf::enums::{AttachmentPoint, HorizontalTextJustification, VerticalTextJustification};
@@ -151,7 +152,35 @@ pub fn text_run(t: &Text, drawing: &Drawing, opts: &ImportOptions) -> TextRun {
 }
 
 /// An MTEXT entity (WCS insertion point, direction from the x axis or the rotation in degrees).
-pub fn mtext_run(t: &MText, drawing: &Drawing, opts: &ImportOptions) -> TextRun {
+/// `\U+XXXX` escapes of a DXF value as written, decoded (what the `dxf` crate does to values
+/// it reads); anything else is kept for [`strip_mtext`].
+fn decode_unicode(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    let mut rest = s;
+    while let Some(i) = rest.find("\\U+") {
+        out.push_str(&rest[..i]);
+        let hex = rest.get(i + 3..i + 7);
+        match hex
+            .and_then(|h| u32::from_str_radix(h, 16).ok())
+            .and_then(char::from_u32)
+        {
+            Some(c) => {
+                out.push(c);
+                rest = &rest[i + 7..];
+            }
+            None => {
+                out.push_str("\\U+");
+                rest = &rest[i + 3..];
+            }
+        }
+    }
+    out.push_str(rest);
+    out
+}
+
+/// An MTEXT entity (`raw`: its text as the file writes it, when the scan of the file found it;
+/// else the `dxf` crate's reading of it).
+pub fn mtext_run(t: &MText, raw: Option<&str>, drawing: &Drawing, opts: &ImportOptions) -> TextRun {
     use AttachmentPoint as A;
     let (h, v) = match t.attachment_point {
         A::TopLeft => (HAnchor::Start, VAnchor::Top),
@@ -170,8 +199,14 @@ pub fn mtext_run(t: &MText, drawing: &Drawing, opts: &ImportOptions) -> TextRun 
     } else {
         t.rotation_angle.to_radians()
     };
-    let mut raw: String = t.extended_text.concat();
-    raw.push_str(&t.text);
+    let raw = match raw {
+        Some(r) => decode_unicode(r),
+        None => {
+            let mut r: String = t.extended_text.concat();
+            r.push_str(&t.text);
+            r
+        }
+    };
     let spacing = if t.line_spacing_factor > 0.0 {
         t.line_spacing_factor
     } else {
@@ -282,29 +317,74 @@ pub fn outlines(
         return Err(format!("{chars} characters (more than {MAX_TEXT_CHARS})"));
     }
     let (h, v) = run.anchor;
-    let n = run.lines.len().max(1) as f64;
-    // first baseline, y up, relative to the anchor
-    let first = match v {
-        VAnchor::Baseline => 0.0,
-        VAnchor::Top => -run.height,
-        VAnchor::Middle => (-run.height + (n - 1.0) * run.pitch) / 2.0,
-        VAnchor::Bottom => (n - 1.0) * run.pitch + DESCENT_EM / BUNDLED_CAP_HEIGHT_EM * run.height,
+    let align = match h {
+        HAnchor::Start => TextAlign::Start,
+        HAnchor::Middle => TextAlign::Middle,
+        HAnchor::End => TextAlign::End,
     };
-    // the SVG is in px: 1 drawing unit = 1 mm of the SVG importer's output
-    let px = 1.0 / PX_TO_MM;
     let em = run.height / BUNDLED_CAP_HEIGHT_EM;
-    let anchor = match h {
-        HAnchor::Start => "start",
-        HAnchor::Middle => "middle",
-        HAnchor::End => "end",
+    let layout = Layout {
+        family: &run.family,
+        em,
+        pitch: run.pitch,
+        first_baseline: first_baseline(run.lines.len(), run.height, run.pitch, v),
+        align,
+    };
+    glyph_outlines(&run.lines, &layout, opts, tol, budget)
+}
+
+/// The first baseline above the anchor (y up) of `lines` lines of cap height `height`, `pitch`
+/// apart, for a vertical anchor.
+pub fn first_baseline(lines: usize, height: f64, pitch: f64, v: VAnchor) -> f64 {
+    let n = lines.max(1) as f64;
+    match v {
+        VAnchor::Baseline => 0.0,
+        VAnchor::Top => -height,
+        VAnchor::Middle => (-height + (n - 1.0) * pitch) / 2.0,
+        VAnchor::Bottom => (n - 1.0) * pitch + DESCENT_EM / BUNDLED_CAP_HEIGHT_EM * height,
+    }
+}
+
+/// How lines of text sit in their frame (x along the baseline, y up, origin at the anchor), in
+/// the frame's units.
+pub struct Layout<'a> {
+    /// Font family list, as CSS writes it.
+    pub family: &'a str,
+    /// Font size (em).
+    pub em: f64,
+    /// Baseline-to-baseline distance.
+    pub pitch: f64,
+    /// The first baseline's height above the anchor.
+    pub first_baseline: f64,
+    /// Alignment along the baseline.
+    pub align: TextAlign,
+}
+
+/// The glyph outlines of `lines` laid out as `layout` says, in its frame (y up), flattened
+/// within `tol` frame units into at most `budget` vertices, with the font warnings. The one
+/// text path of DXF text and of text templates: a small SVG laid out by usvg with the import's
+/// fonts.
+pub fn glyph_outlines(
+    lines: &[String],
+    layout: &Layout,
+    opts: &ImportOptions,
+    tol: f64,
+    budget: usize,
+) -> Result<(Vec<Outline>, Vec<Warning>), String> {
+    // the SVG is in px: 1 frame unit = 1 mm of the SVG importer's output
+    let px = 1.0 / PX_TO_MM;
+    let anchor = match layout.align {
+        TextAlign::Start => "start",
+        TextAlign::Middle => "middle",
+        TextAlign::End => "end",
     };
     let mut svg = format!(
         r#"<svg xmlns="http://www.w3.org/2000/svg" width="1" height="1"><text font-family="{}" font-size="{}" text-anchor="{anchor}" xml:space="preserve">"#,
-        xml_escape(&run.family),
-        em * px
+        xml_escape(layout.family),
+        layout.em * px
     );
-    for (i, line) in run.lines.iter().enumerate() {
-        let y = -(first - i as f64 * run.pitch) * px;
+    for (i, line) in lines.iter().enumerate() {
+        let y = -(layout.first_baseline - i as f64 * layout.pitch) * px;
         svg.push_str(&format!(
             r#"<tspan x="0" y="{y}">{}</tspan>"#,
             xml_escape(line)
@@ -330,5 +410,11 @@ mod tests {
             "SN 0042\nACME 1/2 10°"
         );
         assert_eq!(strip_mtext(r"a\\b\{c\}"), r"a\b{c}");
+        assert_eq!(decode_unicode(r"a\U+00B0b\U+zz"), "a°b\\U+zz");
+        // a field in a formatted MTEXT: the braces of the format go, the escaped ones stay
+        assert_eq!(
+            strip_mtext(r"{\fArial|b1;SN} \{serial:04\}"),
+            "SN {serial:04}"
+        );
     }
 }

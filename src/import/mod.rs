@@ -12,23 +12,34 @@ mod fonts;
 mod guard;
 mod place;
 mod svg;
+mod svg_bounds;
 mod svg_scan;
+mod template;
 
 pub use self::dxf::import_dxf;
 pub use crate::document::{ArtworkImport, LayerHidden, Place, PlaceError, SkippedLayer};
 pub use fonts::{bundled_font, BUNDLED_CAP_HEIGHT_EM, BUNDLED_FAMILY};
 pub use place::place_artwork;
 pub use svg::{import_svg, import_svg_file};
+pub use svg_bounds::USER_MAX;
+pub use template::shape_template;
 
-use crate::document::Geometry;
+use crate::document::{Geometry, TextTemplate};
 use crate::geom::{polyline_length, Pt};
 
 use std::path::Path;
 use thiserror::Error;
 
 /// Output budget of one import: more vertices than this is an error, not minutes of flattening
-/// and gigabytes of memory (80 MB of points).
-const MAX_POINTS: usize = 5_000_000;
+/// and gigabytes of memory (80 MB of points). One curve's share follows from [`MAX_COORD_MM`]
+/// and the chord tolerance (`geom::flatten`): a curve within the bound needs at most
+/// `2,100 / √tol` chords (21,000 at 0.01 mm), and a curve that would take more than what is
+/// left of the budget is refused before it is flattened.
+pub const MAX_POINTS: usize = 5_000_000;
+pub use crate::geom::MAX_COORD_MM;
+/// Most characters of text one file may lay out (each a glyph of tens of curves): beyond, the
+/// file is refused before any text is shaped.
+pub const MAX_GLYPHS: usize = 100_000;
 /// Subpaths shorter than this (mm) are degenerate: below the exported G-code's resolution.
 const MIN_LENGTH_MM: f64 = 1e-3;
 /// Points closer than this are one point (mm).
@@ -119,6 +130,9 @@ pub struct Imported {
     pub skipped_layers: Vec<SkippedLayer>,
     /// How far the placement moved the artwork (mm; zero when it stays as in the file).
     pub moved_mm: [f64; 2],
+    /// Texts holding fields (`SN {serial:05}`), kept to be shaped per part; in the file's
+    /// coordinates (the placement does not move them: `moved_mm` says where it moved the rest).
+    pub templates: Vec<TextTemplate>,
 }
 
 /// A file format [`import_file`] reads.
@@ -233,6 +247,24 @@ pub enum ImportError {
         /// The file.
         file: String,
         /// What overflowed.
+        detail: String,
+    },
+    /// A coordinate, size or count in the file beyond what galvoplan reads ([`MAX_COORD_MM`],
+    /// [`USER_MAX`], [`MAX_GLYPHS`]); `detail` names the element and where it is.
+    #[error("{file}: {detail}")]
+    Bounds {
+        /// The file.
+        file: String,
+        /// The element, its line and the number.
+        detail: String,
+    },
+    /// A text's fields cannot be read (an unknown field, an unbalanced brace); `detail` names
+    /// the text and where it is.
+    #[error("{file}: {detail}")]
+    Field {
+        /// The file.
+        file: String,
+        /// The element, its line, the text and what is wrong.
         detail: String,
     },
     /// The file holds nothing that can be marked.

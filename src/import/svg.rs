@@ -10,13 +10,16 @@
 
 use super::clip::{Region, Rule};
 use super::fonts::{family_list, miss_warnings, usvg_options, Misses};
-use super::svg_scan::{self, describe};
+use super::svg_bounds;
+use super::svg_scan;
+use super::template::{self, svg_template, SvgChunk};
 use super::{
     normalise, nothing_to_mark, placed, short_list, ImportError, ImportOptions, Imported, Warning,
-    MAX_POINTS,
+    MAX_COORD_MM, MAX_POINTS,
 };
-use crate::document::{Geometry, Source};
-use crate::geom::{flatten_cubic, flatten_quad, Pt};
+use crate::document::production::is_template;
+use crate::document::{Geometry, Source, TextAlign, TextTemplate};
+use crate::geom::{cubic_chords, flatten_cubic, flatten_quad, quad_chords, within_reach_bound, Pt};
 use rustc_hash::FxHashMap;
 use usvg::roxmltree;
 use usvg::tiny_skia_path::PathSegment;
@@ -80,23 +83,34 @@ pub fn import_svg(bytes: &[u8], file: &str, opts: &ImportOptions) -> Result<Impo
             root.tag_name().name()
         )));
     }
-    check_arc_radii(&xml).map_err(malformed)?;
+    svg_bounds::check(&xml).map_err(|detail| ImportError::Bounds {
+        file: file.into(),
+        detail,
+    })?;
+    template::check_svg_texts(&xml).map_err(|detail| ImportError::Field {
+        file: file.into(),
+        detail,
+    })?;
     let scan = svg_scan::scan(&xml, &opts.hidden_layers);
     // hidden layers the options include: shown by editing their display (same lines)
     let edited = (!scan.edits.is_empty()).then(|| svg_scan::apply_edits(text, &scan.edits));
     let reparsed = edited.as_deref().map(parse).transpose()?;
     let xml = reparsed.as_ref().unwrap_or(&xml);
     let mut warnings = scan.warnings;
-    let (geometries, page_mm, tree_warnings) =
-        tree_geometries(xml, opts, opts.chord_tol_mm, MAX_POINTS).map_err(|e| match e {
+    let (geometries, page_mm, tree_warnings, templates) =
+        tree_geometries(xml, opts, opts.chord_tol_mm, MAX_POINTS, true).map_err(|e| match e {
             TreeError::Malformed(cause) => malformed(cause),
-            TreeError::TooLarge => ImportError::TooLarge {
+            TreeError::TooLarge(element) => ImportError::TooLarge {
                 file: file.into(),
-                detail: too_many_points(opts.chord_tol_mm),
+                detail: too_many_points(opts.chord_tol_mm, &element),
+            },
+            TreeError::Beyond(detail) => ImportError::Bounds {
+                file: file.into(),
+                detail,
             },
         })?;
     warnings.extend(tree_warnings);
-    if geometries.is_empty() {
+    if geometries.is_empty() && templates.is_empty() {
         return Err(nothing_to_mark(
             file,
             &warnings,
@@ -109,12 +123,13 @@ pub fn import_svg(bytes: &[u8], file: &str, opts: &ImportOptions) -> Result<Impo
         page_mm,
         skipped_layers: scan.skipped_layers,
         moved_mm: [0.0, 0.0],
+        templates,
     };
     placed(imported, file, opts)
 }
 
-/// Geometries, page size in mm and font warnings of one usvg tree.
-type TreeGeometries = (Vec<Geometry>, [f64; 2], Vec<Warning>);
+/// Geometries, page size in mm, font warnings and texts with fields of one usvg tree.
+type TreeGeometries = (Vec<Geometry>, [f64; 2], Vec<Warning>, Vec<TextTemplate>);
 
 /// A flattened subpath: points and whether it is closed.
 pub(super) type Outline = (Vec<Pt>, bool);
@@ -123,18 +138,22 @@ pub(super) type Outline = (Vec<Pt>, bool);
 enum TreeError {
     /// usvg's own error.
     Malformed(String),
-    /// More vertices than the budget.
-    TooLarge,
+    /// More vertices than the budget, reached at this element.
+    TooLarge(String),
+    /// A point beyond [`MAX_COORD_MM`] after transforms: the element and the point.
+    Beyond(String),
 }
 
 /// Builds the usvg tree of `xml` (text laid out with the options' fonts) and flattens it within
-/// `tol_mm` into at most `budget` vertices: the geometries, the page size in mm and the font
-/// substitutions as warnings.
+/// `tol_mm` into at most `budget` vertices: the geometries, the page size in mm, the font
+/// substitutions as warnings and, with `templates`, the texts holding fields (kept as
+/// [`TextTemplate`]s, not outlined; without, every text is outlined as written).
 fn tree_geometries(
     xml: &roxmltree::Document,
     opts: &ImportOptions,
     tol_mm: f64,
     budget: usize,
+    templates: bool,
 ) -> Result<TreeGeometries, TreeError> {
     let misses = Misses::default();
     let tree = usvg::Tree::from_xmltree(xml, &usvg_options(opts.fonts, &misses))
@@ -154,14 +173,16 @@ fn tree_geometries(
         text_families: FxHashMap::default(),
         invisible: Vec::new(),
         budget,
-        overflow: false,
+        stop: None,
+        templates: templates.then(Vec::new),
     };
     walker.group(tree.root(), None, None);
-    if walker.overflow {
-        return Err(TreeError::TooLarge);
+    if let Some(stop) = walker.stop.take() {
+        return Err(stop);
     }
     walker.invisible_warning();
     let geometries = std::mem::take(&mut walker.geometries);
+    let templates = walker.templates.take().unwrap_or_default();
     let families = std::mem::take(&mut walker.text_families);
     warnings.extend(miss_warnings(misses.take(), |requested| {
         families
@@ -169,12 +190,15 @@ fn tree_geometries(
             .cloned()
             .unwrap_or_else(|| "<text>".into())
     }));
-    Ok((geometries, page_mm, warnings))
+    Ok((geometries, page_mm, warnings, templates))
 }
 
-/// The error text of an import beyond [`MAX_POINTS`].
-pub(super) fn too_many_points(tol_mm: f64) -> String {
-    format!("the drawing flattens to more than {MAX_POINTS} vertices at a chord tolerance of {tol_mm} mm")
+/// The error text of an import beyond [`MAX_POINTS`], reached at `element`.
+pub(super) fn too_many_points(tol_mm: f64, element: &str) -> String {
+    format!(
+        "the drawing flattens to more than {MAX_POINTS} vertices at a chord tolerance of {tol_mm} mm \
+         (reached at {element}); raise the chord tolerance or simplify the drawing"
+    )
 }
 
 /// Glyph outlines of a small SVG made by the DXF text import: `(points, closed)` per subpath in
@@ -187,10 +211,10 @@ pub(super) fn text_outlines(
     budget: usize,
 ) -> Result<(Vec<Outline>, Vec<Warning>), String> {
     let xml = roxmltree::Document::parse(svg).map_err(|e| e.to_string())?;
-    let (geometries, _, warnings) =
-        tree_geometries(&xml, opts, tol_mm, budget).map_err(|e| match e {
-            TreeError::Malformed(cause) => cause,
-            TreeError::TooLarge => format!("more than {budget} vertices"),
+    let (geometries, _, warnings, _) =
+        tree_geometries(&xml, opts, tol_mm, budget, false).map_err(|e| match e {
+            TreeError::Malformed(cause) | TreeError::Beyond(cause) => cause,
+            TreeError::TooLarge(_) => format!("more than {budget} vertices"),
         })?;
     let outlines = geometries
         .into_iter()
@@ -214,36 +238,6 @@ fn layer_names(xml: &roxmltree::Document) -> FxHashMap<String, String> {
         .collect()
 }
 
-/// Largest arc radius in path data, in user units (10⁹: 1,000 km in mm, 264 km in px). usvg
-/// turns arcs into curves in `f32`, where radii past ~10³⁸ become infinite, and a radius of
-/// 10⁴⁰–10¹¹⁷ made it loop for minutes and use gigabytes (found by fuzzing); anything past this
-/// bound is not artwork, so the file is refused before usvg sees it.
-pub const ARC_RADIUS_MAX: f64 = 1e9;
-
-/// Refuses path data whose arcs have radii beyond [`ARC_RADIUS_MAX`] (or not finite), naming the
-/// element and its line. Path data that does not parse is left to usvg (which keeps the part
-/// before the error, as the SVG specification asks).
-fn check_arc_radii(xml: &roxmltree::Document) -> Result<(), String> {
-    for node in xml.descendants().filter(|n| n.is_element()) {
-        let Some(d) = node.attribute("d") else {
-            continue;
-        };
-        for segment in svgtypes::PathParser::from(d) {
-            let Ok(svgtypes::PathSegment::EllipticalArc { rx, ry, .. }) = segment else {
-                continue;
-            };
-            let worst = rx.abs().max(ry.abs());
-            if worst.is_nan() || worst > ARC_RADIUS_MAX {
-                let line = xml.text_pos_at(node.range().start).row;
-                return Err(format!(
-                    "{} (line {line}): an arc radius of {worst:e} user units is beyond {ARC_RADIUS_MAX:e}",
-                    describe(&node)
-                ));
-            }
-        }
-    }
-    Ok(())
-}
 struct Walker<'w> {
     tol_px: f64,
     geometries: Vec<Geometry>,
@@ -260,8 +254,11 @@ struct Walker<'w> {
     text_families: FxHashMap<String, String>,
     /// Vertices the walk may still produce.
     budget: usize,
-    /// Set when the budget ran out (the walk then stops adding geometry).
-    overflow: bool,
+    /// Set when the walk must stop (the budget ran out, or a point lies beyond the bound); it
+    /// then adds no more geometry.
+    stop: Option<TreeError>,
+    /// Texts holding fields, kept as templates (none: every text is outlined as written).
+    templates: Option<Vec<TextTemplate>>,
 }
 
 fn paint_hex(paint: &usvg::Paint) -> String {
@@ -279,6 +276,15 @@ fn to_mm(t: usvg::Transform) -> impl Fn(usvg::tiny_skia_path::Point) -> Pt {
             snap((f64::from(t.sx) * x + f64::from(t.kx) * y + f64::from(t.tx)) * PX_TO_MM),
             snap((f64::from(t.ky) * x + f64::from(t.sy) * y + f64::from(t.ty)) * PX_TO_MM),
         )
+    }
+}
+
+/// A clip or mask shape in errors: `#id`, or what it is.
+fn shape_name(p: &usvg::Path) -> String {
+    if p.id().is_empty() {
+        "a clip or mask shape".into()
+    } else {
+        format!("#{}", p.id())
     }
 }
 
@@ -303,7 +309,7 @@ impl Walker<'_> {
     /// Walks a group; `layer` is the layer name of the top-level group above, if any, `clip`
     /// the region the groups above clip to.
     fn group(&mut self, g: &usvg::Group, layer: Option<&str>, clip: Option<&Region>) {
-        if self.overflow {
+        if self.stop.is_some() {
             return;
         }
         let named = self.layer_names.get(g.id()).cloned();
@@ -329,7 +335,7 @@ impl Walker<'_> {
                 }
             }
         }
-        if self.overflow {
+        if self.stop.is_some() {
             return;
         }
         let combined = match (clip, own) {
@@ -403,7 +409,7 @@ impl Walker<'_> {
                 usvg::Node::Path(p) if p.is_visible() => {
                     let fill_rule = p.fill().map_or(Rule::NonZero, |f| rule(f.rule()));
                     let contours: Vec<Vec<Pt>> = self
-                        .subpaths(p, to_mm(t.pre_concat(p.abs_transform())))?
+                        .subpaths(p, to_mm(t.pre_concat(p.abs_transform())), &shape_name(p))?
                         .into_iter()
                         .map(|(pts, _)| pts)
                         .collect();
@@ -486,9 +492,8 @@ impl Walker<'_> {
                             usvg::MaskType::Alpha => "a shape that is not opaque".into(),
                         });
                     }
-                    let Some(subpaths) =
-                        self.subpaths(p, to_mm(base.pre_concat(p.abs_transform())))
-                    else {
+                    let map = to_mm(base.pre_concat(p.abs_transform()));
+                    let Some(subpaths) = self.subpaths(p, map, &shape_name(p)) else {
                         return Ok(Region::default());
                     };
                     let contours: Vec<Vec<Pt>> = subpaths.into_iter().map(|(pts, _)| pts).collect();
@@ -515,6 +520,10 @@ impl Walker<'_> {
                 .entry(family_list(span.font().families()))
                 .or_insert_with(|| format!("<text> {element}"));
         }
+        if self.templates.is_some() && t.chunks().iter().any(|c| is_template(c.text())) {
+            self.template(t, element, layer);
+            return;
+        }
         // the outline glyphs (colour glyphs come as groups of their own, not read)
         for node in t.flattened().children() {
             if let usvg::Node::Path(p) = node {
@@ -523,13 +532,61 @@ impl Walker<'_> {
         }
     }
 
-    /// The flattened subpaths of a path, `None` when the vertex budget ran out.
+    /// A text holding fields: one template per chunk (a chunk is a run of text with its own
+    /// position), shaped per part later.
+    fn template(&mut self, t: &usvg::Text, element: String, layer: Option<&str>) {
+        let a = t.abs_transform();
+        let transform = [a.sx, a.ky, a.kx, a.sy, a.tx, a.ty].map(f64::from);
+        let line = (!t.id().is_empty())
+            .then(|| self.id_lines.get(t.id()).copied())
+            .flatten();
+        let mut made = Vec::new();
+        for c in t.chunks() {
+            let Some(span) = c.spans().first() else {
+                continue;
+            };
+            if c.text().trim().is_empty() {
+                continue;
+            }
+            let layer = match (layer, span.stroke(), span.fill()) {
+                (Some(name), _, _) => name.to_string(),
+                (None, Some(s), _) => paint_hex(s.paint()),
+                (None, None, Some(f)) => format!("fill {}", paint_hex(f.paint())),
+                (None, None, None) => "none".into(),
+            };
+            let align = match c.anchor() {
+                usvg::TextAnchor::Start => TextAlign::Start,
+                usvg::TextAnchor::Middle => TextAlign::Middle,
+                usvg::TextAnchor::End => TextAlign::End,
+            };
+            let chunk = SvgChunk {
+                text: c.text(),
+                at: (
+                    f64::from(c.x().unwrap_or(0.0)),
+                    f64::from(c.y().unwrap_or(0.0)),
+                ),
+                align,
+                family: family_list(span.font().families()),
+                em_px: f64::from(span.font_size().get()),
+                transform,
+            };
+            made.push(svg_template(&chunk, element.clone(), line, layer, PX_TO_MM));
+        }
+        if let Some(templates) = self.templates.as_mut() {
+            templates.extend(made);
+        }
+    }
+
+    /// The flattened subpaths of a path (`element` names it in errors), `None` when the walk
+    /// stops here: a point beyond [`MAX_COORD_MM`] after transforms, or a curve that would take
+    /// more vertices than the budget has left (both checked before anything is flattened).
     fn subpaths(
         &mut self,
         p: &usvg::Path,
         map: impl Fn(usvg::tiny_skia_path::Point) -> Pt,
+        element: &str,
     ) -> Option<Vec<Outline>> {
-        if self.overflow {
+        if self.stop.is_some() {
             return None;
         }
         // chord tolerance in mm, applied after the transform
@@ -539,8 +596,35 @@ impl Walker<'_> {
         let mut closed = false;
         let mut done = 0;
         for seg in p.data().segments() {
+            let (ends, chords) = match seg {
+                PathSegment::MoveTo(q) | PathSegment::LineTo(q) => ([map(q); 3], 1),
+                PathSegment::QuadTo(c, q) => {
+                    let p0 = cur.last().copied().unwrap_or_default();
+                    let (c, q) = (map(c), map(q));
+                    ([c, q, q], quad_chords(p0, c, q, tol_mm))
+                }
+                PathSegment::CubicTo(c1, c2, q) => {
+                    let p0 = cur.last().copied().unwrap_or_default();
+                    let (c1, c2, q) = (map(c1), map(c2), map(q));
+                    ([c1, c2, q], cubic_chords(p0, c1, c2, q, tol_mm))
+                }
+                PathSegment::Close => ([cur.first().copied().unwrap_or_default(); 3], 1),
+            };
+            if let Some(far) = ends.iter().find(|q| !within_reach_bound(**q)) {
+                self.stop = Some(TreeError::Beyond(format!(
+                    "{element}: a point at ({:e}, {:e}) mm after transforms is beyond \
+                     ±{MAX_COORD_MM:e} mm",
+                    far.x, far.y
+                )));
+                return None;
+            }
+            if chords > self.budget.saturating_sub(done + cur.len()) {
+                self.stop = Some(TreeError::TooLarge(element.to_string()));
+                return None;
+            }
+            let [c1, c2, q] = ends;
             match seg {
-                PathSegment::MoveTo(q) => {
+                PathSegment::MoveTo(_) => {
                     // a lone point (e.g. the start left behind by Z) is not a subpath
                     if cur.len() > 1 {
                         done += cur.len();
@@ -548,16 +632,16 @@ impl Walker<'_> {
                     }
                     cur.clear();
                     closed = false;
-                    cur.push(map(q));
+                    cur.push(q);
                 }
-                PathSegment::LineTo(q) => cur.push(map(q)),
-                PathSegment::QuadTo(c, q) => {
+                PathSegment::LineTo(_) => cur.push(q),
+                PathSegment::QuadTo(..) => {
                     let p0 = cur.last().copied().unwrap_or_default();
-                    flatten_quad(p0, map(c), map(q), tol_mm, &mut cur);
+                    flatten_quad(p0, c1, q, tol_mm, &mut cur);
                 }
-                PathSegment::CubicTo(c1, c2, q) => {
+                PathSegment::CubicTo(..) => {
                     let p0 = cur.last().copied().unwrap_or_default();
-                    flatten_cubic(p0, map(c1), map(c2), map(q), tol_mm, &mut cur);
+                    flatten_cubic(p0, c1, c2, q, tol_mm, &mut cur);
                 }
                 PathSegment::Close => {
                     closed = true;
@@ -569,10 +653,6 @@ impl Walker<'_> {
                         closed = false;
                     }
                 }
-            }
-            if done + cur.len() > self.budget {
-                self.overflow = true;
-                return None;
             }
         }
         if cur.len() > 1 {
@@ -627,7 +707,7 @@ impl Walker<'_> {
         glyphs: bool,
         clip: Option<&Region>,
     ) {
-        if self.overflow {
+        if self.stop.is_some() {
             return;
         }
         if !p.is_visible() {
@@ -643,7 +723,7 @@ impl Walker<'_> {
             (None, None, Some(f)) => format!("fill {}", paint_hex(f.paint())),
             (None, None, None) => "none".into(),
         };
-        let Some(mut subpaths) = self.subpaths(p, to_mm(p.abs_transform())) else {
+        let Some(mut subpaths) = self.subpaths(p, to_mm(p.abs_transform()), element) else {
             return;
         };
         if let Some(region) = clip {
@@ -654,6 +734,7 @@ impl Walker<'_> {
                 element: element.to_string(),
                 subpath: sub_index,
                 layer: layer.clone(),
+                part: 0,
             };
             match normalise(pts, closed) {
                 Ok((pts, closed)) => self.geometries.push(Geometry::new(pts, closed, source)),

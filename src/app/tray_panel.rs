@@ -1,0 +1,410 @@
+//! The Tray section: the part repeated over a tray, its serial numbers, what a part will carry,
+//! and *Export and advance*. A panel with its own state (the form's buffers, the part
+//! previewed, the parts log's path); it reads the document and returns what the operator asked.
+
+use super::panels::{combo, Choice, Form};
+use crate::document::spec::{check_all, tray_specs};
+use crate::document::{Document, Numbering, Production, TraySetup};
+use egui::RichText;
+
+/// What the operator asked of the Tray section.
+#[derive(Debug, Clone, PartialEq)]
+pub enum TrayAction {
+    /// Make the tray with this tray and serials (in a background job, undoable).
+    Set(TraySetup),
+    /// Write the program of the shown plan, log its parts and move the serials on.
+    ExportAndAdvance,
+}
+
+/// The Tray section's state.
+pub struct TrayPanel {
+    form: Form<TraySetup>,
+    /// The part whose texts the preview shows (from 1).
+    preview: u32,
+    /// Where *Export and advance* appends its rows (empty: beside the artwork).
+    pub log_path: String,
+}
+
+impl Default for TrayPanel {
+    fn default() -> Self {
+        Self {
+            form: Form::new(tray_specs()),
+            preview: 1,
+            log_path: String::new(),
+        }
+    }
+}
+
+const NUMBERINGS: [Choice<Numbering>; 2] = [
+    (
+        Numbering::Rows,
+        "Row by row",
+        "parts numbered along each row from the top-left, every row left to right",
+    ),
+    (
+        Numbering::Serpentine,
+        "Serpentine",
+        "parts numbered along each row from the top-left, every other row right to left",
+    ),
+];
+
+fn validate(p: &TraySetup) -> Result<(), String> {
+    check_all(&tray_specs(), p).map_err(|e| e.to_string())?;
+    p.tray.validate().map_err(|e| e.to_string())
+}
+
+/// The production the section edits: the document's, or one of its artwork as a single part.
+pub fn production_or_part(doc: &Document) -> Production {
+    doc.production.clone().unwrap_or_else(|| {
+        Production::of_part(
+            doc.artwork.clone(),
+            Vec::new(),
+            Production::default().chord_tol_mm,
+        )
+    })
+}
+
+impl TrayPanel {
+    /// Draws the section; returns what the operator asked.
+    pub fn ui(
+        &mut self,
+        ui: &mut egui::Ui,
+        doc: &Document,
+        can_export: bool,
+    ) -> Option<TrayAction> {
+        if doc.artwork.is_empty() && doc.geometries.is_empty() {
+            ui.label("Open the drawing of one part: the tray repeats it.");
+            return None;
+        }
+        let current = doc
+            .production
+            .as_ref()
+            .map(Production::setup)
+            .unwrap_or_default();
+        let mut out = None;
+        if let Some(p) = self.form.ui(ui, "tray form", &current, validate) {
+            out = Some(TrayAction::Set(p));
+        }
+        let mut numbering = current.tray.numbering;
+        if combo(ui, "Numbering", &mut numbering, &NUMBERINGS).changed() {
+            let mut p = current.clone();
+            p.tray.numbering = numbering;
+            out = Some(TrayAction::Set(p));
+        }
+        ui.separator();
+        self.summary(ui, doc);
+        self.preview_ui(ui, doc);
+        ui.separator();
+        ui.horizontal(|ui| {
+            let l = ui.label("Parts log");
+            ui.add(
+                egui::TextEdit::singleline(&mut self.log_path)
+                    .hint_text("beside the drawing: NAME.parts.csv")
+                    .desired_width(180.0),
+            )
+            .labelled_by(l.id)
+            .on_hover_text("Export and advance appends one row per part marked to this CSV file");
+        });
+        let advance = ui
+            .add_enabled(
+                can_export && !doc.parts.is_empty(),
+                egui::Button::new("Export and advance"),
+            )
+            .on_hover_text(
+                "Write the shown plan's G-code, append its parts to the parts log and start the \
+                 next tray at the serial after the last one (saved with the project)",
+            )
+            .on_disabled_hover_text("Solve a plan of the tray first");
+        if advance.clicked() {
+            out = Some(TrayAction::ExportAndAdvance);
+        }
+        out
+    }
+
+    /// The parts, skipped cells and serials in words.
+    fn summary(&self, ui: &mut egui::Ui, doc: &Document) {
+        let Some(p) = &doc.production else {
+            ui.label("One part: set columns and rows to repeat it.");
+            return;
+        };
+        let marked = doc.parts.len();
+        let skipped = p.tray.skip.len();
+        let mut line = super::count(marked.max(1), "part", "parts");
+        if skipped > 0 {
+            line.push_str(&format!(
+                " ({skipped} skipped: cells {})",
+                join(&p.tray.skip)
+            ));
+        }
+        ui.label(line);
+        if let (Some(first), Some(last)) = (doc.parts.first(), doc.parts.last()) {
+            ui.label(format!("Serials {} … {}", first.serial, last.serial));
+            if let Some(next) = p.serial.after(marked as u32) {
+                ui.label(RichText::new(format!("Next tray starts at {next}")).strong());
+            }
+        }
+        if let Some(l) = p.logged_through {
+            ui.label(RichText::new(format!("Serials up to {l} are in the parts log")).weak());
+        }
+    }
+
+    /// Any part's texts, as they will be marked.
+    fn preview_ui(&mut self, ui: &mut egui::Ui, doc: &Document) {
+        if doc.parts.is_empty() || doc.parts.iter().all(|p| p.texts.is_empty()) {
+            return;
+        }
+        let n = doc.parts.len() as u32;
+        self.preview = self.preview.clamp(1, n);
+        ui.horizontal(|ui| {
+            let l = ui.label("Preview part");
+            ui.add(egui::DragValue::new(&mut self.preview).range(1..=n))
+                .labelled_by(l.id);
+        });
+        if let Some(part) = doc.parts.get(self.preview as usize - 1) {
+            for t in &part.texts {
+                ui.label(RichText::new(t).monospace());
+            }
+        }
+    }
+}
+
+fn join(v: &[u32]) -> String {
+    v.iter().map(u32::to_string).collect::<Vec<_>>().join(", ")
+}
+
+impl super::App {
+    /// The Tray section and what it asks.
+    pub(super) fn tray_ui(&mut self, ui: &mut egui::Ui) {
+        let can_export = self
+            .session
+            .active
+            .is_some_and(|k| self.plan_staleness(k).is_empty());
+        match self.view.tray.ui(ui, &self.session.doc, can_export) {
+            Some(TrayAction::Set(setup)) => self.set_tray(setup, ui.ctx()),
+            Some(TrayAction::ExportAndAdvance) => {
+                let ctx = ui.ctx().clone();
+                self.choose_path(super::PathAction::ExportAdvance, &ctx);
+            }
+            None => {}
+        }
+    }
+
+    /// Makes the tray with `setup` (the part repeated, its texts shaped per part, geometries
+    /// made and fields placed again) in a background job, undoable when it ends.
+    pub fn set_tray(&mut self, setup: TraySetup, repaint: &egui::Context) {
+        let logged = self
+            .session
+            .doc
+            .production
+            .as_ref()
+            .and_then(|p| p.logged_through);
+        if let Some(l) = logged.filter(|&l| setup.serial.start <= l) {
+            self.set_status(
+                format!(
+                    "cannot start the tray at serial {}: serials up to {l} are in the parts log \
+                     and are never handed out again",
+                    setup.serial.start
+                ),
+                true,
+            );
+            return;
+        }
+        let mut work = self.session.doc.clone();
+        let mut p = production_or_part(&work);
+        let what = format!(
+            "set the tray: {} × {} parts at {} × {} mm",
+            setup.tray.cols, setup.tray.rows, setup.tray.pitch_mm[0], setup.tray.pitch_mm[1]
+        );
+        p.tray = setup.tray;
+        p.serial = setup.serial;
+        work.production = Some(p);
+        self.start_job(what.clone(), "tray", repaint, move |ctx| {
+            use crate::pipeline::{derive_geometries, expand_production, place_document_fields};
+            expand_production(&mut work).map_err(|e| super::gui_error(&e))?;
+            derive_geometries(&mut work, ctx).map_err(|e| super::gui_error(&e))?;
+            let problem = match place_document_fields(&mut work, ctx) {
+                Ok(_) => None,
+                Err(e) if ctx.is_cancelled() => return Err(format!("cancelled ({e})")),
+                Err(e) => {
+                    work.fields.retain(|f| f.locked);
+                    Some(super::gui_error(&e))
+                }
+            };
+            Ok(super::jobs::JobResult::Placed {
+                doc: Box::new(work),
+                what,
+                problem,
+                refit: true,
+            })
+        });
+    }
+
+    /// Leaves a tray cell out, or marks it again (`skip`), through [`super::App::set_tray`].
+    pub fn skip_cell(&mut self, cell: u32, skip: bool, repaint: &egui::Context) {
+        let Some(p) = &self.session.doc.production else {
+            return;
+        };
+        let mut setup = p.setup();
+        setup.tray.skip.retain(|&c| c != cell);
+        if skip {
+            setup.tray.skip.push(cell);
+            setup.tray.skip.sort_unstable();
+        }
+        self.set_tray(setup, repaint);
+    }
+
+    /// The parts log *Export and advance* appends to: the section's path, else
+    /// `NAME.parts.csv` beside the drawing (or beside the program).
+    pub fn parts_log_path(&self, program: &std::path::Path) -> std::path::PathBuf {
+        let typed = self.view.tray.log_path.trim();
+        if !typed.is_empty() {
+            return std::path::PathBuf::from(typed);
+        }
+        let base = self
+            .session
+            .doc
+            .source
+            .as_deref()
+            .map(std::path::Path::new)
+            .unwrap_or(program);
+        base.with_extension("parts.csv")
+    }
+
+    /// *Export and advance*: writes the shown plan's G-code to `path`, appends its parts to the
+    /// parts log, starts the next tray at the serial after the last (an edit that cannot be
+    /// undone: those serials are on record), saves the project where it has a file, and makes
+    /// the next tray's texts in a background job.
+    pub fn export_and_advance(
+        &mut self,
+        path: &std::path::Path,
+        repaint: &egui::Context,
+    ) -> Result<(), String> {
+        let k = self
+            .session
+            .active
+            .ok_or("no plan to export: run a solver first")?;
+        if !self.plan_staleness(k).is_empty() {
+            return Err("the plan is stale: solve the tray again before marking it".into());
+        }
+        let plan = &self.session.doc.plans[k];
+        let (first, last) = match (plan.parts.first(), plan.parts.last()) {
+            (Some(f), Some(l)) => (f.serial, l.serial),
+            _ => return Err("the plan marks no tray: set a tray and solve it".into()),
+        };
+        let parts = plan.parts.clone();
+        let production = self
+            .session
+            .doc
+            .production
+            .as_ref()
+            .ok_or("the document is not a tray")?;
+        if production.logged_through.is_some_and(|l| first <= l) {
+            return Err(format!(
+                "serial {first} is already in the parts log: set the tray's first serial above {}",
+                production.logged_through.unwrap_or(first)
+            ));
+        }
+        let next = production
+            .serial
+            .after(parts.len() as u32)
+            .ok_or("the next serial overflows")?;
+        let log = self.parts_log_path(path);
+        self.export(crate::app::files::ExportKind::Gcode, path)?;
+        let when = chrono::Local::now().format("%Y-%m-%dT%H:%M:%S").to_string();
+        crate::export::append_parts_log(&log, &path.display().to_string(), &parts, when)
+            .map_err(|e| format!("{}: cannot append to the parts log: {e}", log.display()))?;
+        self.execute(super::commands::Command::AdvanceSerial {
+            next,
+            logged_through: last,
+        })?;
+        let saved = match self.session.project_path.clone() {
+            Some(project) => self.save_project(&project).map(|()| " (project saved)"),
+            None => Ok("; save the project to keep it"),
+        }?;
+        let done = format!(
+            "wrote {}, logged serials {first} … {last} in {}; next tray starts at {next}{saved}",
+            path.display(),
+            log.display()
+        );
+        if let Some(setup) = self.session.doc.production.as_ref().map(Production::setup) {
+            self.set_tray(setup, repaint);
+        }
+        self.set_status(done, false);
+        Ok(())
+    }
+}
+
+/// A tray cell as the canvas shows it: where it is, and what its part carries.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PartBox {
+    /// The part marked there (none: the cell is skipped).
+    pub part: Option<u32>,
+    /// The cell (row by row from 1).
+    pub cell: u32,
+    /// Its extent on the machine, mm.
+    pub bbox: crate::geom::BBox,
+    /// What hovering it tells: part, cell, serial, its texts.
+    pub words: Vec<String>,
+}
+
+/// The cells of the document's tray: each marked part's extent, and the skipped cells at the
+/// extent a part would have there (empty when the document is not a tray of several cells).
+pub fn part_boxes(doc: &Document) -> Vec<PartBox> {
+    use crate::geom::BBox;
+    let Some(p) = &doc.production else {
+        return Vec::new();
+    };
+    if p.tray.cells() < 2 || doc.parts.is_empty() {
+        return Vec::new();
+    }
+    let mut boxes: Vec<BBox> = vec![BBox::EMPTY; doc.parts.len()];
+    for g in &doc.artwork {
+        if let Some(b) = (g.source.part as usize)
+            .checked_sub(1)
+            .and_then(|k| boxes.get_mut(k))
+        {
+            *b = b.union(BBox::of(&g.points));
+        }
+    }
+    let mut out: Vec<PartBox> = doc
+        .parts
+        .iter()
+        .zip(&boxes)
+        .map(|(r, &bbox)| {
+            let mut words = vec![format!(
+                "part {} (cell {}, row {}, column {}): serial {}",
+                r.part, r.cell, r.row, r.col, r.serial
+            )];
+            words.extend(r.texts.iter().map(|t| format!("  “{t}”")));
+            PartBox {
+                part: Some(r.part),
+                cell: r.cell,
+                bbox,
+                words,
+            }
+        })
+        .collect();
+    // a skipped cell: the first part's extent moved by the pitch
+    if let (Some(first), Some(b0)) = (doc.parts.first(), boxes.first()) {
+        let at = |cell: u32| p.tray.cell_offset(cell).unwrap_or_default();
+        let o0 = at(first.cell);
+        for &cell in &p.tray.skip {
+            let d = at(cell).minus(o0);
+            let bbox = BBox {
+                min_x: b0.min_x + d.x,
+                min_y: b0.min_y + d.y,
+                max_x: b0.max_x + d.x,
+                max_y: b0.max_y + d.y,
+            };
+            out.push(PartBox {
+                part: None,
+                cell,
+                bbox,
+                words: vec![format!(
+                    "cell {cell}: skipped (no part, no serial); right-click to mark it"
+                )],
+            });
+        }
+    }
+    out
+}
