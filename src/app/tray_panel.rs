@@ -95,11 +95,22 @@ impl TrayPanel {
         self.summary(ui, doc);
         self.preview_ui(ui, doc);
         ui.separator();
+        // the file Export and advance appends to when none is typed: beside the drawing
+        let default_log = doc
+            .source
+            .as_deref()
+            .map(std::path::Path::new)
+            .and_then(|p| {
+                p.with_extension("parts.csv")
+                    .file_name()
+                    .map(|n| n.to_string_lossy().into_owned())
+            })
+            .unwrap_or_else(|| "parts.csv".into());
         ui.horizontal(|ui| {
             let l = ui.label("Parts log");
             ui.add(
                 egui::TextEdit::singleline(&mut self.log_path)
-                    .hint_text("beside the drawing: NAME.parts.csv")
+                    .hint_text(default_log)
                     .desired_width(180.0),
             )
             .labelled_by(l.id)

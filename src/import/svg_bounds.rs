@@ -55,8 +55,8 @@ pub(super) fn check(xml: &Document) -> Result<(), String> {
         }
         if let Some(points) = node.attribute("points") {
             for (x, y) in svgtypes::PointsParser::from(points) {
-                within(x, "a point")
-                    .and(within(y, "a point"))
+                within(x, "a coordinate")
+                    .and(within(y, "a coordinate"))
                     .map_err(|e| format!("{}: {e}", where_()))?;
             }
         }
@@ -66,7 +66,7 @@ pub(super) fn check(xml: &Document) -> Result<(), String> {
             };
             // a list (`x="1 2 3"` on text) or a single length; what does not parse is usvg's
             for length in svgtypes::LengthListParser::from(value).flatten() {
-                within(length.number, &format!("{name}=\"{value}\""))
+                within(length.number, &format!("the {name}"))
                     .map_err(|e| format!("{}: {e}", where_()))?;
             }
         }
@@ -99,8 +99,8 @@ fn within(v: f64, what: &str) -> Result<(), String> {
         Ok(())
     } else {
         Err(format!(
-            "{what}: {v:e} user units is beyond ±{USER_MAX:e} (at most ±{MAX_COORD_MM:e} mm \
-             after transforms)"
+            "{what} of {v:.4e} user units is beyond ±{USER_MAX:e} (a drawing lies within \
+             ±{MAX_COORD_MM:e} mm)"
         ))
     }
 }
@@ -118,7 +118,7 @@ fn path_data(d: &str) -> Result<(), String> {
             (cur.0 + x, cur.1 + y)
         }
     };
-    let point = |p: (f64, f64)| within(p.0, "a point").and(within(p.1, "a point"));
+    let point = |p: (f64, f64)| within(p.0, "a coordinate").and(within(p.1, "a coordinate"));
     for segment in svgtypes::PathParser::from(d) {
         let Ok(segment) = segment else {
             break;
@@ -198,17 +198,29 @@ mod tests {
         for (body, what) in [
             (
                 "<path id=\"p\" d=\"M 4666666666666666666666666666660 240 A 15 10 0 0 1 70 240\"/>",
-                "a point",
+                "a coordinate",
             ),
             (
                 "<path id=\"p\" d=\"M 0 0 A 1e40 1 0 0 1 70 240\"/>",
                 "an arc radius",
             ),
-            ("<path id=\"p\" d=\"M 0 0 l 6e8 0 l 6e8 0\"/>", "a point"),
-            ("<path id=\"p\" d=\"M 0 0 C 0 0 0 -2e9 5 5\"/>", "a point"),
-            ("<circle id=\"p\" r=\"1e300\"/>", "r=\"1e300\""),
-            ("<rect id=\"p\" width=\"1e12mm\" height=\"3\"/>", "width"),
-            ("<polygon id=\"p\" points=\"0,0 1e10,0 3,3\"/>", "a point"),
+            (
+                "<path id=\"p\" d=\"M 0 0 l 6e8 0 l 6e8 0\"/>",
+                "a coordinate",
+            ),
+            (
+                "<path id=\"p\" d=\"M 0 0 C 0 0 0 -2e9 5 5\"/>",
+                "a coordinate",
+            ),
+            ("<circle id=\"p\" r=\"1e300\"/>", "the r of 1.0000e300"),
+            (
+                "<rect id=\"p\" width=\"1e12mm\" height=\"3\"/>",
+                "the width",
+            ),
+            (
+                "<polygon id=\"p\" points=\"0,0 1e10,0 3,3\"/>",
+                "a coordinate",
+            ),
             ("<text id=\"p\" font-size=\"1e99\">a</text>", "font-size"),
         ] {
             let e = checked(body).unwrap_err();
