@@ -14,6 +14,7 @@
 //! [`pipeline`] strings them together.
 
 pub mod bench;
+pub mod codes;
 pub mod document;
 pub mod export;
 pub mod fields;

@@ -7,9 +7,11 @@
 //! machine as the import places artwork (`--place`), so fields, ordering, lowering and every
 //! export see one job. `doc.parts` records what each part carries.
 
+use crate::codes::{marks, quiet_box, symbol, Fill};
 use crate::document::production::{parse_template, render, Field, PartValues, Piece};
 use crate::document::{
     sync_layers, Document, Geometry, PartRecord, PartSlot, Production, ProductionError, Stamp,
+    CODE_LAYER,
 };
 use crate::geom::{BBox, Pt};
 use crate::import::{
@@ -30,54 +32,93 @@ fn options(doc: &Document, prod: &Production) -> ImportOptions {
     }
 }
 
-/// The templates read into pieces, each checked against the data it needs.
-fn pieces(prod: &Production, parts: usize) -> Result<Vec<Vec<Piece>>, ProductionError> {
-    let mut out = Vec::with_capacity(prod.templates.len());
-    for t in &prod.templates {
-        let bad = |why: String| ProductionError::Template {
-            element: t.element.clone(),
-            line: t.line,
-            text: t.text.clone(),
-            why,
+/// A text of the production (a template or a code's content) read into pieces and checked
+/// against the data it needs; `bad` makes the error naming the text.
+fn read_checked(
+    text: &str,
+    prod: &Production,
+    parts: usize,
+    bad: impl Fn(String) -> ProductionError,
+) -> Result<Vec<Piece>, ProductionError> {
+    let p = parse_template(text).map_err(&bad)?;
+    for f in &p {
+        let Piece::Field(Field::Csv(column)) = f else {
+            continue;
         };
-        let p = parse_template(&t.text).map_err(bad)?;
-        for f in &p {
-            let Piece::Field(Field::Csv(column)) = f else {
-                continue;
-            };
-            let Some(data) = &prod.data else {
-                return Err(bad(format!(
-                    "{{csv:{column}}} needs a data file (--data FILE.csv)"
-                )));
-            };
-            if !data.header.iter().any(|h| h == column) {
-                return Err(bad(format!(
-                    "{}: no column '{column}' (columns: {})",
-                    data.file,
-                    data.header.join(", ")
-                )));
-            }
-            if data.rows.len() < parts {
-                return Err(ProductionError::Data(format!(
-                    "{}: {} data rows for {parts} marked parts (row k is part k's)",
-                    data.file,
-                    data.rows.len()
-                )));
-            }
+        let Some(data) = &prod.data else {
+            return Err(bad(format!(
+                "{{csv:{column}}} needs a data file (--data FILE.csv)"
+            )));
+        };
+        if !data.header.iter().any(|h| h == column) {
+            return Err(bad(format!(
+                "{}: no column '{column}' (columns: {})",
+                data.file,
+                data.header.join(", ")
+            )));
         }
-        out.push(p);
+        if data.rows.len() < parts {
+            return Err(ProductionError::Data(format!(
+                "{}: {} data rows for {parts} marked parts (row k is part k's)",
+                data.file,
+                data.rows.len()
+            )));
+        }
     }
-    Ok(out)
+    Ok(p)
 }
 
-/// One part: its record and geometries (the part's outlines moved to its cell, its texts).
-fn make_part(
-    prod: &Production,
-    pieces: &[Vec<Piece>],
-    slot: PartSlot,
+/// The templates and the codes' contents read into pieces, each checked against its data.
+type Pieces = (Vec<Vec<Piece>>, Vec<Vec<Piece>>);
+
+fn pieces(prod: &Production, parts: usize) -> Result<Pieces, ProductionError> {
+    let texts = prod
+        .templates
+        .iter()
+        .map(|t| {
+            read_checked(&t.text, prod, parts, |why| ProductionError::Template {
+                element: t.element.clone(),
+                line: t.line,
+                text: t.text.clone(),
+                why,
+            })
+        })
+        .collect::<Result<_, _>>()?;
+    let codes = prod
+        .codes
+        .iter()
+        .map(|c| {
+            read_checked(&c.content, prod, parts, |why| ProductionError::Code {
+                text: format!("{}:{}", c.kind, c.content),
+                why,
+            })
+        })
+        .collect::<Result<_, _>>()?;
+    Ok((texts, codes))
+}
+
+/// What every part of one expansion shares.
+struct Job<'a> {
+    prod: &'a Production,
+    /// Each template read into pieces.
+    pieces: Vec<Vec<Piece>>,
+    /// Each code's content read into pieces.
+    code_pieces: Vec<Vec<Piece>>,
     stamp: Stamp,
-    opts: &ImportOptions,
-) -> Result<(PartRecord, Vec<Geometry>, Vec<crate::document::Warning>), ProductionError> {
+    opts: ImportOptions,
+    /// How codes are filled.
+    fill: Fill,
+    /// The part's top-left (its outlines' bounding box), in the file's coordinates: where
+    /// codes are placed from.
+    origin: Pt,
+}
+
+/// One part: its record and geometries (the part's outlines moved to its cell, its texts, its
+/// codes).
+type Made = (PartRecord, Vec<Geometry>, Vec<crate::document::Warning>);
+
+fn make_part(job: &Job, slot: PartSlot) -> Result<Made, ProductionError> {
+    let prod = job.prod;
     let serial = prod.serial.of(slot.part).ok_or_else(|| {
         ProductionError::Tray(format!(
             "the serial of part {} overflows (start {}, step {})",
@@ -87,7 +128,7 @@ fn make_part(
     let values = PartValues {
         slot,
         serial,
-        stamp,
+        stamp: job.stamp,
         data: prod.data.as_ref(),
     };
     let mut geometries: Vec<Geometry> = prod
@@ -102,9 +143,9 @@ fn make_part(
             g
         })
         .collect();
-    let mut texts = Vec::with_capacity(pieces.len());
+    let mut texts = Vec::with_capacity(job.pieces.len());
     let mut warnings = Vec::new();
-    for (t, p) in prod.templates.iter().zip(pieces) {
+    for (t, p) in prod.templates.iter().zip(&job.pieces) {
         let bad = |why: String| ProductionError::Template {
             element: t.element.clone(),
             line: t.line,
@@ -112,11 +153,33 @@ fn make_part(
             why,
         };
         let text = render(p, &values).map_err(bad)?;
-        let (g, w) = shape_template(&t.moved(slot.offset), &text, slot.part, opts, MAX_POINTS)
-            .map_err(bad)?;
+        let (g, w) = shape_template(
+            &t.moved(slot.offset),
+            &text,
+            slot.part,
+            &job.opts,
+            MAX_POINTS,
+        )
+        .map_err(bad)?;
         geometries.extend(g);
         warnings.extend(w);
         texts.push(text);
+    }
+    let mut codes = Vec::with_capacity(prod.codes.len());
+    for (k, (spec, p)) in prod.codes.iter().zip(&job.code_pieces).enumerate() {
+        let bad = |why: String| ProductionError::Code {
+            text: format!("{}:{}", spec.kind, spec.content),
+            why,
+        };
+        let content = render(p, &values).map_err(bad)?;
+        let sym = symbol(spec, &content).map_err(bad)?;
+        let at = job
+            .origin
+            .plus(Pt::new(spec.at_mm[0], spec.at_mm[1]))
+            .plus(slot.offset);
+        let element = format!("{} code {}", spec.kind, k + 1);
+        geometries.extend(marks(spec, &sym, at, job.fill, slot.part, &element).map_err(bad)?);
+        codes.push(content);
     }
     let record = PartRecord {
         part: slot.part,
@@ -126,8 +189,57 @@ fn make_part(
         position_mm: [slot.offset.x, slot.offset.y],
         serial,
         texts,
+        codes,
     };
     Ok((record, geometries, warnings))
+}
+
+/// How the codes of `doc` are filled: the codes layer's hatch spacing when its pen has a
+/// hatch, else the profile's spot; always inset by half the spot.
+fn code_fill(doc: &Document) -> Fill {
+    let spot = doc.profile.laser.spot_mm;
+    let spacing = doc
+        .layers
+        .iter()
+        .find(|l| l.name == CODE_LAYER)
+        .and_then(|l| l.pen.hatch.as_ref())
+        .map_or(spot, |h| h.spacing_mm);
+    Fill {
+        spacing_mm: spacing,
+        spot_mm: spot,
+    }
+}
+
+/// A warning for each code whose quiet zone holds artwork of the part (texts included),
+/// naming both: the zone must stay unmarked for the code to scan.
+fn quiet_zone_warnings(job: &Job, first: &Made) -> Vec<crate::document::Warning> {
+    let mut out = Vec::new();
+    let (record, geometries, _) = first;
+    for (k, (spec, content)) in job.prod.codes.iter().zip(&record.codes).enumerate() {
+        let Ok(sym) = symbol(spec, content) else {
+            continue;
+        };
+        let at = job.origin.plus(Pt::new(spec.at_mm[0], spec.at_mm[1]));
+        let (lo, hi) = quiet_box(spec, &sym, at);
+        let element = format!("{} code {}", spec.kind, k + 1);
+        let inside = |p: &Pt| p.x > lo.x && p.x < hi.x && p.y > lo.y && p.y < hi.y;
+        if let Some(g) = geometries
+            .iter()
+            .filter(|g| g.layer != CODE_LAYER)
+            .find(|g| g.points.iter().any(inside))
+        {
+            out.push(crate::document::Warning {
+                element: element.clone(),
+                line: None,
+                message: format!(
+                    "its quiet zone ({:.2}, {:.2}) to ({:.2}, {:.2}) mm holds {} of the part: \
+                     move one of them, or the code may not scan",
+                    lo.x, lo.y, hi.x, hi.y, g.source.element
+                ),
+            });
+        }
+    }
+    out
 }
 
 /// Makes `doc.artwork` (and `doc.parts`) from `doc.production`, placed on the machine as the
@@ -139,7 +251,7 @@ pub fn expand(doc: &mut Document, now: Stamp) -> Result<(), ProductionError> {
     };
     prod.tray.validate()?;
     let slots = prod.tray.parts();
-    let pieces = pieces(prod, slots.len())?;
+    let (pieces, code_pieces) = pieces(prod, slots.len())?;
     let glyphs: usize = prod
         .templates
         .iter()
@@ -153,19 +265,39 @@ pub fn expand(doc: &mut Document, now: Stamp) -> Result<(), ProductionError> {
             slots.len()
         )));
     }
-    let stamp = prod.stamp.unwrap_or(now);
-    let opts = options(doc, prod);
-    let made: Vec<_> = slots
+    let origin = prod
+        .part
+        .iter()
+        .fold(BBox::EMPTY, |b, g| b.union(BBox::of(&g.points)));
+    let job = Job {
+        prod,
+        pieces,
+        code_pieces,
+        stamp: prod.stamp.unwrap_or(now),
+        opts: options(doc, prod),
+        fill: code_fill(doc),
+        origin: if origin.is_empty() {
+            Pt::new(0.0, 0.0)
+        } else {
+            Pt::new(origin.min_x, origin.min_y)
+        },
+    };
+    let made: Vec<Made> = slots
         .par_iter()
-        .map(|&slot| make_part(prod, &pieces, slot, stamp, &opts))
+        .map(|&slot| make_part(&job, slot))
         .collect::<Result<_, _>>()?;
+    let quiet = made
+        .first()
+        .map(|m| quiet_zone_warnings(&job, m))
+        .unwrap_or_default();
+    let opts = job.opts;
     let mut records = Vec::with_capacity(made.len());
     let mut geometries = Vec::new();
     let mut warnings = Vec::new();
     for (r, g, w) in made {
         records.push(r);
         geometries.extend(g);
-        for w in w {
+        for w in w.into_iter().chain(quiet.iter().cloned()) {
             if !warnings.contains(&w) {
                 warnings.push(w);
             }

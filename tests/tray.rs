@@ -323,3 +323,55 @@ fn mtext_with_format_braces_and_a_field() {
     };
     assert!(glyphs(1) > 4 && glyphs(2) > 4);
 }
+
+/// Codes on the parts: bad codes refused in one line naming the code, nothing written; a code
+/// whose quiet zone holds the part's text warns, naming both.
+#[test]
+fn bad_codes_are_one_line_and_a_crowded_quiet_zone_warns() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let part = example("part.svg").display().to_string();
+    let long = format!("qr:{}@14,2:9", "x".repeat(5000));
+    for (code, says) in [
+        (long.as_str(), "does not fit a QR code at any size"),
+        ("code128:Grüße@3,3:20", "cannot encode 'ü'"),
+        ("datamatrix:GP{serial:05}@3,3:0.5", "at least 1.20 mm wide"),
+        ("aztec:x@1,1:5", "unknown kind 'aztec'"),
+        ("qr:x@1,1:5:rect", "unknown option 'rect' for qr"),
+        ("datamatrix:{seriall}@1,1:5", "unknown field {seriall}"),
+    ] {
+        let (ok, err) = galvoplan(
+            &[
+                "plan",
+                &part,
+                "--code",
+                code,
+                "-o",
+                "out.gcode",
+                "--report",
+                "out.json",
+            ],
+            d,
+        );
+        assert!(!ok, "{code} accepted");
+        assert!(err.contains(says), "{code}: '{says}' not in:\n{err}");
+        assert!(err.trim_end().lines().count() <= 3, "{err}");
+        assert!(!d.join("out.gcode").exists());
+    }
+    let (ok, err) = galvoplan(
+        &[
+            "plan",
+            &part,
+            "--code",
+            "datamatrix:GP{serial:05}@3,17:6",
+            "-o",
+            "out.gcode",
+        ],
+        d,
+    );
+    assert!(ok, "{err}");
+    assert!(
+        err.contains("datamatrix code 1") && err.contains("quiet zone") && err.contains("#sn"),
+        "{err}"
+    );
+}

@@ -14,7 +14,7 @@ use galvoplan::document::{
     Algo, CostModel, FieldsMode, MachineProfile, MotionMode, PenLibrary, RouteGaSettings,
     SolverSettings, StageRouteKind, VertexMode,
 };
-use galvoplan::document::{DataTable, Numbering, Serial, Stamp, Tray, TraySettings};
+use galvoplan::document::{CodeSpec, DataTable, Numbering, Serial, Stamp, Tray, TraySettings};
 use galvoplan::geom::seam::SeamForm;
 use galvoplan::hatch::{HatchSettings, OutlineMode};
 use galvoplan::import::{HiddenLayers, ImportOptions, Place};
@@ -252,6 +252,11 @@ struct TrayOpts {
     /// The date and time `{date}` and `{time}` show (default: now), for reproducible programs.
     #[arg(long, value_name = "YYYY-MM-DD[THH:MM]", value_parser = parse_date)]
     date: Option<Stamp>,
+    /// A code on every part: KIND (datamatrix, qr, code128), CONTENT (fields allowed; the last
+    /// `@` ends it), its top-left X,Y from the part's top-left and its width SIZE_MM without the
+    /// quiet zone; OPTIONS: inverted, rect, gs1 (DataMatrix), ecc=L|M|Q|H (QR). Repeatable.
+    #[arg(long = "code", value_name = "KIND:CONTENT@X,Y:SIZE_MM[:OPTIONS]", value_parser = parse_code)]
+    codes: Vec<CodeSpec>,
 }
 
 impl TrayOpts {
@@ -264,6 +269,7 @@ impl TrayOpts {
             serial: self.serial,
             stamp: self.date,
             data: self.data.as_deref().map(DataTable::read).transpose()?,
+            codes: (!self.codes.is_empty()).then(|| self.codes.clone()),
         })
     }
 }
@@ -289,6 +295,10 @@ fn parse_numbering(s: &str) -> Result<Numbering, String> {
 
 fn parse_serial(s: &str) -> Result<Serial, String> {
     Serial::parse(s).map_err(|e| e.to_string())
+}
+
+fn parse_code(s: &str) -> Result<CodeSpec, String> {
+    CodeSpec::parse(s).map_err(|e| e.to_string())
 }
 
 fn parse_date(s: &str) -> Result<Stamp, String> {

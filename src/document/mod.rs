@@ -1,6 +1,7 @@
 //! The document model: geometries, machine profile, solver settings, scan fields and plans.
 
 mod artwork_import;
+mod code;
 mod geometry;
 mod hatch;
 mod inputs;
@@ -17,6 +18,7 @@ pub mod validate;
 mod warning;
 
 pub use artwork_import::{ArtworkImport, LayerHidden, Place, PlaceError, SkippedLayer};
+pub use code::{CodeKind, CodeOptions, CodeSpec, Ecc, CODE_LAYER};
 pub use geometry::{is_hatch_output, Geometry, Run, RunOrder, Source, HATCH_LAYER_PREFIX};
 pub use hatch::{
     FillRule, FillShapes, HatchSettings, HatchSpecError, HatchStyle, OutlineMode, MIN_SPACING_MM,

@@ -654,6 +654,9 @@ pub struct Production {
     /// The chord tolerance the texts are shaped with (the artwork's import tolerance), mm.
     #[serde(default = "default_chord_tol")]
     pub chord_tol_mm: f64,
+    /// The part's codes (DataMatrix, QR, Code 128), each with its content per part.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub codes: Vec<super::CodeSpec>,
 }
 
 fn default_chord_tol() -> f64 {
@@ -671,6 +674,7 @@ impl Default for Production {
             data: None,
             logged_through: None,
             chord_tol_mm: default_chord_tol(),
+            codes: Vec::new(),
         }
     }
 }
@@ -708,6 +712,8 @@ pub struct TraySettings {
     pub stamp: Option<Stamp>,
     /// Data per part.
     pub data: Option<DataTable>,
+    /// The part's codes (replace the production's).
+    pub codes: Option<Vec<super::CodeSpec>>,
 }
 
 impl TraySettings {
@@ -736,6 +742,9 @@ impl TraySettings {
         }
         if let Some(d) = &self.data {
             p.data = Some(d.clone());
+        }
+        if let Some(c) = &self.codes {
+            p.codes = c.clone();
         }
         Ok(())
     }
@@ -777,6 +786,9 @@ pub struct PartRecord {
     pub serial: i64,
     /// Every template's text as marked, in template order.
     pub texts: Vec<String>,
+    /// Every code's content as marked, in code order.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub codes: Vec<String>,
 }
 
 /// A production input that cannot be used; every message names what and where.
@@ -810,6 +822,14 @@ pub enum ProductionError {
     /// The data file cannot be used.
     #[error("{0}")]
     Data(String),
+    /// A code cannot be read or made (`--code TEXT`, or its content for a part).
+    #[error("code '{text}': {why}")]
+    Code {
+        /// The code as given.
+        text: String,
+        /// What is wrong.
+        why: String,
+    },
 }
 
 #[cfg(test)]

@@ -110,6 +110,15 @@ pub struct LaserTiming {
     pub off_delay_s: f64,
     /// Settling delay after a scanner jump, in s.
     pub jump_delay_s: f64,
+    /// The laser spot's diameter on the work, mm: codes without a pen of their own are filled
+    /// at this spacing, inset by half of it.
+    #[serde(default = "default_spot_mm")]
+    pub spot_mm: f64,
+}
+
+/// A galvo's typical focused spot, mm.
+fn default_spot_mm() -> f64 {
+    0.05
 }
 
 impl Default for LaserTiming {
@@ -118,6 +127,7 @@ impl Default for LaserTiming {
             on_delay_s: 100e-6,
             off_delay_s: 100e-6,
             jump_delay_s: 200e-6,
+            spot_mm: default_spot_mm(),
         }
     }
 }

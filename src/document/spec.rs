@@ -432,6 +432,14 @@ pub fn profile_specs() -> Vec<FieldSpec<MachineProfile>> {
             |p| p.laser.jump_delay_s
         ),
         number!(
+            "Laser spot",
+            "mm",
+            "laser.spot_mm",
+            "the spot's diameter: codes without a pen of their own are filled at this spacing",
+            Rule::Length,
+            |p| p.laser.spot_mm
+        ),
+        number!(
             "On-the-fly margin",
             "mm",
             "otf_margin_mm",

@@ -8,8 +8,8 @@ use std::path::Path;
 /// The log's header row.
 pub const PARTS_LOG_HEADER: &str = "date_time,program,part,serial,contents";
 
-/// The rows of `parts` (with the header when `header`), as CSV text; the texts of a part are
-/// joined by ` | ` in its `contents`.
+/// The rows of `parts` (with the header when `header`), as CSV text; the texts of a part, then
+/// its codes' contents, are joined by ` | ` in its `contents`.
 pub fn parts_log_rows(program: &str, parts: &[PartRecord], when: &str, header: bool) -> String {
     let mut w = csv::WriterBuilder::new()
         .has_headers(false)
@@ -26,7 +26,12 @@ pub fn parts_log_rows(program: &str, parts: &[PartRecord], when: &str, header: b
             program,
             &p.part.to_string(),
             &p.serial.to_string(),
-            &p.texts.join(" | "),
+            &p.texts
+                .iter()
+                .chain(&p.codes)
+                .cloned()
+                .collect::<Vec<_>>()
+                .join(" | "),
         ]);
     }
     let _ = w.flush();
@@ -65,11 +70,12 @@ mod tests {
             position_mm: [80.0, 0.0],
             serial: 1002,
             texts: vec!["SN 01002".into(), "lot \"A\", 7".into()],
+            codes: vec!["GP01002".into()],
         };
         let rows = parts_log_rows("tray.gcode", &[p], "2026-12-07T14:30:00", true);
         assert_eq!(
             rows,
-            "date_time,program,part,serial,contents\n2026-12-07T14:30:00,tray.gcode,2,1002,\"SN 01002 | lot \"\"A\"\", 7\"\n"
+            "date_time,program,part,serial,contents\n2026-12-07T14:30:00,tray.gcode,2,1002,\"SN 01002 | lot \"\"A\"\", 7 | GP01002\"\n"
         );
     }
 }

@@ -1,0 +1,356 @@
+//! Codes that scan: a part's DataMatrix, QR or Code 128 as marks.
+//!
+//! [`symbol`] encodes a content with a well-kept crate (`datamatrix`, `qrcode`, `barcoders`)
+//! into a grid of modules with its quiet zone; [`marks`] turns the dark modules (or, inverted,
+//! the light ones and the quiet zone) into fill strokes:
+//!
+//! * a module is `size / columns` wide (a Code 128 bar is as tall as [`BAR_HEIGHT_OF_WIDTH`] of
+//!   the symbol's width);
+//! * the dark modules of a row are merged into runs, and each run's rectangle is filled by one
+//!   serpentine stroke along its long side at the pen's spacing `s`;
+//! * the fill is inset by half the spot `d`: the lines run from `d/2` inside one edge to `d/2`
+//!   inside the other, so that a spot of diameter `d` marks exactly the run's rectangle (its
+//!   edges) and no more: a marked module has the module's size;
+//! * a module smaller than `max(2·s, d)` cannot be filled that way and is refused with the
+//!   smallest symbol width that works.
+
+use crate::document::{CodeKind, CodeSpec, Ecc, Geometry, Source, CODE_LAYER};
+use crate::geom::Pt;
+
+/// A Code 128's bar height as a share of the symbol's width (without quiet zones).
+pub const BAR_HEIGHT_OF_WIDTH: f64 = 0.3;
+/// Quiet zones in modules: DataMatrix (ISO/IEC 16022 asks 1; 2 reads better on marked parts),
+/// QR (ISO/IEC 18004: 4), Code 128 (ISO/IEC 15417: 10).
+const QUIET_DATAMATRIX: usize = 2;
+const QUIET_QR: usize = 4;
+const QUIET_CODE128: usize = 10;
+
+/// A code as modules: `rows × cols`, row-major, `true` for dark.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Symbol {
+    /// Columns of modules (without the quiet zone).
+    pub cols: usize,
+    /// Rows of modules (1 for a 1-D code).
+    pub rows: usize,
+    /// Dark modules, row-major.
+    pub dark: Vec<bool>,
+    /// The quiet zone, in modules, on each side (left and right only for a 1-D code).
+    pub quiet: usize,
+    /// A 1-D code: its one row is a row of bars.
+    pub bars: bool,
+}
+
+impl Symbol {
+    /// Module `(row, col)` is dark.
+    pub fn is_dark(&self, row: usize, col: usize) -> bool {
+        self.dark
+            .get(row * self.cols + col)
+            .copied()
+            .unwrap_or(false)
+    }
+}
+
+/// Encodes `content` as `spec` says; `Err` says why it cannot be (too long for the kind at
+/// any size, a character the kind cannot encode).
+pub fn symbol(spec: &CodeSpec, content: &str) -> Result<Symbol, String> {
+    match spec.kind {
+        CodeKind::DataMatrix => {
+            use datamatrix::{DataMatrix, SymbolList};
+            let list = if spec.options.rect {
+                SymbolList::with_extended_rectangles().enforce_rectangular()
+            } else {
+                SymbolList::default().enforce_square()
+            };
+            let made = if spec.options.gs1 {
+                DataMatrix::encode_gs1(content.as_bytes(), list)
+            } else {
+                DataMatrix::encode_str(content, list)
+            };
+            let dm = made.map_err(|_| {
+                format!(
+                    "\"{content}\" does not fit a{} DataMatrix at any size",
+                    if spec.options.rect {
+                        " rectangular"
+                    } else {
+                        " square"
+                    }
+                )
+            })?;
+            let bitmap = dm.bitmap();
+            Ok(Symbol {
+                cols: bitmap.width(),
+                rows: bitmap.height(),
+                dark: bitmap.bits().to_vec(),
+                quiet: QUIET_DATAMATRIX,
+                bars: false,
+            })
+        }
+        CodeKind::Qr => {
+            use qrcode::{Color, EcLevel, QrCode};
+            let ecc = match spec.options.ecc {
+                Ecc::L => EcLevel::L,
+                Ecc::M => EcLevel::M,
+                Ecc::Q => EcLevel::Q,
+                Ecc::H => EcLevel::H,
+            };
+            let qr =
+                QrCode::with_error_correction_level(content.as_bytes(), ecc).map_err(|_| {
+                    format!(
+                    "\"{content}\" does not fit a QR code at any size with error correction {:?}",
+                    spec.options.ecc
+                )
+                })?;
+            let n = qr.width();
+            Ok(Symbol {
+                cols: n,
+                rows: n,
+                dark: qr.to_colors().iter().map(|c| *c == Color::Dark).collect(),
+                quiet: QUIET_QR,
+                bars: false,
+            })
+        }
+        CodeKind::Code128 => {
+            if let Some(c) = content.chars().find(|c| !(' '..='~').contains(c)) {
+                let shown = if c.is_control() {
+                    c.escape_default().to_string()
+                } else {
+                    c.to_string()
+                };
+                return Err(format!(
+                    "Code 128 (set B) cannot encode '{shown}' in \"{content}\" (printable ASCII \
+                     only)"
+                ));
+            }
+            // set B: every printable ASCII character
+            let code = barcoders::sym::code128::Code128::new(format!("Ɓ{content}"))
+                .map_err(|e| format!("Code 128 cannot encode \"{content}\": {e}"))?;
+            let dark: Vec<bool> = code.encode().into_iter().map(|b| b == 1).collect();
+            Ok(Symbol {
+                cols: dark.len(),
+                rows: 1,
+                dark,
+                quiet: QUIET_CODE128,
+                bars: true,
+            })
+        }
+    }
+}
+
+/// How a code is filled: the pen's line spacing and the laser's spot, mm.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Fill {
+    /// Distance between fill lines, mm.
+    pub spacing_mm: f64,
+    /// Spot diameter, mm.
+    pub spot_mm: f64,
+}
+
+/// The symbol's module size for `spec`, mm: (across, down).
+pub fn module_mm(spec: &CodeSpec, sym: &Symbol) -> (f64, f64) {
+    let m = spec.size_mm / sym.cols.max(1) as f64;
+    if sym.bars {
+        (m, spec.size_mm * BAR_HEIGHT_OF_WIDTH)
+    } else {
+        (m, m)
+    }
+}
+
+/// The box the code takes with its quiet zone (top-left, bottom-right), mm, for a symbol whose
+/// top-left is `at`.
+pub fn quiet_box(spec: &CodeSpec, sym: &Symbol, at: Pt) -> (Pt, Pt) {
+    let (mx, my) = module_mm(spec, sym);
+    let q = sym.quiet as f64;
+    let (qx, qy) = (q * mx, if sym.bars { 0.0 } else { q * my });
+    (
+        Pt::new(at.x - qx, at.y - qy),
+        Pt::new(
+            at.x + sym.cols as f64 * mx + qx,
+            at.y + sym.rows as f64 * my + qy,
+        ),
+    )
+}
+
+/// The fill strokes of `sym` with its top-left at `at` (machine mm), as geometries of part
+/// `part` on the codes' layer named `element`; `Err` when its modules are too small for the
+/// fill, with the smallest width that works.
+pub fn marks(
+    spec: &CodeSpec,
+    sym: &Symbol,
+    at: Pt,
+    fill: Fill,
+    part: u32,
+    element: &str,
+) -> Result<Vec<Geometry>, String> {
+    let (mx, my) = module_mm(spec, sym);
+    let least = (2.0 * fill.spacing_mm).max(fill.spot_mm);
+    if mx < least - 1e-9 {
+        return Err(format!(
+            "modules of {mx:.3} mm are smaller than twice the fill spacing ({} mm) or the spot \
+             ({} mm): make it at least {:.2} mm wide",
+            fill.spacing_mm,
+            fill.spot_mm,
+            least * sym.cols as f64
+        ));
+    }
+    // the grid that is marked: the symbol, or (inverted) the symbol in its quiet zone
+    let q = if spec.options.inverted { sym.quiet } else { 0 };
+    let (qr, cols, rows) = if sym.bars {
+        (0, sym.cols + 2 * q, 1)
+    } else {
+        (q, sym.cols + 2 * q, sym.rows + 2 * q)
+    };
+    let marked = |r: usize, c: usize| -> bool {
+        let inside = r >= qr && r < qr + sym.rows && c >= q && c < q + sym.cols;
+        let dark = inside && sym.is_dark(r - qr, c - q);
+        dark != spec.options.inverted
+    };
+    let origin = Pt::new(at.x - q as f64 * mx, at.y - qr as f64 * my);
+    let mut out = Vec::new();
+    for r in 0..rows {
+        let mut c = 0;
+        while c < cols {
+            if !marked(r, c) {
+                c += 1;
+                continue;
+            }
+            let start = c;
+            while c < cols && marked(r, c) {
+                c += 1;
+            }
+            let (x0, x1) = (origin.x + start as f64 * mx, origin.x + c as f64 * mx);
+            let (y0, y1) = (origin.y + r as f64 * my, origin.y + (r + 1) as f64 * my);
+            let points = serpentine(x0, y0, x1, y1, fill);
+            let source = Source {
+                element: element.to_string(),
+                subpath: out.len(),
+                layer: CODE_LAYER.into(),
+                part,
+            };
+            out.push(Geometry::new(points, false, source).with_layer(CODE_LAYER));
+        }
+    }
+    Ok(out)
+}
+
+/// One stroke filling the rectangle `[x0, x1] × [y0, y1]` with lines along its long side,
+/// `spacing` apart, inset by half the spot (a single centre line when only one fits).
+fn serpentine(x0: f64, y0: f64, x1: f64, y1: f64, fill: Fill) -> Vec<Pt> {
+    let h = fill.spot_mm / 2.0;
+    let along_x = x1 - x0 >= y1 - y0;
+    // (from, to) along the lines, (lo, hi) across them
+    let (a0, a1, lo, hi) = if along_x {
+        (x0 + h, x1 - h, y0 + h, y1 - h)
+    } else {
+        (y0 + h, y1 - h, x0 + h, x1 - h)
+    };
+    let (a0, a1) = if a1 > a0 {
+        (a0, a1)
+    } else {
+        let m = (a0 + a1) / 2.0;
+        (m - 1e-3, m + 1e-3)
+    };
+    let span = (hi - lo).max(0.0);
+    let n = (span / fill.spacing_mm).ceil().max(1.0) as usize;
+    let step = span / n as f64;
+    let levels: Vec<f64> = if span <= 0.0 {
+        vec![(lo + hi) / 2.0]
+    } else {
+        (0..=n).map(|k| lo + k as f64 * step).collect()
+    };
+    let mut pts = Vec::with_capacity(2 * levels.len());
+    for (k, v) in levels.into_iter().enumerate() {
+        let (p, q) = if k % 2 == 0 { (a0, a1) } else { (a1, a0) };
+        let (p, q) = if along_x {
+            (Pt::new(p, v), Pt::new(q, v))
+        } else {
+            (Pt::new(v, p), Pt::new(v, q))
+        };
+        pts.push(p);
+        pts.push(q);
+    }
+    pts
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::document::CodeOptions;
+
+    fn spec(kind: CodeKind, size: f64) -> CodeSpec {
+        CodeSpec {
+            kind,
+            content: "x".into(),
+            at_mm: [0.0, 0.0],
+            size_mm: size,
+            options: CodeOptions::default(),
+        }
+    }
+
+    #[test]
+    fn symbols_of_each_kind() {
+        let dm = symbol(&spec(CodeKind::DataMatrix, 6.0), "GP01001").unwrap();
+        assert_eq!((dm.cols, dm.rows), (12, 12));
+        let mut rect = spec(CodeKind::DataMatrix, 6.0);
+        rect.options.rect = true;
+        let r = symbol(&rect, "GP01001").unwrap();
+        assert!(r.cols > r.rows, "{} × {}", r.cols, r.rows);
+        let qr = symbol(&spec(CodeKind::Qr, 9.0), "L26-001/1001").unwrap();
+        assert_eq!((qr.cols, qr.rows), (21, 21));
+        let c = symbol(&spec(CodeKind::Code128, 30.0), "SN1001").unwrap();
+        assert!(c.bars && c.rows == 1 && c.cols > 60);
+        let e = symbol(&spec(CodeKind::Code128, 30.0), "Grüße").unwrap_err();
+        assert!(e.contains("cannot encode 'ü'"), "{e}");
+        let e = symbol(&spec(CodeKind::Qr, 9.0), &"x".repeat(5000)).unwrap_err();
+        assert!(e.contains("does not fit a QR code at any size"), "{e}");
+    }
+
+    #[test]
+    fn runs_are_filled_inset_by_half_the_spot() {
+        let s = spec(CodeKind::DataMatrix, 3.5);
+        let sym = symbol(&s, "GP01001").unwrap();
+        let fill = Fill {
+            spacing_mm: 0.05,
+            spot_mm: 0.05,
+        };
+        let g = marks(&s, &sym, Pt::new(10.0, 20.0), fill, 1, "code").unwrap();
+        // one stroke per run, far fewer than dark modules
+        let dark = sym.dark.iter().filter(|d| **d).count();
+        assert!(
+            g.len() < dark && !g.is_empty(),
+            "{} strokes, {dark} modules",
+            g.len()
+        );
+        // every point stays half a spot inside the symbol
+        let m = 3.5 / sym.cols as f64;
+        for p in g.iter().flat_map(|g| &g.points) {
+            assert!(p.x >= 10.0 + 0.025 - 1e-9 && p.x <= 10.0 + 3.5 - 0.025 + 1e-9);
+            assert!(p.y >= 20.0 + 0.025 - 1e-9 && p.y <= 20.0 + 3.5 - 0.025 + 1e-9);
+        }
+        assert!(m > 0.2);
+        // too small for the fill: the smallest width that works
+        let tiny = spec(CodeKind::DataMatrix, 1.0);
+        let e = marks(&tiny, &sym, Pt::new(0.0, 0.0), fill, 1, "code").unwrap_err();
+        // 12 modules of at least 2 × 0.05 mm
+        assert_eq!(sym.cols, 12);
+        assert!(e.contains("at least 1.20 mm wide"), "{e}");
+    }
+
+    #[test]
+    fn inverted_marks_the_quiet_zone_and_leaves_the_modules() {
+        let mut s = spec(CodeKind::Qr, 9.0);
+        s.options.inverted = true;
+        let sym = symbol(&s, "A").unwrap();
+        let fill = Fill {
+            spacing_mm: 0.05,
+            spot_mm: 0.05,
+        };
+        let g = marks(&s, &sym, Pt::new(0.0, 0.0), fill, 1, "code").unwrap();
+        let (lo, hi) = quiet_box(&s, &sym, Pt::new(0.0, 0.0));
+        let xs = g.iter().flat_map(|g| &g.points).map(|p| p.x);
+        let min_x = xs.fold(f64::INFINITY, f64::min);
+        assert!(
+            (min_x - (lo.x + 0.025)).abs() < 1e-9,
+            "{min_x} {lo:?} {hi:?}"
+        );
+    }
+}
