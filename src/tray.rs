@@ -178,7 +178,10 @@ fn make_part(job: &Job, slot: PartSlot) -> Result<Made, ProductionError> {
             .plus(Pt::new(spec.at_mm[0], spec.at_mm[1]))
             .plus(slot.offset);
         let element = format!("{} code {}", spec.kind, k + 1);
-        geometries.extend(marks(spec, &sym, at, job.fill, slot.part, &element).map_err(bad)?);
+        // a run id of its own for each code of each part
+        let run_id = slot.part.wrapping_mul(64).wrapping_add(k as u32);
+        geometries
+            .extend(marks(spec, &sym, at, job.fill, slot.part, &element, run_id).map_err(bad)?);
         codes.push(content);
     }
     let record = PartRecord {

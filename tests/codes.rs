@@ -94,7 +94,7 @@ fn round_trip(kind: CodeKind, content: &str, module_mm: f64, options: CodeOption
         spot_mm: SPOT_MM,
     };
     let at = Pt::new(5.0, 5.0);
-    let g = marks(&spec, &sym, at, fill, 1, "code").unwrap();
+    let g = marks(&spec, &sym, at, fill, 1, "code", 1).unwrap();
     let strokes: Vec<Vec<Pt>> = g.into_iter().map(|g| g.points).collect();
     let (lo, hi) = quiet_box(&spec, &sym, at);
     decode(kind, &strokes, lo, hi, options.inverted)
