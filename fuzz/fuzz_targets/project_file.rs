@@ -1,5 +1,6 @@
 //! Project files (versioned JSON) must load or give an error, never panic. Goes through
-//! `load_project`, the path the CLI and GUI take (a file in /dev/shm, rewritten each run).
+//! `load_project`, the path the CLI and GUI take (a file in /dev/shm, written and removed each
+//! run, so that none is left behind).
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
@@ -22,5 +23,6 @@ fuzz_target!(|data: &[u8]| {
     let path = scratch();
     if std::fs::write(path, data).is_ok() {
         let _ = galvoplan::document::load_project(path);
+        let _ = std::fs::remove_file(path);
     }
 });
