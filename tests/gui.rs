@@ -1876,3 +1876,46 @@ fn export_and_advance_logs_the_parts_moves_the_serial_on_and_cannot_be_undone() 
         h.state().status()
     );
 }
+
+#[test]
+fn a_datamatrix_on_a_three_by_two_tray_is_drawn_and_tells_part_4s_content() {
+    let mut h = tray("3", "2", "1001");
+    h.get_by_label("Add a code").click();
+    h.run();
+    for (label, text) in [
+        ("Code content", "GP{serial:05}"),
+        ("Code X (mm)", "3"),
+        ("Code Y (mm)", "3"),
+        ("Code size (mm)", "6"),
+    ] {
+        enter_nth(&mut h, label, 0, text);
+        h.run();
+    }
+    h.get_by_label("Apply codes").click();
+    h.step();
+    wait_idle(&mut h, Duration::from_secs(60));
+    let doc = &h.state().session.doc;
+    assert_eq!(doc.parts[3].codes, ["GP01004"]);
+    // its modules are on the canvas: strokes on the codes layer, in part 4 too
+    let modules = doc
+        .geometries
+        .iter()
+        .filter(|g| g.layer == "codes" && g.source.part == 4)
+        .count();
+    assert!(modules > 10, "{modules} strokes");
+    h.get_by_label_contains("code: GP01001");
+    hover_part(&mut h, 4);
+    h.get_by_label_contains("code “GP01004”");
+    // a code that cannot be made says why, in the section
+    enter_nth(&mut h, "Code size (mm)", 0, "0.5");
+    h.run();
+    h.get_by_label("Apply codes").click();
+    h.step();
+    wait_idle(&mut h, Duration::from_secs(60));
+    assert!(
+        h.state().status().contains("at least") && h.state().status().contains("mm wide"),
+        "{}",
+        h.state().status()
+    );
+    assert_eq!(h.state().session.doc.parts[3].codes, ["GP01004"]);
+}

@@ -4,7 +4,7 @@
 
 use super::panels::{combo, Choice, Form};
 use crate::document::spec::{check_all, tray_specs};
-use crate::document::{Document, Numbering, Production, TraySetup};
+use crate::document::{CodeKind, CodeSpec, Document, Ecc, Numbering, Production, TraySetup};
 use egui::RichText;
 
 /// What the operator asked of the Tray section.
@@ -12,13 +12,90 @@ use egui::RichText;
 pub enum TrayAction {
     /// Make the tray with this tray and serials (in a background job, undoable).
     Set(TraySetup),
+    /// Give every part these codes (in a background job, undoable).
+    SetCodes(Vec<CodeSpec>),
     /// Write the program of the shown plan, log its parts and move the serials on.
     ExportAndAdvance,
 }
 
+/// One code as the Tray section edits it: its kind and the text of each value.
+#[derive(Debug, Clone, PartialEq)]
+struct CodeRow {
+    kind: CodeKind,
+    content: String,
+    x: String,
+    y: String,
+    size: String,
+    options: String,
+}
+
+impl CodeRow {
+    fn of(c: &CodeSpec) -> Self {
+        let o = &c.options;
+        let mut opts = Vec::new();
+        if o.inverted {
+            opts.push("inverted".to_string());
+        }
+        if o.rect {
+            opts.push("rect".into());
+        }
+        if o.gs1 {
+            opts.push("gs1".into());
+        }
+        if c.kind == CodeKind::Qr && o.ecc != Ecc::M {
+            opts.push(format!("ecc={:?}", o.ecc));
+        }
+        Self {
+            kind: c.kind,
+            content: c.content.clone(),
+            x: c.at_mm[0].to_string(),
+            y: c.at_mm[1].to_string(),
+            size: c.size_mm.to_string(),
+            options: opts.join(","),
+        }
+    }
+
+    /// The code, read as `--code` reads it (one parser for both).
+    fn spec(&self) -> Result<CodeSpec, String> {
+        let text = format!(
+            "{}:{}@{},{}:{}:{}",
+            self.kind,
+            self.content,
+            self.x.trim(),
+            self.y.trim(),
+            self.size.trim(),
+            self.options.trim()
+        );
+        CodeSpec::parse(&text).map_err(|e| e.to_string())
+    }
+}
+
+const CODE_KINDS: [Choice<CodeKind>; 3] = [
+    (
+        CodeKind::DataMatrix,
+        "DataMatrix",
+        "DataMatrix ECC200; options rect, gs1, inverted",
+    ),
+    (
+        CodeKind::Qr,
+        "QR code",
+        "QR code; options ecc=L|M|Q|H, inverted",
+    ),
+    (
+        CodeKind::Code128,
+        "Code 128",
+        "a 1-D Code 128 (printable ASCII); option inverted",
+    ),
+];
+
 /// The Tray section's state.
 pub struct TrayPanel {
     form: Form<TraySetup>,
+    /// The codes being edited, and the document's codes they were filled from.
+    codes: Vec<CodeRow>,
+    codes_synced: Option<Vec<CodeSpec>>,
+    /// Why the codes as typed cannot be applied.
+    codes_error: Option<String>,
     /// The part whose texts the preview shows (from 1).
     preview: u32,
     /// Where *Export and advance* appends its rows (empty: beside the artwork).
@@ -29,6 +106,9 @@ impl Default for TrayPanel {
     fn default() -> Self {
         Self {
             form: Form::new(tray_specs()),
+            codes: Vec::new(),
+            codes_synced: None,
+            codes_error: None,
             preview: 1,
             log_path: String::new(),
         }
@@ -92,6 +172,10 @@ impl TrayPanel {
             out = Some(TrayAction::Set(p));
         }
         ui.separator();
+        if let Some(codes) = self.codes_ui(ui, doc) {
+            out = Some(TrayAction::SetCodes(codes));
+        }
+        ui.separator();
         self.summary(ui, doc);
         self.preview_ui(ui, doc);
         ui.separator();
@@ -132,6 +216,94 @@ impl TrayPanel {
         out
     }
 
+    /// The part's codes: kind, content (fields allowed), place and size, options; *Add a code*,
+    /// *Remove*, *Apply codes*. Returns the codes to set when they are applied and read.
+    fn codes_ui(&mut self, ui: &mut egui::Ui, doc: &Document) -> Option<Vec<CodeSpec>> {
+        let current: Vec<CodeSpec> = doc
+            .production
+            .as_ref()
+            .map(|p| p.codes.clone())
+            .unwrap_or_default();
+        if self.codes_synced.as_ref() != Some(&current) {
+            self.codes = current.iter().map(CodeRow::of).collect();
+            self.codes_synced = Some(current);
+            self.codes_error = None;
+        }
+        ui.label(RichText::new("Codes on every part").strong());
+        let mut remove = None;
+        for (k, row) in self.codes.iter_mut().enumerate() {
+            ui.push_id(("code", k), |ui| {
+                combo(ui, "Code kind", &mut row.kind, &CODE_KINDS);
+                let text = |ui: &mut egui::Ui, label: &str, value: &mut String, hint: &str| {
+                    ui.horizontal(|ui| {
+                        let l = ui.label(label);
+                        ui.add(
+                            egui::TextEdit::singleline(value)
+                                .hint_text(hint)
+                                .desired_width(150.0),
+                        )
+                        .labelled_by(l.id);
+                    });
+                };
+                text(ui, "Code content", &mut row.content, "GP{serial:05}");
+                text(ui, "Code X (mm)", &mut row.x, "from the part's left");
+                text(ui, "Code Y (mm)", &mut row.y, "from the part's top");
+                text(ui, "Code size (mm)", &mut row.size, "width");
+                text(ui, "Code options", &mut row.options, "e.g. inverted");
+                if ui.button("Remove this code").clicked() {
+                    remove = Some(k);
+                }
+            });
+            ui.separator();
+        }
+        if let Some(k) = remove {
+            self.codes.remove(k);
+        }
+        let mut out = None;
+        ui.horizontal(|ui| {
+            if ui
+                .button("Add a code")
+                .on_hover_text("a DataMatrix at the part's top-left; edit it, then Apply codes")
+                .clicked()
+            {
+                self.codes.push(CodeRow {
+                    kind: CodeKind::DataMatrix,
+                    content: "{serial}".into(),
+                    x: "1".into(),
+                    y: "1".into(),
+                    size: "5".into(),
+                    options: String::new(),
+                });
+            }
+            let changed = self.codes_synced.as_ref().map(|c| c.len()) != Some(self.codes.len())
+                || self
+                    .codes_synced
+                    .iter()
+                    .flatten()
+                    .zip(&self.codes)
+                    .any(|(c, r)| CodeRow::of(c) != *r);
+            if ui
+                .add_enabled(changed, egui::Button::new("Apply codes"))
+                .clicked()
+            {
+                match self.codes.iter().map(CodeRow::spec).collect() {
+                    Ok(codes) => {
+                        self.codes_error = None;
+                        out = Some(codes);
+                    }
+                    Err(e) => self.codes_error = Some(e),
+                }
+            }
+        });
+        if let Some(e) = &self.codes_error {
+            ui.add(
+                egui::Label::new(RichText::new(e).color(egui::Color32::from_rgb(200, 30, 30)))
+                    .wrap(),
+            );
+        }
+        out
+    }
+
     /// The parts, skipped cells and serials in words.
     fn summary(&self, ui: &mut egui::Ui, doc: &Document) {
         let Some(p) = &doc.production else {
@@ -161,7 +333,12 @@ impl TrayPanel {
 
     /// Any part's texts, as they will be marked.
     fn preview_ui(&mut self, ui: &mut egui::Ui, doc: &Document) {
-        if doc.parts.is_empty() || doc.parts.iter().all(|p| p.texts.is_empty()) {
+        if doc.parts.is_empty()
+            || doc
+                .parts
+                .iter()
+                .all(|p| p.texts.is_empty() && p.codes.is_empty())
+        {
             return;
         }
         let n = doc.parts.len() as u32;
@@ -174,6 +351,9 @@ impl TrayPanel {
         if let Some(part) = doc.parts.get(self.preview as usize - 1) {
             for t in &part.texts {
                 ui.label(RichText::new(t).monospace());
+            }
+            for c in &part.codes {
+                ui.label(RichText::new(format!("code: {c}")).monospace());
             }
         }
     }
@@ -192,6 +372,14 @@ impl super::App {
             .is_some_and(|k| self.plan_staleness(k).is_empty());
         match self.view.tray.ui(ui, &self.session.doc, can_export) {
             Some(TrayAction::Set(setup)) => self.set_tray(setup, ui.ctx()),
+            Some(TrayAction::SetCodes(codes)) => {
+                let what = match codes.len() {
+                    0 => "remove the codes".to_string(),
+                    1 => "set the part's code".to_string(),
+                    n => format!("set the part's {n} codes"),
+                };
+                self.remake_tray(what, ui.ctx(), move |p| p.codes = codes);
+            }
             Some(TrayAction::ExportAndAdvance) => {
                 let ctx = ui.ctx().clone();
                 self.choose_path(super::PathAction::ExportAdvance, &ctx);
@@ -220,14 +408,28 @@ impl super::App {
             );
             return;
         }
-        let mut work = self.session.doc.clone();
-        let mut p = production_or_part(&work);
         let what = format!(
             "set the tray: {} × {} parts at {} × {} mm",
             setup.tray.cols, setup.tray.rows, setup.tray.pitch_mm[0], setup.tray.pitch_mm[1]
         );
-        p.tray = setup.tray;
-        p.serial = setup.serial;
+        self.remake_tray(what, repaint, move |p| {
+            p.tray = setup.tray;
+            p.serial = setup.serial;
+        });
+    }
+
+    /// Changes the production (`change`), then makes the tray again (the part repeated, texts
+    /// and codes made per part, geometries made and fields placed again) in a background job,
+    /// undoable as `what` when it ends.
+    fn remake_tray(
+        &mut self,
+        what: String,
+        repaint: &egui::Context,
+        change: impl FnOnce(&mut Production),
+    ) {
+        let mut work = self.session.doc.clone();
+        let mut p = production_or_part(&work);
+        change(&mut p);
         work.production = Some(p);
         self.start_job(what.clone(), "tray", repaint, move |ctx| {
             use crate::pipeline::{derive_geometries, expand_production, place_document_fields};
@@ -387,6 +589,7 @@ pub fn part_boxes(doc: &Document) -> Vec<PartBox> {
                 r.part, r.cell, r.row, r.col, r.serial
             )];
             words.extend(r.texts.iter().map(|t| format!("  “{t}”")));
+            words.extend(r.codes.iter().map(|c| format!("  code “{c}”")));
             PartBox {
                 part: Some(r.part),
                 cell: r.cell,
