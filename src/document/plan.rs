@@ -157,7 +157,7 @@ pub struct MotionRegion {
     pub end_s: f64,
 }
 
-/// Metrics of a plan (definitions in DESIGN.md and `order::metrics`).
+/// Metrics of a plan (definitions in docs/DESIGN.md and `order::metrics`).
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct Metrics {
     /// Laser-off travel between consecutive strokes, mm.

@@ -148,7 +148,7 @@ pub enum GcodeMode {
     Linuxcnc,
 }
 
-/// G-code dialect options. The defaults produce the contract in DESIGN.md.
+/// G-code dialect options. The defaults produce the contract in docs/DESIGN.md.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 #[serde(default, deny_unknown_fields)]
 pub struct GcodeDialect {

@@ -1,4 +1,4 @@
-//! G-code from the lowered toolpath, in two dialects (DESIGN.md, docs/GCODE.md):
+//! G-code from the lowered toolpath, in two dialects (docs/DESIGN.md, docs/GCODE.md):
 //!
 //! * `tcp`: the tool-centre-point path on X/Y — `G0` to each stroke's start, the laser-on word,
 //!   `G1` marks (feed on the first), the laser-off word; a comment at every field change;

@@ -1,4 +1,4 @@
-//! The sampled stage + scanner trajectory (DESIGN.md, *Trajectory*): what a controller streams.
+//! The sampled stage + scanner trajectory (docs/DESIGN.md, *Trajectory*): what a controller streams.
 
 use crate::motion::Toolpath;
 use std::fmt::Write;

@@ -322,7 +322,7 @@ impl Toolpath {
     }
 
     /// The stage's route, speeds and the scanner's reach, sampled every `period_s` from 0 to the
-    /// end (DESIGN.md: the total variation of the stage speed over the samples).
+    /// end (docs/DESIGN.md: the total variation of the stage speed over the samples).
     pub fn motion_figures(&self, period_s: f64) -> MotionFigures {
         let n = (self.duration_s() / period_s).ceil() as usize;
         let mut f = MotionFigures::default();

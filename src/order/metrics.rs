@@ -1,4 +1,4 @@
-//! Plan metrics. Every report, benchmark and GUI table uses these definitions (DESIGN.md).
+//! Plan metrics. Every report, benchmark and GUI table uses these definitions (docs/DESIGN.md).
 //!
 //! * `idle_mm`: Σ over consecutive strokes of the straight distance from where one ends to where
 //!   the next starts (laser off). The approach from the start position and a final return are
