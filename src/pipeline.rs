@@ -169,7 +169,7 @@ pub fn load_production(
     opts.work_area_mm.get_or_insert(profile.stroke_mm);
     opts.field_mm.get_or_insert(profile.field_mm);
     // the G-code's resolution: a unit in its last decimal
-    opts.resolution_mm = 0.1_f64.powi(i32::try_from(profile.gcode.decimals).unwrap_or(i32::MAX));
+    opts.resolution_mm = profile.resolution_mm();
     let imported = import_file(path, &opts)?;
     let mut layers = Vec::new();
     sync_layers(&mut layers, &imported.geometries, &settings.default_pen());

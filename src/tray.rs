@@ -27,7 +27,7 @@ fn options(doc: &Document, prod: &Production) -> ImportOptions {
         work_area_mm: Some(doc.profile.stroke_mm),
         field_mm: Some(doc.profile.field_mm),
         place: doc.import.place,
-        resolution_mm: 0.1_f64.powi(i32::try_from(doc.profile.gcode.decimals).unwrap_or(i32::MAX)),
+        resolution_mm: doc.profile.resolution_mm(),
         ..ImportOptions::default()
     }
 }

@@ -92,21 +92,24 @@ fn a_dxf_arc_of_radius_1e50_is_refused() {
     );
 }
 
+/// Writes `svg` to a file in `dir` and imports it with `opts`: the error.
+fn import_error(dir: &Path, svg: &str, opts: &ImportOptions) -> String {
+    let f = dir.join("t.svg");
+    std::fs::write(&f, svg).unwrap();
+    import_file(&f, opts).unwrap_err().to_string()
+}
+
 /// A transform may take sane numbers beyond the bound: the walk refuses the point it maps there.
 #[test]
 fn a_point_beyond_the_bound_after_transforms_is_refused() {
     let dir = tempfile::tempdir().unwrap();
-    let f = dir.path().join("scaled.svg");
-    std::fs::write(
-        &f,
+    let e = import_error(
+        dir.path(),
         r#"<svg xmlns="http://www.w3.org/2000/svg" width="100mm" height="100mm" viewBox="0 0 100 100">
 <g transform="scale(1e8)"><path id="far" d="M 0 0 L 10 10 C 20 0 30 0 40 10"/></g>
 </svg>"#,
-    )
-    .unwrap();
-    let e = import_file(&f, &ImportOptions::default())
-        .unwrap_err()
-        .to_string();
+        &ImportOptions::default(),
+    );
     assert!(e.contains("#far") && e.contains("after transforms"), "{e}");
     assert!(!e.contains('\n'), "{e}");
 }
@@ -184,20 +187,18 @@ fn dxf_text_is_bounded_per_file() {
 #[test]
 fn flattening_is_budgeted_per_curve_before_it_runs() {
     let dir = tempfile::tempdir().unwrap();
-    let f = dir.path().join("fine.svg");
-    std::fs::write(
-        &f,
-        r#"<svg xmlns="http://www.w3.org/2000/svg" width="100mm" height="100mm" viewBox="0 0 1 1">
-<g transform="scale(1e3)"><path id="wide" d="M 0 0 C 9 0 0 9 9 9 C 0 9 9 0 0 0 C 9 0 0 9 9 9 C 0 9 9 0 0 0 C 9 0 0 9 9 9 C 0 9 9 0 0 0"/></g>
-</svg>"#,
-    )
-    .unwrap();
     let o = ImportOptions {
         chord_tol_mm: 1e-6,
         ..ImportOptions::default()
     };
     let t0 = Instant::now();
-    let e = import_file(&f, &o).unwrap_err().to_string();
+    let e = import_error(
+        dir.path(),
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="100mm" height="100mm" viewBox="0 0 1 1">
+<g transform="scale(1e3)"><path id="wide" d="M 0 0 C 9 0 0 9 9 9 C 0 9 9 0 0 0 C 9 0 0 9 9 9 C 0 9 9 0 0 0 C 9 0 0 9 9 9 C 0 9 9 0 0 0"/></g>
+</svg>"#,
+        &o,
+    );
     assert!(
         e.contains("#wide") && e.contains("raise the chord tolerance"),
         "{e}"

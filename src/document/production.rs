@@ -166,11 +166,6 @@ impl Tray {
         self.skip.iter().copied().collect()
     }
 
-    /// True when cell `cell` (row by row from 1) is left out.
-    pub fn skips(&self, cell: u32) -> bool {
-        self.skip.contains(&cell)
-    }
-
     /// The marked parts in numbering order.
     pub fn parts(&self) -> Vec<PartSlot> {
         let skip = self.skip_set();

@@ -347,6 +347,11 @@ fn upgrade(table: &mut toml::Table) {
 }
 
 impl MachineProfile {
+    /// The G-code's resolution, mm: a unit in its last decimal (offsets below it are not made).
+    pub fn resolution_mm(&self) -> f64 {
+        0.1_f64.powi(i32::try_from(self.gcode.decimals).unwrap_or(i32::MAX))
+    }
+
     /// Parses and validates a profile from TOML text; `file` names it in errors.
     pub fn from_toml(text: &str, file: &str) -> Result<Self, ProfileError> {
         let parse_error = |e: toml::de::Error| ProfileError::Parse {
