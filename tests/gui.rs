@@ -44,8 +44,32 @@ fn opened(path: &Path) -> Harness<'static, App> {
     let mut app = App::default();
     assert!(app.open(path), "{}", app.status());
     let mut h = harness(app);
-    h.run();
+    settle(&mut h);
     h
+}
+
+/// Runs the UI until it settles, however long background work (an import, a solve, a canvas
+/// raster) keeps it repainting: steps with small sleeps while a job runs, then `try_run`, and
+/// again after a sleep if a frame is still asked for. Panics only if the UI has not settled
+/// after 60 s. (`Harness::run` alone gives up after `MAX_STEPS` frames, which a loaded CI
+/// machine can exceed while a quick job finishes.)
+fn settle(h: &mut Harness<'_, App>) {
+    let t0 = Instant::now();
+    loop {
+        while h.state().is_busy() {
+            assert!(
+                t0.elapsed() < Duration::from_secs(60),
+                "a job still runs after 60 s"
+            );
+            std::thread::sleep(Duration::from_millis(20));
+            h.step();
+        }
+        match h.try_run() {
+            Ok(_) => return,
+            Err(e) => assert!(t0.elapsed() < Duration::from_secs(60), "{e}"),
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
 }
 
 /// Steps the UI (with small sleeps) until no solve runs; panics after `limit`.
@@ -56,13 +80,13 @@ fn wait_idle(h: &mut Harness<'_, App>, limit: Duration) {
         std::thread::sleep(Duration::from_millis(20));
         h.step();
     }
-    h.run_ok();
+    settle(h);
 }
 
 /// Shows a section of the left panel ("Layers (n)", "Solver settings", "Machine profile").
 fn section(h: &mut Harness<'_, App>, name: &str) {
     h.get_by_label(name).click();
-    h.run();
+    settle(h);
 }
 
 /// A file dropped on the window.
@@ -133,7 +157,7 @@ fn dragging_a_field_reallocates_and_undoes() {
         h.step();
     }
     h.drop_at(p0 + d);
-    h.run();
+    settle(&mut h);
     let moved = h
         .state()
         .session
@@ -158,7 +182,7 @@ fn dragging_a_field_reallocates_and_undoes() {
     assert!(h.state().solve_blocker().is_some());
     // the whole drag is one undo step
     h.key_press_modifiers(ctrl(), Key::Z);
-    h.run();
+    settle(&mut h);
     let back = h
         .state()
         .session
@@ -172,7 +196,7 @@ fn dragging_a_field_reallocates_and_undoes() {
     assert!(h.state().uncovered().is_empty());
     assert!(h.query_by_label("stale").is_none());
     h.key_press_modifiers(ctrl() | Modifiers::SHIFT, Key::Z);
-    h.run();
+    settle(&mut h);
     let again = h
         .state()
         .session
@@ -189,7 +213,7 @@ fn add_lock_delete_and_replace_fields() {
     let mut h = opened(&demo());
     let n = h.state().session.doc.fields.len();
     h.get_by_label("Add field").click();
-    h.run();
+    settle(&mut h);
     let canvas = h.get_by_label("Work area").rect();
     let at = canvas.center() + Vec2::new(10.0, 10.0);
     h.hover_at(at);
@@ -202,14 +226,14 @@ fn add_lock_delete_and_replace_fields() {
             modifiers: Modifiers::NONE,
         });
     }
-    h.run();
+    settle(&mut h);
     assert_eq!(h.state().session.doc.fields.len(), n + 1);
     let id = h
         .state()
         .selected_field()
         .expect("the new field is selected");
     h.get_by_label("Lock").click();
-    h.run();
+    settle(&mut h);
     assert!(h
         .state()
         .session
@@ -230,12 +254,12 @@ fn add_lock_delete_and_replace_fields() {
         .any(|f| f.id == id && f.locked));
     assert!(h.state().uncovered().is_empty());
     h.get_by_label("Delete field").click();
-    h.run();
+    settle(&mut h);
     assert!(!h.state().session.doc.fields.iter().any(|f| f.id == id));
     // undo the delete, the re-placement, the lock and the add
     for _ in 0..4 {
         h.get_by_label("Undo").click();
-        h.run();
+        settle(&mut h);
     }
     assert_eq!(h.state().session.doc.fields.len(), n);
 }
@@ -244,22 +268,22 @@ fn add_lock_delete_and_replace_fields() {
 /// background job may start).
 fn enter_nth(h: &mut Harness<'_, App>, label: &str, n: usize, text: &str) {
     nth_by_label(h, label, n).focus();
-    h.run();
+    settle(h);
     h.key_press_modifiers(ctrl(), Key::A);
     nth_by_label(h, label, n).type_text(text);
-    h.run();
+    settle(h);
     h.key_press(Key::Enter);
     h.step();
 }
 
 fn set_text(h: &mut Harness<'_, App>, label: &str, text: &str) {
     h.get_by_label(label).focus();
-    h.run();
+    settle(h);
     h.key_press_modifiers(ctrl(), Key::A);
     h.get_by_label(label).type_text(text);
-    h.run();
+    settle(h);
     h.key_press(Key::Enter);
-    h.run();
+    settle(h);
 }
 
 #[test]
@@ -296,13 +320,13 @@ fn invalid_profile_and_settings_input_is_rejected() {
         .iter()
         .all(|f| f.size == [60.0, 70.0]));
     h.get_by_label("Undo").click();
-    h.run();
+    settle(&mut h);
     assert_eq!(h.state().session.doc.profile.field_mm, [70.0, 70.0]);
     // a built-in profile is selectable
     h.get_by_label("Built-in").click();
-    h.run();
+    settle(&mut h);
     h.get_by_label("small-field").click();
-    h.run();
+    settle(&mut h);
     assert_ne!(h.state().session.doc.profile.field_mm, [70.0, 70.0]);
     assert!(h
         .state()
@@ -437,7 +461,7 @@ fn compare_view_shows_both_plans_and_the_difference() {
         wait_idle(&mut h, Duration::from_secs(120));
     }
     h.get_by_label("Compare").click();
-    h.run();
+    settle(&mut h);
     h.get_by_label("B vs A");
     // the compare table and the active plan's table in the side panel
     assert_eq!(h.get_all_by_label("Direction changes").count(), 2);
@@ -455,12 +479,12 @@ fn compare_view_shows_both_plans_and_the_difference() {
     // one playback clock for both canvases, as long as the longer job
     let longer_s = a.job_time_s.unwrap().max(b.job_time_s.unwrap());
     h.get_by_label("Time").set_value_accesskit(1.5);
-    h.run();
+    settle(&mut h);
     assert_eq!(h.state().compare_state().playback.t_s, 1.5);
     h.get_by_label(&time_text(1.5, longer_s));
     assert_eq!(h.state().playback().t_s, 0.0, "the workbench keeps its own");
     h.get_by_label("Overlay").click();
-    h.run();
+    settle(&mut h);
     h.get_by_label("Compare (overlay)");
 }
 
@@ -481,7 +505,7 @@ fn project_round_trip_and_drag_and_drop() {
 
     // a fresh window; the project is dropped on it
     let mut h2 = harness(App::default());
-    h2.run();
+    settle(&mut h2);
     h2.input_mut()
         .dropped_files
         .push(std::sync::Arc::new(Dropped(project.clone())));
@@ -520,7 +544,7 @@ fn oversize_geometries_are_shown_uncovered_until_split() {
     section(&mut h, "Solver settings");
     h.get_by_label("Split oversize geometries (on re-place)")
         .click();
-    h.run();
+    settle(&mut h);
     assert!(h.state().session.doc.settings.split_oversize);
     h.get_by_label("Re-place automatically").click();
     h.step();
@@ -533,7 +557,7 @@ fn oversize_geometries_are_shown_uncovered_until_split() {
     h.get_by_label(&format!("Warnings ({w})"));
     // undo restores the unsplit geometries
     h.get_by_label("Undo").click();
-    h.run();
+    settle(&mut h);
     assert_eq!(h.state().session.doc.geometries.len(), n);
     assert_eq!(h.state().uncovered().len(), n);
 }
@@ -544,7 +568,7 @@ fn switching_to_on_the_fly_places_fields_for_what_was_uncovered() {
     assert_eq!(h.state().uncovered().len(), n);
     section(&mut h, "Solver settings");
     h.get_by_label("Motion").click();
-    h.run();
+    settle(&mut h);
     // the switch starts a background placement: step, not run (the progress bar repaints)
     h.get_by_label("On the fly (stage moves while marking)")
         .click();
@@ -611,7 +635,7 @@ fn frame_time_while_solving() {
             },
             app,
         );
-    h.run();
+    settle(&mut h);
     let label = format!("Run {}", algo.to_uppercase());
     h.get_by_label(&label).click();
     h.step();
@@ -660,13 +684,13 @@ fn the_cost_switch_decides_what_the_solve_minimises() {
     assert_eq!(h.state().session.doc.settings.cost_model, CostModel::Time);
     section(&mut h, "Solver settings");
     h.get_by_label("Cost model").hover();
-    h.run();
+    settle(&mut h);
     h.get_by_label_contains("What the ordering minimises");
     let by_time = solve(&mut h, "Run HHA");
     h.get_by_label("Cost model").click();
-    h.run();
+    settle(&mut h);
     h.get_by_label("Idle travel distance").click();
-    h.run();
+    settle(&mut h);
     assert_eq!(
         h.state().session.doc.settings.cost_model,
         CostModel::Distance
@@ -686,7 +710,7 @@ fn the_cost_switch_decides_what_the_solve_minimises() {
     assert!(by_distance.metrics.idle_mm < by_time.metrics.idle_mm);
     // the change is one undoable settings step
     h.get_by_label("Undo").click();
-    h.run();
+    settle(&mut h);
     assert_eq!(h.state().session.doc.settings.cost_model, CostModel::Time);
 }
 
@@ -716,7 +740,7 @@ fn playback_scrubs_plays_pauses_and_rewinds() {
     let (s0, s1) = l.mark_s[n / 2];
     let t_s = (s0 + s1) / 2.0;
     h.get_by_label("Time").set_value_accesskit(t_s);
-    h.run();
+    settle(&mut h);
     assert!((h.state().playback().t_s - t_s).abs() < 1e-9);
     assert_eq!(
         h.state().playback().shown_t_s(),
@@ -758,16 +782,16 @@ fn playback_scrubs_plays_pauses_and_rewinds() {
     );
     // pause: time stands
     h.get_by_label("Pause").click();
-    h.run();
+    settle(&mut h);
     let t2_s = h.state().playback().t_s;
     h.step();
     h.step();
     assert_eq!(h.state().playback().t_s, t2_s);
     // 100×: plays to the end of the job and stops there
     h.get_by_label("Speed").click();
-    h.run();
+    settle(&mut h);
     h.get_by_label("100×").click();
-    h.run();
+    settle(&mut h);
     h.get_by_label("Play").click();
     for _ in 0..20 {
         h.step();
@@ -777,7 +801,7 @@ fn playback_scrubs_plays_pauses_and_rewinds() {
     h.get_by_label_contains(&format!("job done: {n} strokes marked"));
     // rewind: back to the planned path
     h.get_by_label("Rewind").click();
-    h.run();
+    settle(&mut h);
     assert_eq!(h.state().playback().t_s, 0.0);
     assert_eq!(h.state().playback().shown_t_s(), None);
     assert_eq!(h.state().playback().speed_x, Some(100.0), "the speed stays");
@@ -787,9 +811,9 @@ fn playback_scrubs_plays_pauses_and_rewinds() {
 fn set_motion(h: &mut Harness<'_, App>, option: &str) {
     section(h, "Solver settings");
     h.get_by_label("Motion").click();
-    h.run();
+    settle(h);
     h.get_by_label(option).click();
-    h.run();
+    settle(h);
 }
 
 #[test]
@@ -798,7 +822,7 @@ fn the_motion_switch_plans_on_the_fly() {
     assert_eq!(h.state().session.doc.settings.motion, MotionMode::Step);
     section(&mut h, "Solver settings");
     h.get_by_label("Motion").hover();
-    h.run();
+    settle(&mut h);
     h.get_by_label_contains("How the machine moves while it marks");
     let step = solve(&mut h, "Run HHA");
     assert!(!h.state().toolpath(0).unwrap().unwrap().on_the_fly());
@@ -825,16 +849,16 @@ fn the_motion_switch_plans_on_the_fly() {
     assert_eq!(Some(l.duration_s()), otf.metrics.job_time_s);
     // the compare view puts both side by side, each with the job time of its solve
     h.get_by_label("Compare").click();
-    h.run();
+    settle(&mut h);
     for t_s in [t_step, t_otf] {
         let text = format!("{t_s:.3}");
         assert!(h.query_all_by_label(&text).count() >= 1, "{text}");
     }
     // one undoable settings step back to step-and-scan
     h.get_by_label("Workbench").click();
-    h.run();
+    settle(&mut h);
     h.get_by_label("Undo").click();
-    h.run();
+    settle(&mut h);
     assert_eq!(h.state().session.doc.settings.motion, MotionMode::Step);
     // the on-the-fly plan stays on the fly
     assert!(h.state().toolpath(1).unwrap().unwrap().on_the_fly());
@@ -871,10 +895,10 @@ fn motion_plots_show_an_on_the_fly_plan() {
     );
     // hidden with their header, and gone for a step-and-scan toolpath
     h.get_by_label_contains("Motion plots").click();
-    h.run();
+    settle(&mut h);
     assert!(h.query_by_label_contains("Scanner offset").is_none());
     h.get_by_label_contains("Motion plots").click();
-    h.run();
+    settle(&mut h);
     h.get_by_label_contains("Scanner offset");
     // the setting does not change a plan's motion; a step-and-scan plan has no plots
     set_motion(&mut h, "Step-and-scan");
@@ -891,10 +915,10 @@ fn the_stage_route_switch_plans_seed001_routes() {
     let mut h = opened(&demo());
     set_motion(&mut h, "On the fly (stage moves while marking)");
     h.get_by_label("Stage route").click();
-    h.run();
+    settle(&mut h);
     h.get_by_label("Follow a simplified path of the marks")
         .click();
-    h.run();
+    settle(&mut h);
     assert_eq!(
         h.state().session.doc.settings.stage_route,
         StageRouteKind::Lsa
@@ -929,7 +953,7 @@ fn hatch_settings_in_the_layers_panel_rehatch_the_document() {
     h.get_by_label("Layers (2)");
     // choose a hatch for the second layer: a background job hatches and places fields again
     nth_by_label(&h, "Hatch", 1).click();
-    h.run();
+    settle(&mut h);
     h.get_by_label("zigzag").click();
     h.step();
     wait_idle(&mut h, Duration::from_secs(60));
@@ -964,11 +988,11 @@ fn hatch_settings_in_the_layers_panel_rehatch_the_document() {
     let fine_mm = len(&h.state().session.doc);
     // undo goes back to the coarser hatch, then to outlines only
     h.key_press_modifiers(ctrl(), Key::Z);
-    h.run();
+    settle(&mut h);
     assert!(len(&h.state().session.doc) < fine_mm);
     assert_eq!(h.state().session.doc.geometries.len(), hatched);
     h.key_press_modifiers(ctrl(), Key::Z);
-    h.run();
+    settle(&mut h);
     assert_eq!(h.state().session.doc.geometries.len(), outlines);
     assert!(h.state().session.doc.layers[1].pen.hatch.is_none());
 }
@@ -992,7 +1016,7 @@ fn a_disabled_layer_is_left_out_and_pens_change_at_once() {
     assert_eq!(h.state().session.doc.geometries.len(), all - fill);
     // a speed is a pen change only: no job, the geometries stay
     enter_nth(&mut h, "Mark speed (mm/s)", 0, "750");
-    h.run();
+    settle(&mut h);
     assert!(!h.state().is_busy());
     assert_eq!(
         h.state().session.doc.layers[0].pen.mark_speed_mm_s,
@@ -1009,11 +1033,11 @@ fn a_rejected_pen_value_shows_a_worded_error() {
     assert_eq!(passes, 2);
     // the second layer's passes
     enter_nth(&mut h, "Passes", 1, "0");
-    h.run();
+    settle(&mut h);
     h.get_by_label("Layer 'fill': Passes must be a whole number from 1 to 100, not 0");
     assert_eq!(h.state().session.doc.layers, before);
     enter_nth(&mut h, "Mark speed (mm/s)", 0, "fast");
-    h.run();
+    settle(&mut h);
     h.get_by_label("Layer 'outline': Mark speed (mm/s) must be a number, not 'fast'");
     assert_eq!(h.state().session.doc.layers, before);
 }
@@ -1023,9 +1047,9 @@ fn without_a_file_dialog_a_path_field_is_offered() {
     let mut app = App::default();
     app.set_native_dialogs(false);
     let mut h = harness(app);
-    h.run();
+    settle(&mut h);
     h.get_by_label("Open…").click();
-    h.run();
+    settle(&mut h);
     h.get_by_label_contains("No file dialog can be shown");
     enter_nth(&mut h, "File path", 0, &demo().display().to_string());
     wait_idle(&mut h, Duration::from_secs(60));
@@ -1033,7 +1057,7 @@ fn without_a_file_dialog_a_path_field_is_offered() {
     assert_eq!(h.state().session.doc.geometries.len(), 122);
     // Ctrl+S asks for the project's path the same way
     h.key_press_modifiers(ctrl(), Key::S);
-    h.run();
+    settle(&mut h);
     assert!(matches!(
         h.state().prompt(),
         Some(galvoplan::app::Prompt::Path {
@@ -1044,7 +1068,7 @@ fn without_a_file_dialog_a_path_field_is_offered() {
     let dir = tempfile::tempdir().unwrap();
     let project = dir.path().join("demo.galvoplan");
     enter_nth(&mut h, "File path", 0, &project.display().to_string());
-    h.run();
+    settle(&mut h);
     assert!(project.exists(), "{}", h.state().status());
     assert!(!h.state().has_unsaved_changes());
 }
@@ -1057,21 +1081,21 @@ fn quitting_after_an_edit_asks_about_unsaved_changes() {
     h.state_mut()
         .execute(Command::SetLocked { id, locked: true })
         .unwrap();
-    h.run();
+    settle(&mut h);
     assert!(h.state().has_unsaved_changes());
     h.key_press_modifiers(ctrl(), Key::Q);
-    h.run();
+    settle(&mut h);
     h.get_by_label("Unsaved changes");
     h.get_by_label("Cancel").click();
-    h.run();
+    settle(&mut h);
     assert!(h.state().prompt().is_none());
     assert!(h.query_by_label("Unsaved changes").is_none());
     // opening another file asks too
     h.key_press_modifiers(ctrl(), Key::O);
-    h.run();
+    settle(&mut h);
     h.get_by_label("Unsaved changes");
     h.get_by_label("Discard changes").click();
-    h.run();
+    settle(&mut h);
     assert!(!matches!(
         h.state().prompt(),
         Some(galvoplan::app::Prompt::Unsaved(_))
@@ -1092,9 +1116,9 @@ fn exporting_a_stale_plan_asks_first() {
             center: galvoplan::geom::Pt::new(c.x + 1.0, c.y),
         })
         .unwrap();
-    h.run();
+    settle(&mut h);
     h.key_press_modifiers(ctrl(), Key::E);
-    h.run();
+    settle(&mut h);
     h.get_by_label("The plan shown is stale");
     h.get_by_label("• the scan fields changed");
 }
@@ -1121,7 +1145,7 @@ fn fields_are_numbered_from_one_in_placement_then_visiting_order() {
 #[test]
 fn a_dropped_dxf_opens_with_its_layers() {
     let mut h = harness(App::default());
-    h.run();
+    settle(&mut h);
     let path = common::root().join("tests/data/dxf/entities-inch.dxf");
     h.input_mut()
         .dropped_files
@@ -1140,7 +1164,7 @@ fn two_layers_solved() -> Harness<'static, App> {
     app.set_native_dialogs(false);
     assert!(app.open(&two_layers()), "{}", app.status());
     let mut h = harness(app);
-    h.run();
+    settle(&mut h);
     solve(&mut h, "Run HHA");
     h
 }
@@ -1150,7 +1174,7 @@ fn a_pen_edit_makes_the_plan_stale_and_re_solve_and_export_writes_the_new_feed()
     let mut h = two_layers_solved();
     assert!(h.state().plan_staleness(0).is_empty());
     enter_nth(&mut h, "Mark speed (mm/s)", 1, "300");
-    h.run();
+    settle(&mut h);
     // stale, with the reason in words, in the plan list and under the metrics
     assert_eq!(
         h.state().plan_staleness(0),
@@ -1160,11 +1184,11 @@ fn a_pen_edit_makes_the_plan_stale_and_re_solve_and_export_writes_the_new_feed()
     h.get_by_label_contains("HHA · job time · step-and-scan · seed 1 is stale: fill: mark speed unset → 300 mm/s since it was made");
     // export asks; re-solving is the default answer and writes the new feed
     h.key_press_modifiers(ctrl(), Key::E);
-    h.run();
+    settle(&mut h);
     h.get_by_label("The plan shown is stale");
     h.get_by_label("• fill: mark speed unset → 300 mm/s");
     h.get_by_label("Re-solve and export").click();
-    h.run();
+    settle(&mut h);
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("job.gcode");
     enter_nth(&mut h, "File path", 0, &out.display().to_string());
@@ -1184,7 +1208,7 @@ fn a_profile_edit_makes_the_headline_stale() {
     let mut h = two_layers_solved();
     section(&mut h, "Machine profile");
     set_text(&mut h, "Base X max velocity (mm/s)", "100");
-    h.run();
+    settle(&mut h);
     assert_eq!(
         h.state().session.doc.profile.axis_x.max_velocity_mm_s,
         100.0
@@ -1211,14 +1235,14 @@ fn exports_never_overwrite_the_artwork() {
         galvoplan::app::files::ExportKind::Preview,
         &egui::Context::default(),
     );
-    h.run();
+    settle(&mut h);
     let Some(galvoplan::app::Prompt::Path { text, .. }) = h.state().prompt().cloned() else {
         panic!("no path field: {:?}", h.state().prompt());
     };
     assert!(text.ends_with("two-layers.preview.svg"), "{text}");
     // typing the artwork's own path is refused and the file is unchanged
     h.get_by_label("Cancel").click();
-    h.run();
+    settle(&mut h);
     let e = h
         .state_mut()
         .export(galvoplan::app::files::ExportKind::Preview, &source)
@@ -1229,7 +1253,7 @@ fn exports_never_overwrite_the_artwork() {
         &source,
         &egui::Context::default(),
     );
-    h.run();
+    settle(&mut h);
     assert!(
         h.state().status().contains("refusing"),
         "{}",
@@ -1242,7 +1266,7 @@ fn exports_never_overwrite_the_artwork() {
 fn a_hatch_edit_keeps_the_plans_and_marks_them_stale() {
     let mut h = two_layers_solved();
     nth_by_label(&h, "Hatch", 1).click();
-    h.run();
+    settle(&mut h);
     h.get_by_label("zigzag").click();
     h.step();
     wait_idle(&mut h, Duration::from_secs(60));
@@ -1291,7 +1315,7 @@ fn the_status_of_a_delete_names_the_field_as_the_canvas_does() {
     h.state_mut()
         .execute(Command::DeleteField { id: f.id })
         .unwrap();
-    h.run();
+    settle(&mut h);
     assert!(
         h.state()
             .status()
@@ -1307,7 +1331,7 @@ fn stage_routes_and_settings_are_offered_in_an_operators_words() {
     let mut h = opened(&demo());
     set_motion(&mut h, "On the fly (stage moves while marking)");
     h.get_by_label("Stage route").click();
-    h.run();
+    settle(&mut h);
     for option in [
         "Tracked route (default)",
         "Follow a simplified path of the marks",
@@ -1320,25 +1344,25 @@ fn stage_routes_and_settings_are_offered_in_an_operators_words() {
     assert!(h.query_by_label_contains("LSA)").is_none());
     h.get_by_label("Follow a simplified path of the marks")
         .hover();
-    h.run();
+    settle(&mut h);
     h.get_by_label_contains("--stage-route lsa");
     h.get_by_label("Genetic algorithm route (slow)").click();
-    h.run();
+    settle(&mut h);
     assert_eq!(
         h.state().session.doc.settings.stage_route,
         galvoplan::document::StageRouteKind::CetspGa
     );
     // the other choices: words, with the command line in the hover
     h.get_by_label("Field placement").click();
-    h.run();
+    settle(&mut h);
     h.get_by_label("Fewest fields (automatic)");
     h.get_by_label("Quick greedy cover").hover();
-    h.run();
+    settle(&mut h);
     h.get_by_label_contains("--fields greedy");
     h.key_press(Key::Escape);
-    h.run();
+    settle(&mut h);
     h.get_by_label("Start points").click();
-    h.run();
+    settle(&mut h);
     h.get_by_label("Best start points (exact)");
     h.get_by_label("Quick start points (estimate)");
     assert!(h.query_by_label_contains("(seed 000)").is_none());
@@ -1363,11 +1387,11 @@ fn layers_named_after_their_colour_show_a_colour_word() {
     // a rejected value names the layer by its label ...
     let k = names.iter().position(|n| n == "#1f2937").unwrap();
     enter_nth(&mut h, "Mark speed (mm/s)", k, "fast");
-    h.run();
+    settle(&mut h);
     h.get_by_label("Layer 'dark grey (#1f2937)': Mark speed (mm/s) must be a number, not 'fast'");
     // ... and a valid edit leaves the document's name (what pens files match) as it was
     enter_nth(&mut h, "Mark speed (mm/s)", k, "400");
-    h.run();
+    settle(&mut h);
     let layer = &h.state().session.doc.layers[k];
     assert_eq!(layer.name, "#1f2937");
     assert_eq!(layer.pen.mark_speed_mm_s, Some(400.0));
@@ -1432,9 +1456,9 @@ fn the_built_in_picker_names_the_profile_shown() {
     set_text(&mut h, "Name", "bench machine");
     assert_eq!(picked(&h).as_deref(), Some("custom (edited or loaded)"));
     h.get_by_label("Built-in").click();
-    h.run();
+    settle(&mut h);
     h.get_by_label("small-field").click();
-    h.run();
+    settle(&mut h);
     assert_eq!(picked(&h).as_deref(), Some("small-field"));
 }
 
@@ -1452,7 +1476,7 @@ fn an_on_the_fly_region_larger_than_the_scan_field_is_called_a_region() {
     let mut h = opened(&circle);
     section(&mut h, "Solver settings");
     h.get_by_label("Motion").click();
-    h.run();
+    settle(&mut h);
     h.get_by_label("On the fly (stage moves while marking)")
         .click();
     h.step();
@@ -1485,13 +1509,13 @@ fn an_on_the_fly_region_larger_than_the_scan_field_is_called_a_region() {
             modifiers: Modifiers::NONE,
         });
     }
-    h.run();
+    settle(&mut h);
     assert_eq!(h.state().selected_field(), Some(region.id));
     h.get_by_label(&format!("Region {n}"));
     h.get_by_label_contains("Larger than the 70 × 70 mm scan field");
     // the undo menu and status say "region" too
     h.key_press(Key::Delete);
-    h.run();
+    settle(&mut h);
     assert!(
         h.state()
             .status()
@@ -1508,7 +1532,7 @@ fn uncovered_geometries_are_told_apart_from_every_layer_colour() {
     // uncover some geometries: delete a field
     let id = h.state().session.doc.fields[0].id;
     h.state_mut().execute(Command::DeleteField { id }).unwrap();
-    h.run();
+    settle(&mut h);
     assert!(!h.state().uncovered().is_empty());
     // the side panel names the highlight (as the canvas's caption does), not a layer's colour
     h.get_by_label_contains("(magenta halo on the canvas)");
@@ -1539,7 +1563,7 @@ fn small(path: &Path) -> Harness<'static, App> {
         .with_max_steps(MAX_STEPS)
         .with_size(Vec2::new(900.0, 600.0))
         .build_ui_state(|ui, app: &mut App| app.ui(ui), app);
-    h.run();
+    settle(&mut h);
     h
 }
 
@@ -1572,7 +1596,7 @@ fn nothing_is_cut_off_on_the_smallest_window() {
     }
     solve(&mut h, "Run as-is");
     h.get_by_label("Compare").click();
-    h.run();
+    settle(&mut h);
     for label in ["Fit view", "Overlay", "Plan B", "B vs A"] {
         for node in h.get_all_by_label(label) {
             let r = node.rect();
@@ -1616,10 +1640,10 @@ fn hidden_layers_are_listed_greyed_and_included_with_one_click_then_undone() {
     h.get_by_label_contains("OFF: off, 1 item, not marked");
     // undo brings the included layer back, a second undo the first import
     h.get_by_label("Undo").click();
-    h.run();
+    settle(&mut h);
     assert_eq!(h.state().session.doc.geometries.len(), 2);
     h.get_by_label("Undo").click();
-    h.run();
+    settle(&mut h);
     assert_eq!(h.state().session.doc.geometries.len(), 1);
     h.get_by_label_contains("OFF: off, 1 item, not marked");
 }
@@ -1640,7 +1664,7 @@ fn placement_centres_the_artwork_on_the_base_stroke() {
     section(&mut h, &layers);
     // as in the file: out of reach, and the error names the control that helps
     h.get_by_label("Placement").click();
-    h.run();
+    settle(&mut h);
     h.get_by_label("as in the file").click();
     h.step();
     wait_idle(&mut h, Duration::from_secs(60));
@@ -1651,7 +1675,7 @@ fn placement_centres_the_artwork_on_the_base_stroke() {
         "{status}"
     );
     h.get_by_label("Placement").click();
-    h.run();
+    settle(&mut h);
     h.get_by_label("centred").click();
     h.step();
     wait_idle(&mut h, Duration::from_secs(60));
@@ -1686,7 +1710,7 @@ fn convergence_plot_speaks_the_tables_figures_and_names_say_what_a_plan_is() {
     );
     assert!(ta <= th + 1e-12, "HGA {ta} s vs HHA {th} s");
     h.get_by_label("Compare").click();
-    h.run();
+    settle(&mut h);
     // the table's figures (3 decimals) …
     h.get_all_by_label(&format!("{th:.3}")).next().unwrap();
     h.get_all_by_label(&format!("{ta:.3}")).next().unwrap();
@@ -1709,17 +1733,19 @@ fn a_hostile_file_leaves_the_open_document_and_its_edits() {
     h.state_mut()
         .execute(Command::SetLocked { id, locked: true })
         .unwrap();
-    h.run();
+    settle(&mut h);
     let before = h.state().session.doc.clone();
     let hostile = common::root().join("tests/data/hostile/demo-huge-coordinate.svg");
     h.input_mut()
         .dropped_files
         .push(std::sync::Arc::new(Dropped(hostile)));
     h.step();
-    h.run();
+    settle(&mut h);
     // the edits are unsaved: the operator is asked first, and goes on without saving
     h.get_by_label("Discard changes").click();
-    h.run();
+    // the open runs in the background: step until it is done, never run() (which gives up
+    // after 16 repaints while a job is polled)
+    h.step();
     wait_idle(&mut h, Duration::from_secs(30));
     let status = h.state().status().to_string();
     assert!(
@@ -1763,7 +1789,7 @@ fn hover_part(h: &mut Harness<'_, App>, n: u32) {
     let at = h.state().part_screen_pos(n).unwrap();
     h.hover_at(at);
     h.step();
-    h.run();
+    settle(h);
 }
 
 #[test]
@@ -1796,7 +1822,7 @@ fn cell_menu(h: &mut Harness<'_, App>, cell: u32, item: &str) {
             modifiers: Modifiers::NONE,
         });
     }
-    h.run();
+    settle(h);
     h.get_by_label(item).click();
     h.step();
     wait_idle(h, Duration::from_secs(60));
@@ -1827,9 +1853,9 @@ fn export_and_advance_logs_the_parts_moves_the_serial_on_and_cannot_be_undone() 
     let log = dir.path().join("parts.csv");
     let program = dir.path().join("tray.gcode");
     enter_nth(&mut h, "Parts log", 0, &log.display().to_string());
-    h.run();
+    settle(&mut h);
     h.get_by_label("Export and advance").click();
-    h.run();
+    settle(&mut h);
     // no file dialog in the tests: the path is typed
     // (the next tray's texts are made in the background: no settling before it ends)
     enter_nth(&mut h, "File path", 0, &program.display().to_string());
@@ -1848,9 +1874,9 @@ fn export_and_advance_logs_the_parts_moves_the_serial_on_and_cannot_be_undone() 
     h.get_by_label("Next tray starts at 1013");
     // undo takes back the remade texts, then refuses to hand out the logged serials again
     h.key_press_modifiers(ctrl(), Key::Z);
-    h.run();
+    settle(&mut h);
     h.key_press_modifiers(ctrl(), Key::Z);
-    h.run();
+    settle(&mut h);
     let status = h.state().status().to_string();
     assert!(
         status.contains("cannot undo") && status.contains("1001 … 1006 are in the parts log"),
@@ -1869,7 +1895,7 @@ fn export_and_advance_logs_the_parts_moves_the_serial_on_and_cannot_be_undone() 
     );
     // nor can the tray be set back onto them
     enter_nth(&mut h, "First serial", 0, "1003");
-    h.run();
+    settle(&mut h);
     assert!(
         h.state().status().contains("never handed out again"),
         "{}",
@@ -1881,7 +1907,7 @@ fn export_and_advance_logs_the_parts_moves_the_serial_on_and_cannot_be_undone() 
 fn a_datamatrix_on_a_three_by_two_tray_is_drawn_and_tells_part_4s_content() {
     let mut h = tray("3", "2", "1001");
     h.get_by_label("Add a code").click();
-    h.run();
+    settle(&mut h);
     for (label, text) in [
         ("Code content", "GP{serial:05}"),
         ("Code X (mm)", "3"),
@@ -1889,7 +1915,7 @@ fn a_datamatrix_on_a_three_by_two_tray_is_drawn_and_tells_part_4s_content() {
         ("Code size (mm)", "6"),
     ] {
         enter_nth(&mut h, label, 0, text);
-        h.run();
+        settle(&mut h);
     }
     h.get_by_label("Apply codes").click();
     h.step();
@@ -1908,7 +1934,7 @@ fn a_datamatrix_on_a_three_by_two_tray_is_drawn_and_tells_part_4s_content() {
     h.get_by_label_contains("code “GP01004”");
     // a code that cannot be made says why, in the section
     enter_nth(&mut h, "Code size (mm)", 0, "0.5");
-    h.run();
+    settle(&mut h);
     h.get_by_label("Apply codes").click();
     h.step();
     wait_idle(&mut h, Duration::from_secs(60));
