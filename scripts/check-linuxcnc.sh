@@ -106,6 +106,8 @@ job oversize assets/examples/oversize.svg on-the-fly
 job lissajous tests/data/linuxcnc/lissajous.svg on-the-fly
 # a production job: a 2 × 2 tray of parts, each with its serial number as text
 job tray-2x2 assets/examples/part.svg step --array 2x2@40,32 --serial 1001 --date 2026-12-07
+# a dotted DataMatrix on each part (one spot per module, fired for the dwell) on the fly
+job tray-dots assets/examples/part.svg on-the-fly --array 2x2@40,32 --serial 1001 --code "datamatrix:GP{serial:05}@3,3:6:dots"
 if [ -n "$SHARED" ]; then
   for f in "$SHARED"/instances/*.svg; do
     n=$(basename "$f" .svg)

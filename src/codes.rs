@@ -12,7 +12,10 @@
 //!   inside the other, so that a spot of diameter `d` marks exactly the run's rectangle (its
 //!   edges) and no more: a marked module has the module's size;
 //! * a module smaller than `max(2·s, d)` cannot be filled that way and is refused with the
-//!   smallest symbol width that works.
+//!   smallest symbol width that works;
+//! * `dots`: one spot (a mark of one point, fired for the pen's dot dwell) at the centre of each
+//!   marked module instead, in the same order; a module smaller than the spot is refused (the
+//!   dots would run together).
 
 use crate::document::{CodeKind, CodeSpec, Ecc, Geometry, Run, RunOrder, Source, CODE_LAYER};
 use crate::geom::Pt;
@@ -187,8 +190,16 @@ pub fn marks(
     run_id: u32,
 ) -> Result<Vec<Geometry>, String> {
     let (mx, my) = module_mm(spec, sym);
+    if spec.options.dots && mx < fill.spot_mm - 1e-9 {
+        return Err(format!(
+            "modules of {mx:.3} mm are smaller than the spot ({} mm), so the dots would run \
+             together: make it at least {:.2} mm wide",
+            fill.spot_mm,
+            fill.spot_mm * sym.cols as f64
+        ));
+    }
     let least = (2.0 * fill.spacing_mm).max(fill.spot_mm);
-    if mx < least - 1e-9 {
+    if !spec.options.dots && mx < least - 1e-9 {
         return Err(format!(
             "modules of {mx:.3} mm are smaller than twice the fill spacing ({} mm) or the spot \
              ({} mm): make it at least {:.2} mm wide",
@@ -233,16 +244,40 @@ pub fn marks(
         }
         rects.extend(row);
     }
-    let mut out = Vec::with_capacity(rects.len());
-    for (k, (x0, y0, x1, y1, leftwards)) in rects.into_iter().enumerate() {
-        let mut points = serpentine(x0, y0, x1, y1, fill);
-        if leftwards {
-            points.reverse();
-        }
-        // a swept run marks every other member reversed: stored so that it comes out as meant
-        if k % 2 == 1 {
-            points.reverse();
-        }
+    let pieces: Vec<Vec<Pt>> = if spec.options.dots {
+        // one spot at the centre of each marked module, in the runs' order
+        rects
+            .into_iter()
+            .flat_map(|(x0, y0, x1, y1, leftwards)| {
+                let n = ((x1 - x0) / mx).round().max(1.0) as usize;
+                let y = (y0 + y1) / 2.0;
+                let centre = move |j: usize| {
+                    let j = if leftwards { n - 1 - j } else { j };
+                    vec![Pt::new(x0 + (j as f64 + 0.5) * mx, y)]
+                };
+                (0..n).map(centre)
+            })
+            .collect()
+    } else {
+        rects
+            .into_iter()
+            .enumerate()
+            .map(|(k, (x0, y0, x1, y1, leftwards))| {
+                let mut points = serpentine(x0, y0, x1, y1, fill);
+                if leftwards {
+                    points.reverse();
+                }
+                // a swept run marks every other member reversed: stored so that it comes out
+                // as meant
+                if k % 2 == 1 {
+                    points.reverse();
+                }
+                points
+            })
+            .collect()
+    };
+    let mut out = Vec::with_capacity(pieces.len());
+    for (k, points) in pieces.into_iter().enumerate() {
         let source = Source {
             element: element.to_string(),
             subpath: k,

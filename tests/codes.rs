@@ -215,3 +215,114 @@ fn every_code_of_a_tray_reads_its_part_content_from_the_toolpath() {
     assert_eq!(read, 96);
     assert_eq!(doc.parts[4].codes, ["GP01005", "L26-005/1005"]);
 }
+
+/// `dots`: one spot (a mark of one point) at the centre of every marked module, and nothing
+/// else: the dark modules, or (inverted) the light ones and the quiet zone.
+#[test]
+fn dots_put_one_spot_at_each_marked_module_centre() {
+    let fill = Fill {
+        spacing_mm: SPOT_MM,
+        spot_mm: SPOT_MM,
+    };
+    for (kind, content, inverted) in [
+        (CodeKind::DataMatrix, "GP01001", false),
+        (CodeKind::Qr, "L26-001/1001", false),
+        (CodeKind::DataMatrix, "GP01001", true),
+    ] {
+        let mut spec = CodeSpec::parse(&format!("{kind}:{content}@0,0:1")).unwrap();
+        spec.options.dots = true;
+        spec.options.inverted = inverted;
+        let sym = symbol(&spec, content).unwrap();
+        let module = 0.25;
+        spec.size_mm = module * sym.cols as f64;
+        let at = Pt::new(5.0, 7.0);
+        let g = marks(&spec, &sym, at, fill, 1, "code", 1).unwrap();
+        // the centres the spots must stand on
+        let q = if inverted { sym.quiet as i64 } else { 0 };
+        let mut want = Vec::new();
+        for r in -q..sym.rows as i64 + q {
+            for c in -q..sym.cols as i64 + q {
+                let inside = (0..sym.rows as i64).contains(&r) && (0..sym.cols as i64).contains(&c);
+                let dark = inside && sym.is_dark(r as usize, c as usize);
+                if dark != inverted {
+                    want.push((
+                        (c as f64 + 0.5) * module + at.x,
+                        (r as f64 + 0.5) * module + at.y,
+                    ));
+                }
+            }
+        }
+        assert_eq!(g.len(), want.len(), "{kind} inverted {inverted}");
+        let key = |x: f64, y: f64| ((x * 1e6).round() as i64, (y * 1e6).round() as i64);
+        let mut got: Vec<_> = g
+            .iter()
+            .map(|g| {
+                assert_eq!(g.points.len(), 1, "a dot is one point");
+                key(g.points[0].x, g.points[0].y)
+            })
+            .collect();
+        let mut want: Vec<_> = want.into_iter().map(|(x, y)| key(x, y)).collect();
+        got.sort_unstable();
+        want.sort_unstable();
+        assert_eq!(got, want, "{kind} inverted {inverted}");
+    }
+    // dots smaller than the spot would run together: refused with the least width
+    let mut spec = CodeSpec::parse("datamatrix:GP01001@0,0:0.5:dots").unwrap();
+    let sym = symbol(&spec, "GP01001").unwrap();
+    let big_spot = Fill {
+        spacing_mm: SPOT_MM,
+        spot_mm: 0.1,
+    };
+    let e = marks(&spec, &sym, Pt::new(0.0, 0.0), big_spot, 1, "code", 1).unwrap_err();
+    assert!(e.contains("at least 1.20 mm wide"), "{e}");
+    spec.size_mm = 1.2;
+    assert!(marks(&spec, &sym, Pt::new(0.0, 0.0), big_spot, 1, "code", 1).is_ok());
+}
+
+/// A dotted code through the whole job: each dot is lowered as a mark of its pen's dwell, and
+/// written as a dwell with the laser on.
+#[test]
+fn dots_are_marked_for_their_pens_dwell_through_the_job() {
+    let root = common::root().join("assets/examples");
+    let loaded = load_production(
+        &root.join("part.svg"),
+        MachineProfile::default(),
+        SolverSettings::default(),
+        &ImportOptions::default(),
+        &TraySettings {
+            tray: Some(Tray::parse("2x1@40,32").unwrap()),
+            serial: Some(galvoplan::document::Serial::parse("1001").unwrap()),
+            codes: Some(vec![
+                CodeSpec::parse("datamatrix:GP{serial:05}@3,3:6:dots").unwrap()
+            ]),
+            ..TraySettings::default()
+        },
+    )
+    .unwrap();
+    let mut doc = loaded.doc;
+    let codes = doc
+        .layers
+        .iter_mut()
+        .find(|l| l.name == galvoplan::document::CODE_LAYER)
+        .expect("the codes' layer");
+    codes.pen.dot_dwell_s = Some(2e-3);
+    let dots = doc.artwork.iter().filter(|g| g.points.len() == 1).count();
+    assert!(dots > 100, "{dots} dots");
+    let (plan, toolpath) = plan_document_lowered(&mut doc, &JobCtx::default()).unwrap();
+    let dot_marks: Vec<f64> = toolpath
+        .segments
+        .iter()
+        .filter_map(|s| match s.scan {
+            galvoplan::motion::ScanMotion::Mark { stroke, .. }
+                if toolpath.stroke_points(stroke).len() == 1 =>
+            {
+                Some(s.duration_s)
+            }
+            _ => None,
+        })
+        .collect();
+    assert_eq!(dot_marks.len(), dots);
+    assert!(dot_marks.iter().all(|d| (d - 2e-3).abs() < 1e-12));
+    let gcode = galvoplan::export::write_gcode(&toolpath, &plan, 0.0, "dots").unwrap();
+    assert_eq!(gcode.matches("\nG4 P0.002\n").count(), dots);
+}

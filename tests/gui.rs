@@ -1944,4 +1944,62 @@ fn a_datamatrix_on_a_three_by_two_tray_is_drawn_and_tells_part_4s_content() {
         h.state().status()
     );
     assert_eq!(h.state().session.doc.parts[3].codes, ["GP01004"]);
+    // dragging the code on part 4 moves it on every part, in one undoable step
+    enter_nth(&mut h, "Code size (mm)", 0, "6");
+    settle(&mut h);
+    let before = code_box_of_part(&h, 1);
+    let from = h.state().code_centre_mm(0, 4).unwrap();
+    let to = from.plus(galvoplan::geom::Pt::new(2.0, 1.0));
+    let (p0, p1) = (
+        h.state().mm_screen_pos(from).unwrap(),
+        h.state().mm_screen_pos(to).unwrap(),
+    );
+    h.hover_at(p0);
+    h.step();
+    h.drag_at(p0);
+    h.step();
+    for i in 1..=4 {
+        h.hover_at(p0 + (p1 - p0) * (i as f32 / 4.0));
+        h.step();
+    }
+    h.drop_at(p1);
+    h.step();
+    wait_idle(&mut h, Duration::from_secs(60));
+    let status = h.state().status().to_string();
+    assert!(status.contains("move code 1 to ("), "{status}");
+    let spec = &h.state().session.doc.production.as_ref().unwrap().codes[0];
+    // the drag's mm on screen, to the canvas's pixel
+    let px_mm = 1.0 / f64::from(h.state().workbench_px_per_mm());
+    assert!(
+        (spec.at_mm[0] - 5.0).abs() <= px_mm + 0.01,
+        "{:?}",
+        spec.at_mm
+    );
+    assert!(
+        (spec.at_mm[1] - 4.0).abs() <= px_mm + 0.01,
+        "{:?}",
+        spec.at_mm
+    );
+    let after = code_box_of_part(&h, 1);
+    assert!((after.0 - before.0 - (spec.at_mm[0] - 3.0)).abs() < 1e-6);
+    assert!((after.1 - before.1 - (spec.at_mm[1] - 3.0)).abs() < 1e-6);
+    assert_eq!(h.state().session.doc.parts[3].codes, ["GP01004"]);
+    h.key_press_modifiers(ctrl(), Key::Z);
+    settle(&mut h);
+    let spec = &h.state().session.doc.production.as_ref().unwrap().codes[0];
+    assert_eq!(spec.at_mm, [3.0, 3.0]);
+}
+
+/// The top-left of part `part`'s code marks, mm.
+fn code_box_of_part(h: &Harness<'_, App>, part: u32) -> (f64, f64) {
+    h.state()
+        .session
+        .doc
+        .artwork
+        .iter()
+        .filter(|g| g.layer == "codes" && g.source.part == part)
+        .flat_map(|g| g.points.iter())
+        .fold((f64::INFINITY, f64::INFINITY), |(x, y), p| {
+            (x.min(p.x), y.min(p.y))
+        })
 }

@@ -90,6 +90,12 @@ enum Drag {
         id: usize,
         grab: Pt,
     },
+    /// Moving code `code` of every part: from the pointer at `from` to the pointer at `to`.
+    Code {
+        code: usize,
+        from: Pt,
+        to: Pt,
+    },
     /// Moving a seam of `axis` (0: vertical) from `from_mm`; `at_mm` follows the pointer.
     Seam {
         axis: usize,
@@ -137,6 +143,13 @@ pub enum CanvasAction {
         cell: u32,
         /// Leave it out.
         skip: bool,
+    },
+    /// Moved a code of the part, on every part (at the end of its drag).
+    MoveCode {
+        /// The code's index in the production's codes.
+        code: usize,
+        /// How far, mm.
+        by: Pt,
     },
     /// Moved a seam (at the end of its drag).
     MoveSeam {
@@ -201,6 +214,8 @@ pub struct Canvas<'a> {
     pub playback_t_s: Option<f64>,
     /// The tray's cells: numbered, skipped ones greyed, each part's serial on hover.
     pub parts: &'a [super::tray_panel::PartBox],
+    /// The parts' codes (dragged on an editable canvas).
+    pub codes: &'a [super::tray_panel::CodeBox],
     /// Changes whenever the artwork, its colours or coverage change: the canvas keeps a raster
     /// of what it draws while this (and what it compares by value) stays the same.
     pub revision: u64,
@@ -277,6 +292,7 @@ impl Canvas<'_> {
         let painter = ui.painter_at(rect);
         paint::paint(&painter, self, &state.view, rect, response.id);
         self.paint_parts(&painter, &state.view, rect);
+        self.paint_codes(&painter, &state.view, rect, state.drag);
         self.part_menu(&response, rect, state, &mut actions);
         if let Drag::Seam { axis, at_mm, .. } = state.drag {
             // the seam being moved, across the work area
@@ -326,7 +342,17 @@ impl Canvas<'_> {
             });
             let primary =
                 self.editable && response.drag_started_by(PointerButton::Primary) && !self.add_tool;
-            if let (true, Some((axis, from_mm))) = (primary, seam) {
+            let code = origin
+                .filter(|_| primary)
+                .and_then(|o| self.code_at(view.to_mm(rect, o), f64::from(4.0 / view.scale)));
+            if let (Some(c), Some(o)) = (code, origin) {
+                let at = view.to_mm(rect, o);
+                state.drag = Drag::Code {
+                    code: c.code,
+                    from: at,
+                    to: at,
+                };
+            } else if let (true, Some((axis, from_mm))) = (primary, seam) {
                 state.drag = Drag::Seam {
                     axis,
                     from_mm,
@@ -347,6 +373,12 @@ impl Canvas<'_> {
         }
         if response.dragged() {
             match state.drag {
+                Drag::Code { code, from, .. } => {
+                    if let Some(p) = response.interact_pointer_pos() {
+                        let to = view.to_mm(rect, p);
+                        state.drag = Drag::Code { code, from, to };
+                    }
+                }
                 Drag::Field { id, grab } => {
                     if let Some(p) = response.interact_pointer_pos() {
                         let center = view.to_mm(rect, p).plus(grab);
@@ -377,6 +409,12 @@ impl Canvas<'_> {
         if response.drag_stopped() {
             match state.drag {
                 Drag::Field { .. } => actions.push(CanvasAction::EndDrag),
+                Drag::Code { code, from, to } if from.dist(to) > 1e-6 => {
+                    actions.push(CanvasAction::MoveCode {
+                        code,
+                        by: to.minus(from),
+                    })
+                }
                 Drag::Seam {
                     axis,
                     from_mm,
@@ -395,7 +433,11 @@ impl Canvas<'_> {
                 self.seam_at(view.to_mm(rect, p), f64::from(SEAM_GRAB_PX / view.scale))
                     .is_some()
             });
-            if near_seam {
+            let near_code = response.hover_pos().is_some_and(|p| {
+                self.code_at(view.to_mm(rect, p), f64::from(4.0 / view.scale))
+                    .is_some()
+            });
+            if near_seam || near_code {
                 ui.ctx().set_cursor_icon(egui::CursorIcon::Grab);
             }
         }
@@ -482,6 +524,11 @@ impl Canvas<'_> {
         index.nearest(self.geometries, p, tol_mm)
     }
 
+    /// The code whose marks' box holds `p` (grown by `tol_mm`), mm.
+    fn code_at(&self, p: Pt, tol_mm: f64) -> Option<&super::tray_panel::CodeBox> {
+        self.codes.iter().find(|c| c.bbox.contains_pt(p, tol_mm))
+    }
+
     /// The tray cell at `p`, mm.
     fn part_at(&self, p: Pt) -> Option<&super::tray_panel::PartBox> {
         self.parts.iter().find(|b| b.bbox.contains_pt(p, 0.0))
@@ -516,6 +563,46 @@ impl Canvas<'_> {
                     );
                 }
                 Some(_) => {}
+            }
+        }
+    }
+
+    /// Each code's box, thin; the code being dragged outlined where it will go on every part,
+    /// with its move in mm.
+    fn paint_codes(&self, painter: &egui::Painter, view: &View, rect: Rect, drag: Drag) {
+        let moving = match drag {
+            Drag::Code { code, from, to } => Some((code, to.minus(from))),
+            _ => None,
+        };
+        let code_colour = Color32::from_rgb(124, 58, 237);
+        for c in self.codes {
+            let s = |x: f64, y: f64| view.to_screen(rect, Pt::new(x, y));
+            let b = &c.bbox;
+            let r = Rect::from_two_pos(s(b.min_x, b.min_y), s(b.max_x, b.max_y)).expand(1.0);
+            match moving {
+                Some((k, d)) if k == c.code => {
+                    let to = Rect::from_two_pos(
+                        s(b.min_x + d.x, b.min_y + d.y),
+                        s(b.max_x + d.x, b.max_y + d.y),
+                    )
+                    .expand(1.0);
+                    let stroke = egui::Stroke::new(2.0, code_colour);
+                    painter.rect_stroke(to, 1.0, stroke, egui::StrokeKind::Outside);
+                    if c.part == 1 {
+                        painter.text(
+                            to.right_top() + Vec2::new(4.0, 0.0),
+                            egui::Align2::LEFT_TOP,
+                            format!("{}: moved {:+.2}, {:+.2} mm", c.name, d.x, d.y),
+                            egui::FontId::proportional(12.0),
+                            code_colour,
+                        );
+                    }
+                }
+                _ if r.width() > 6.0 => {
+                    let stroke = egui::Stroke::new(1.0, code_colour.gamma_multiply(0.6));
+                    painter.rect_stroke(r, 1.0, stroke, egui::StrokeKind::Outside);
+                }
+                _ => {}
             }
         }
     }

@@ -656,6 +656,7 @@ pub fn show(
         stale: stale_of(k),
         playback_t_s,
         parts: &[],
+        codes: &[],
         revision,
     };
     // the metrics table's height (20 rows), or less on a small window (it scrolls then)

@@ -713,6 +713,7 @@ impl App {
             stale: &stale,
             playback_t_s,
             parts: &self.session.part_boxes,
+            codes: &self.session.code_boxes,
             revision: self.canvas_revision(),
         };
         let motion = lowered.and_then(Result::ok).and_then(|l| l.motion.as_ref());

@@ -813,6 +813,31 @@ impl App {
         Some(self.view.workbench.view.to_screen(rect, c))
     }
 
+    /// Screen position of machine point `p` (mm) on the workbench canvas (after the first
+    /// frame).
+    pub fn mm_screen_pos(&self, p: crate::geom::Pt) -> Option<egui::Pos2> {
+        let rect = self.view.workbench.rect?;
+        Some(self.view.workbench.view.to_screen(rect, p))
+    }
+
+    /// The workbench canvas's zoom: screen pixels per mm.
+    pub fn workbench_px_per_mm(&self) -> f32 {
+        self.view.workbench.view.scale
+    }
+
+    /// The centre of code `code` (from 0) of part `part` on the machine, mm.
+    pub fn code_centre_mm(&self, code: usize, part: u32) -> Option<crate::geom::Pt> {
+        let b = self
+            .session
+            .code_boxes
+            .iter()
+            .find(|c| c.code == code && c.part == part)?;
+        Some(crate::geom::Pt::new(
+            (b.bbox.min_x + b.bbox.max_x) / 2.0,
+            (b.bbox.min_y + b.bbox.max_y) / 2.0,
+        ))
+    }
+
     /// Screen position of a field's centre on the workbench canvas (after the first frame).
     pub fn field_screen_pos(&self, id: usize) -> Option<egui::Pos2> {
         let f = self.session.doc.fields.iter().find(|f| f.id == id)?;
@@ -1025,6 +1050,7 @@ impl App {
                     to_mm,
                 } => self.move_seam(axis, from_mm, to_mm, repaint),
                 CanvasAction::SkipCell { cell, skip } => self.skip_cell(cell, skip, repaint),
+                CanvasAction::MoveCode { code, by } => self.move_code(code, by, repaint),
             }
         }
     }

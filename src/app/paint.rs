@@ -872,6 +872,7 @@ mod tests {
             stale: &[],
             playback_t_s: None,
             parts: &[],
+            codes: &[],
             revision: 0,
         }
     }

@@ -44,6 +44,8 @@ pub struct Session {
     pub can_reimport: bool,
     /// The tray's cells as the canvas shows them (made when the document changes).
     pub part_boxes: Vec<super::tray_panel::PartBox>,
+    /// Every part's codes, boxed (the canvas drags them).
+    pub code_boxes: Vec<super::tray_panel::CodeBox>,
 }
 
 impl Session {
@@ -193,6 +195,7 @@ impl Session {
         self.closed = self.doc.geometries.iter().filter(|g| g.closed).count();
         self.can_reimport = super::files::can_reimport(&self.doc);
         self.part_boxes = super::tray_panel::part_boxes(&self.doc);
+        self.code_boxes = super::tray_panel::code_boxes(&self.doc);
         if self.active.is_some_and(|k| k >= self.doc.plans.len()) {
             self.active = self.doc.plans.len().checked_sub(1);
         }

@@ -4,7 +4,9 @@
 
 use super::panels::{combo, Choice, Form};
 use crate::document::spec::{check_all, tray_specs};
-use crate::document::{CodeKind, CodeSpec, Document, Ecc, Numbering, Production, TraySetup};
+use crate::document::{
+    CodeKind, CodeSpec, Document, Ecc, Numbering, Production, TraySetup, CODE_LAYER,
+};
 use egui::RichText;
 
 /// What the operator asked of the Tray section.
@@ -42,6 +44,9 @@ impl CodeRow {
         if o.gs1 {
             opts.push("gs1".into());
         }
+        if o.dots {
+            opts.push("dots".into());
+        }
         if c.kind == CodeKind::Qr && o.ecc != Ecc::M {
             opts.push(format!("ecc={:?}", o.ecc));
         }
@@ -74,12 +79,12 @@ const CODE_KINDS: [Choice<CodeKind>; 3] = [
     (
         CodeKind::DataMatrix,
         "DataMatrix",
-        "DataMatrix ECC200; options rect, gs1, inverted",
+        "DataMatrix ECC200; options rect, gs1, dots, inverted",
     ),
     (
         CodeKind::Qr,
         "QR code",
-        "QR code; options ecc=L|M|Q|H, inverted",
+        "QR code; options ecc=L|M|Q|H, dots, inverted",
     ),
     (
         CodeKind::Code128,
@@ -250,6 +255,7 @@ impl TrayPanel {
                 text(ui, "Code Y (mm)", &mut row.y, "from the part's top");
                 text(ui, "Code size (mm)", &mut row.size, "width");
                 text(ui, "Code options", &mut row.options, "e.g. inverted");
+                ui.weak("drag the code on the canvas to move it on every part");
                 if ui.button("Remove this code").clicked() {
                     remove = Some(k);
                 }
@@ -452,6 +458,33 @@ impl super::App {
         });
     }
 
+    /// Moves code `code` of the part by `by` (mm, rounded to 0.01 mm) on every part, through a
+    /// background job like any tray change (undoable when it ends).
+    pub fn move_code(&mut self, code: usize, by: crate::geom::Pt, repaint: &egui::Context) {
+        let Some(spec) = self
+            .session
+            .doc
+            .production
+            .as_ref()
+            .and_then(|p| p.codes.get(code))
+        else {
+            return;
+        };
+        let round = |v: f64| (v * 100.0).round() / 100.0;
+        let at = [round(spec.at_mm[0] + by.x), round(spec.at_mm[1] + by.y)];
+        let what = format!(
+            "move code {} to ({}, {}) mm from the part's top-left",
+            code + 1,
+            at[0],
+            at[1]
+        );
+        self.remake_tray(what, repaint, move |p| {
+            if let Some(c) = p.codes.get_mut(code) {
+                c.at_mm = at;
+            }
+        });
+    }
+
     /// Leaves a tray cell out, or marks it again (`skip`), through [`super::App::set_tray`].
     pub fn skip_cell(&mut self, cell: u32, skip: bool, repaint: &egui::Context) {
         let Some(p) = &self.session.doc.production else {
@@ -621,4 +654,56 @@ pub fn part_boxes(doc: &Document) -> Vec<PartBox> {
         }
     }
     out
+}
+
+/// A code of a part as the canvas shows it: which code of the part, and where its marks lie.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CodeBox {
+    /// The code's index in the production's codes (from 0).
+    pub code: usize,
+    /// The part it is on.
+    pub part: u32,
+    /// The box of its marks on the machine, mm.
+    pub bbox: crate::geom::BBox,
+    /// What it is, in words (`DataMatrix code 1`).
+    pub name: String,
+}
+
+/// Every part's codes, boxed (dragging one on the canvas moves that code on every part).
+pub fn code_boxes(doc: &Document) -> Vec<CodeBox> {
+    use crate::geom::BBox;
+    let Some(p) = &doc.production else {
+        return Vec::new();
+    };
+    let mut boxes: std::collections::BTreeMap<(u32, usize), BBox> = Default::default();
+    for g in doc.artwork.iter().filter(|g| g.layer == CODE_LAYER) {
+        // the element is "KIND code N" (`tray::expand`)
+        let Some(k) = g
+            .source
+            .element
+            .rsplit_once(" code ")
+            .and_then(|(_, n)| n.parse::<usize>().ok())
+            .and_then(|n| n.checked_sub(1))
+        else {
+            continue;
+        };
+        let b = boxes.entry((g.source.part, k)).or_insert(BBox::EMPTY);
+        *b = b.union(BBox::of(&g.points));
+    }
+    boxes
+        .into_iter()
+        .filter_map(|((part, code), bbox)| {
+            let spec = p.codes.get(code)?;
+            let kind = CODE_KINDS
+                .iter()
+                .find(|(k, _, _)| *k == spec.kind)
+                .map_or("Code", |(_, words, _)| *words);
+            Some(CodeBox {
+                code,
+                part,
+                bbox,
+                name: format!("{kind} code {}", code + 1),
+            })
+        })
+        .collect()
 }

@@ -58,6 +58,10 @@ pub struct CodeOptions {
     /// are separated by the ASCII group separator.
     #[serde(default)]
     pub gs1: bool,
+    /// One spot per module, fired for the pen's dot dwell, instead of filled squares (2-D
+    /// codes only).
+    #[serde(default)]
+    pub dots: bool,
 }
 
 /// A code of the part.
@@ -82,7 +86,7 @@ pub const CODE_LAYER: &str = "codes";
 
 impl CodeSpec {
     /// Reads `KIND:CONTENT@X,Y:SIZE_MM[:OPTIONS]`; the last `@` ends the content; OPTIONS is a
-    /// comma-separated list of `inverted`, `rect`, `ecc=L|M|Q|H`, `gs1`.
+    /// comma-separated list of `dots`, `inverted`, `rect`, `ecc=L|M|Q|H`, `gs1`.
     pub fn parse(text: &str) -> Result<Self, ProductionError> {
         let bad = |why: String| ProductionError::Code {
             text: text.to_string(),
@@ -132,17 +136,13 @@ impl CodeSpec {
                 "ecc=m" if kind == CodeKind::Qr => options.ecc = Ecc::M,
                 "ecc=q" if kind == CodeKind::Qr => options.ecc = Ecc::Q,
                 "ecc=h" if kind == CodeKind::Qr => options.ecc = Ecc::H,
-                "dots" => {
-                    return Err(bad(
-                        "the option 'dots' is not available yet (pens have no dwell time)".into(),
-                    ))
-                }
+                "dots" if kind != CodeKind::Code128 => options.dots = true,
                 other => {
                     return Err(bad(format!(
                         "unknown option '{other}' for {kind} (options: inverted{})",
                         match kind {
-                            CodeKind::DataMatrix => ", rect, gs1",
-                            CodeKind::Qr => ", ecc=L|M|Q|H",
+                            CodeKind::DataMatrix => ", dots, rect, gs1",
+                            CodeKind::Qr => ", dots, ecc=L|M|Q|H",
                             CodeKind::Code128 => "",
                         }
                     )))
@@ -172,7 +172,8 @@ mod tests {
         assert_eq!(c.options.ecc, Ecc::H);
         assert!(c.options.inverted);
         let d = CodeSpec::parse("datamatrix:GP{serial:05}@3,3:6:rect,gs1").unwrap();
-        assert!(d.options.rect && d.options.gs1);
+        assert!(d.options.rect && d.options.gs1 && !d.options.dots);
+        assert!(CodeSpec::parse("qr:x@1,1:5:dots").unwrap().options.dots);
         for (bad, says) in [
             ("aztec:x@1,1:5", "unknown kind 'aztec'"),
             ("qr:x@1,1:5:rect", "unknown option 'rect' for qr"),
@@ -180,7 +181,7 @@ mod tests {
             ("qr:x@1,1:-5", "positive"),
             ("qr:{serial@1,1:5", "unbalanced"),
             ("qr:@1,1:5", "empty"),
-            ("qr:x@1,1:5:dots", "dots"),
+            ("code128:x@1,1:5:dots", "unknown option 'dots' for code128"),
         ] {
             let e = CodeSpec::parse(bad).unwrap_err().to_string();
             assert!(e.contains(says) && !e.contains('\n'), "{bad}: {e}");

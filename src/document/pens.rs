@@ -54,6 +54,9 @@ pub struct Pen {
     /// `pass / passes` of a cell, so no two passes cut at the same place (more fields, more
     /// job time; the plan reports both).
     pub shift_passes: bool,
+    /// How long the laser fires at a dot (a mark of one spot, as a dotted code's modules),
+    /// s; unset: the profile's.
+    pub dot_dwell_s: Option<f64>,
     /// Display colour `#rrggbb`; unset: from the layer's name when that is a colour, else from
     /// a palette.
     pub colour: Option<String>,
@@ -70,6 +73,7 @@ impl Default for Pen {
             hatch: None,
             seam: SeamForm::Straight,
             shift_passes: false,
+            dot_dwell_s: None,
             colour: None,
         }
     }
@@ -100,12 +104,17 @@ impl Pen {
         self.mark_speed_mm_s.is_none()
             && self.power.is_none()
             && self.frequency_khz.is_none()
+            && self.dot_dwell_s.is_none()
             && self.passes == 1
     }
     /// Mark speed in mm/s on `profile`.
     pub fn mark_speed_mm_s(&self, profile: &MachineProfile) -> f64 {
         self.mark_speed_mm_s
             .unwrap_or(profile.scanner.mark_speed_mm_s)
+    }
+    /// How long a dot is fired on `profile`, s.
+    pub fn dot_dwell_s(&self, profile: &MachineProfile) -> f64 {
+        self.dot_dwell_s.unwrap_or(profile.laser.dot_dwell_s)
     }
     /// Feed on `G1` moves in mm/min on `profile`.
     pub fn feed_mm_min(&self, profile: &MachineProfile) -> f64 {
@@ -115,6 +124,41 @@ impl Pen {
     /// Laser power written on `profile` (none: no power word).
     pub fn power(&self, profile: &MachineProfile) -> Option<f64> {
         self.power.or(profile.gcode.power)
+    }
+}
+
+/// How a pen marks in time: along a line at its mark speed, or a dot (a mark of one point,
+/// [`crate::geom::is_dot`]) fired in place for its dwell.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MarkTiming {
+    /// Mark speed, mm/s.
+    pub speed_mm_s: f64,
+    /// A dot's laser-on time, s.
+    pub dot_dwell_s: f64,
+}
+
+impl MarkTiming {
+    /// The timing of `pen` (none: the profile's settings) on `profile`.
+    pub fn of(pen: Option<&Pen>, profile: &MachineProfile) -> Self {
+        match pen {
+            Some(p) => Self {
+                speed_mm_s: p.mark_speed_mm_s(profile),
+                dot_dwell_s: p.dot_dwell_s(profile),
+            },
+            None => Self {
+                speed_mm_s: profile.scanner.mark_speed_mm_s,
+                dot_dwell_s: profile.laser.dot_dwell_s,
+            },
+        }
+    }
+    /// How long the laser is on for the mark through `points` (`length_mm` long), s, between
+    /// its on and off delays.
+    pub fn mark_s(&self, points: &[crate::geom::Pt], length_mm: f64) -> f64 {
+        if crate::geom::is_dot(points) {
+            self.dot_dwell_s
+        } else {
+            length_mm / self.speed_mm_s
+        }
     }
 }
 
@@ -152,6 +196,8 @@ struct LayerFile {
     #[serde(default)]
     shift_passes: bool,
     #[serde(default)]
+    dot_dwell_s: Option<f64>,
+    #[serde(default)]
     colour: Option<String>,
 }
 
@@ -176,6 +222,7 @@ impl From<LayerFile> for Layer {
                 hatch: f.hatch,
                 seam: f.seam,
                 shift_passes: f.shift_passes,
+                dot_dwell_s: f.dot_dwell_s,
                 colour: f.colour,
             },
         }

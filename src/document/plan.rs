@@ -377,6 +377,14 @@ impl Plan {
     pub fn pen(&self, g: &super::Geometry) -> Option<&super::Pen> {
         super::pen_of(&self.layers, g)
     }
+    /// How geometry `g` is marked in time in this plan on `profile`.
+    pub fn mark_timing(
+        &self,
+        g: &super::Geometry,
+        profile: &super::MachineProfile,
+    ) -> super::MarkTiming {
+        super::MarkTiming::of(self.pen(g), profile)
+    }
     /// Mark speed of geometry `g` in this plan on `profile`, mm/s.
     pub fn mark_speed_mm_s(&self, g: &super::Geometry, profile: &super::MachineProfile) -> f64 {
         self.pen(g).map_or(profile.scanner.mark_speed_mm_s, |p| {

@@ -114,6 +114,15 @@ pub struct LaserTiming {
     /// at this spacing, inset by half of it.
     #[serde(default = "default_spot_mm")]
     pub spot_mm: f64,
+    /// How long the laser fires at a dot (a mark of one spot: a dotted code's module), s;
+    /// pens may set their own.
+    #[serde(default = "default_dot_dwell_s")]
+    pub dot_dwell_s: f64,
+}
+
+/// A dot of a dotted code: half a millisecond, a typical point time of a fibre laser.
+fn default_dot_dwell_s() -> f64 {
+    0.5e-3
 }
 
 /// A galvo's typical focused spot, mm.
@@ -128,6 +137,7 @@ impl Default for LaserTiming {
             off_delay_s: 100e-6,
             jump_delay_s: 200e-6,
             spot_mm: default_spot_mm(),
+            dot_dwell_s: default_dot_dwell_s(),
         }
     }
 }

@@ -440,6 +440,14 @@ pub fn profile_specs() -> Vec<FieldSpec<MachineProfile>> {
             |p| p.laser.spot_mm
         ),
         number!(
+            "Dot dwell",
+            "s",
+            "laser.dot_dwell_s",
+            "how long the laser fires at a dot (a dotted code's module); pens may set their own",
+            Positive,
+            |p| p.laser.dot_dwell_s
+        ),
+        number!(
             "On-the-fly margin",
             "mm",
             "otf_margin_mm",
@@ -817,6 +825,14 @@ pub fn pen_specs() -> Vec<FieldSpec<Pen>> {
             |p| p.passes
         ),
         choice!("Shifted passes", "shift_passes", |p| yes_no(p.shift_passes)),
+        optional!(
+            "Dot dwell",
+            "s",
+            "dot_dwell_s",
+            "how long the laser fires at a dot (a dotted code's module); empty: the profile's",
+            Positive,
+            |p| p.dot_dwell_s
+        ),
         choice!("Hatch", "hatch", |p| hatch_words(p.hatch.as_ref())),
         choice!("Seam", "seam", |p| p.seam.describe()),
         seam_width_spec(),

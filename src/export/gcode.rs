@@ -49,6 +49,8 @@ pub(super) struct PenWords {
     pub(super) power: Option<f64>,
     pub(super) feed: String,
     pub(super) comment: Option<String>,
+    /// A dot's dwell (`G4 P`, seconds as RS274NGC reads it).
+    pub(super) dot_dwell: String,
 }
 
 impl PenWords {
@@ -74,11 +76,13 @@ impl PenWords {
                 l.pen.passes
             )
         });
+        let dot_dwell_s = pen.map_or(profile.laser.dot_dwell_s, |p| p.dot_dwell_s(profile));
         Self {
             on,
             power,
             feed: w.num(feed),
             comment,
+            dot_dwell: crate::geom::format_mm(dot_dwell_s, 7),
         }
     }
 }
@@ -252,6 +256,12 @@ pub fn write_gcode_to(
         out.push('\n');
         out.push_str(&pen.on);
         out.push('\n');
+        if rest.is_empty() {
+            // a dot: fired in place for its pen's dwell
+            out.push_str("G4 P");
+            out.push_str(&pen.dot_dwell);
+            out.push('\n');
+        }
         for (j, &p) in rest.iter().enumerate() {
             out.push_str("G1 ");
             place(&mut out, p);

@@ -20,7 +20,7 @@
 //! synchronised) or, without one, on the profile's power word.
 
 use super::gcode::{GcodeError, PenWords, Words};
-use crate::document::{MachineProfile, Plan};
+use crate::document::{MachineProfile, MarkTiming, Plan};
 use crate::geom::Pt;
 use crate::motion::controller::otf_lines;
 use crate::motion::{ScanMotion, SegmentKind, StageMotion, Toolpath};
@@ -118,6 +118,15 @@ impl<'a, 'w> Program<'a, 'w> {
             let _ = writeln!(self.out, "G4 P{}", fmt_s(self.dwell_s));
         }
         self.dwell_s = 0.0;
+    }
+
+    /// A dot: the laser switched on at once where the scanner stands (`M64`: task waits for
+    /// the motion before it to end), `G4` for the dwell, and off at once (`M65`). `M62` would
+    /// wait for a next move, and a dot has none.
+    fn dot(&mut self, dwell_s: f64) {
+        self.before_move(false);
+        let n = self.profile.gcode.laser_output;
+        let _ = writeln!(self.out, "M64 P{n}\nG4 P{}\nM65 P{n}", fmt_s(dwell_s));
     }
 
     /// Before a move: the dwell before it, and the laser switched for it.
@@ -241,11 +250,16 @@ impl<'a, 'w> Program<'a, 'w> {
                 (SegmentKind::Mark, StageMotion::Hold(stage), ScanMotion::Mark { stroke, .. }) => {
                     let layer = toolpath.strokes.get(stroke).and_then(|s| s.layer);
                     let feed = self.pen_for(plan, layer, stroke)?;
-                    self.before_move(true);
                     let points = toolpath.stroke_points(stroke);
                     if points.is_empty() {
                         return Err(GcodeError::EmptyStroke { stroke });
                     }
+                    if crate::geom::is_dot(points) {
+                        let pen = layer.and_then(|l| plan.layers.get(l)).map(|l| &l.pen);
+                        self.dot(MarkTiming::of(pen, self.profile).dot_dwell_s);
+                        continue;
+                    }
+                    self.before_move(true);
                     for (j, &p) in points.iter().enumerate().skip(1) {
                         let words = self.scan_words(p.minus(stage));
                         if j == 1 {

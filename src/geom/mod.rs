@@ -182,6 +182,12 @@ pub fn star_polygon(c: Pt, radii: &[f64], rot: f64) -> Vec<Pt> {
         .collect()
 }
 
+/// A dot: a mark of one point (the laser fired in place for its pen's dwell, as a dotted
+/// code's module), not a line.
+pub fn is_dot(points: &[Pt]) -> bool {
+    points.len() == 1
+}
+
 /// Length of a polyline in mm; `closed` adds the segment back to the first point.
 pub fn polyline_length(points: &[Pt], closed: bool) -> f64 {
     let open: f64 = points.windows(2).map(|w| w[0].dist(w[1])).sum();

@@ -3,8 +3,8 @@
 use super::axis::StageDynamics;
 use super::controller::LinuxcncClock;
 use super::toolpath::{ScanMotion, Segment, SegmentKind, StageMotion, Toolpath};
-use crate::document::{Geometry, MachineProfile, Plan, ScanField};
-use crate::geom::Pt;
+use crate::document::{Geometry, MachineProfile, MarkTiming, Plan, ScanField};
+use crate::geom::{is_dot, Pt};
 use thiserror::Error;
 
 /// How far a marked point may lie outside its field's reach before lowering refuses the plan,
@@ -113,7 +113,7 @@ pub fn lower(
         let stroke = b
             .path
             .push_stroke(k, step.geometry, step.field, field.center, &path);
-        b.mark(stroke, plan.mark_speed_mm_s(g, profile));
+        b.mark(stroke, plan.mark_timing(g, profile));
     }
     Ok(b.path)
 }
@@ -261,16 +261,18 @@ impl<'a> Builder<'a> {
         }
     }
 
-    /// Marks stroke `stroke` at `speed_mm_s` (its pen's) from where the scanner stands: on
-    /// delay, mark, off delay.
-    fn mark(&mut self, stroke: usize, speed_mm_s: f64) {
+    /// Marks stroke `stroke` as its pen says (`timing`) from where the scanner stands: on
+    /// delay, mark (or a dot's dwell), off delay.
+    fn mark(&mut self, stroke: usize, timing: MarkTiming) {
         let laser = &self.profile.laser;
         let (on_s, off_s) = (laser.on_delay_s, laser.off_delay_s);
         self.hold(SegmentKind::LaserOnDelay, on_s);
         let length_mm = self.path.strokes[stroke].length_mm;
+        let points = self.path.stroke_points(stroke);
         let duration_s = match &self.clock {
-            Some(c) => c.polyline_s(self.path.stroke_points(stroke), speed_mm_s),
-            None => length_mm / speed_mm_s,
+            Some(c) if is_dot(points) => c.dwell_s(timing.dot_dwell_s),
+            Some(c) => c.polyline_s(points, timing.speed_mm_s),
+            None => timing.mark_s(points, length_mm),
         };
         let stage = StageMotion::Hold(self.stage_at);
         self.push(

@@ -44,7 +44,7 @@ use super::route::{AxisRoute, StageRoute};
 use super::taut::{peak_speed_mm_s, taut_string, TautError, Tube};
 use super::toolpath::{ScanMotion, Segment, SegmentKind, StageMotion, Toolpath};
 use crate::document::{AxisLimits, Geometry, MachineProfile, Plan};
-use crate::geom::Pt;
+use crate::geom::{is_dot, Pt};
 use crate::job::{Cancelled, JobCtx};
 use thiserror::Error;
 
@@ -612,7 +612,18 @@ fn tool_pieces(
             Tool::Hold(start),
             stage,
         );
-        let mark_speed_mm_s = plan.mark_speed_mm_s(g, profile);
+        let timing = plan.mark_timing(g, profile);
+        if is_dot(path.stroke_points(stroke)) {
+            // a dot: its one point marked for the dwell (the scanner holds the tool on it
+            // while the stage moves on)
+            let dot = Tool::Stroke {
+                stroke,
+                start_frac: 0.0,
+                end_frac: 1.0,
+            };
+            piece(SegmentKind::Mark, timing.dot_dwell_s, dot, stage);
+        }
+        let mark_speed_mm_s = timing.speed_mm_s;
         for (start_frac, end_frac) in stroke_parts(path, stroke) {
             let part_mm = (end_frac - start_frac) * path.strokes[stroke].length_mm;
             let tool = Tool::Stroke {

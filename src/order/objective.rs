@@ -16,8 +16,8 @@
 //! large jobs); the step-and-scan figure is then an estimate used only to rank chromosomes, and
 //! the plan's own choice between candidates is made on their lowered toolpaths.
 
-use crate::document::{pen_of, Geometry, Layer, MachineProfile, ScanField, Step};
-use crate::geom::Pt;
+use crate::document::{pen_of, Geometry, Layer, MachineProfile, MarkTiming, ScanField, Step};
+use crate::geom::{is_dot, Pt};
 use crate::motion::controller::LinuxcncClock;
 use crate::motion::StageDynamics;
 use std::collections::HashMap;
@@ -52,13 +52,16 @@ impl<'a> StepTime<'a> {
         let mark_s = geometries
             .iter()
             .map(|g| {
-                let speed = pen_of(layers, g).map_or(profile.scanner.mark_speed_mm_s, |p| {
-                    p.mark_speed_mm_s(profile)
-                });
+                let timing = MarkTiming::of(pen_of(layers, g), profile);
                 match &clock {
+                    Some(c) if is_dot(&g.points) => c.dwell_s(timing.dot_dwell_s),
                     // every start vertex and direction marks the same edges
-                    Some(c) => c.polyline_s(&g.marking_path(0, false), speed),
-                    None => laser.on_delay_s + g.length_mm() / speed + laser.off_delay_s,
+                    Some(c) => c.polyline_s(&g.marking_path(0, false), timing.speed_mm_s),
+                    None => {
+                        laser.on_delay_s
+                            + timing.mark_s(&g.points, g.length_mm())
+                            + laser.off_delay_s
+                    }
                 }
             })
             .collect();
