@@ -191,7 +191,7 @@ const ROWS: &[Row] = &[
     },
     Row {
         label: "Stage speed variation (mm/s)",
-        help: "sum of the stage's speed changes between samples (seed 001 Table IV): lower is \
+        help: "sum of the stage's speed changes between samples: lower is \
                a smoother ride",
         value: |p| p.metrics.motion.map(|f| f.stage_speed_variation_mm_s),
         decimals: 0,

@@ -412,7 +412,7 @@ pub const FIELD_PLACEMENTS: &[Choice<FieldsMode>] = &[
     (
         FieldsMode::Paper,
         "Reference paper's method",
-        "The placement of seed 000's paper (§3.1), for comparison; command line: \
+        "The scan-field paper's placement (random fields, removal test, unit moves), for comparison; command line: \
          --fields paper.",
     ),
     (
@@ -438,7 +438,7 @@ pub const START_POINTS: &[Choice<VertexMode>] = &[
     (
         VertexMode::Vea,
         "Quick start points (estimate)",
-        "The estimate alone (seed 000's VEA), for comparison; command line: --vertex vea.",
+        "The estimate alone (each start vertex nearest the next geometry), for comparison; command line: --vertex vea.",
     ),
 ];
 
@@ -456,7 +456,7 @@ pub const COST_MODELS: &[Choice<CostModel>] = &[
     (
         CostModel::Distance,
         "Idle travel distance",
-        "The laser-off travel in mm, ignoring the machine's dynamics (seed 000's objective); \
+        "The laser-off travel in mm, ignoring the machine's dynamics; \
          command line: --cost distance.",
     ),
 ];

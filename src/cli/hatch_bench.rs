@@ -19,7 +19,7 @@ pub struct HatchBenchArgs {
     /// Styles to run.
     #[arg(long, value_delimiter = ',', default_value = "zigzag,contour")]
     style: Vec<String>,
-    /// Timed runs per case (after one warm-up); times are means as in seed 003.
+    /// Timed runs per case (after one warm-up); times are means, as the hatch paper gives them.
     #[arg(long, default_value_t = 10)]
     repeat: usize,
     /// Also write the rows as JSON.

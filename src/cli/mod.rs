@@ -36,7 +36,8 @@ enum Command {
     Plan(PlanArgs),
     /// Run the pipeline over SVG files or folders and print one row per instance.
     Bench(BenchArgs),
-    /// Seed 003's hatch experiment: counts, lengths and times of zigzag and contour fills.
+    /// The hatch experiment of the APMCM hatch paper (docs/REFERENCES.md): counts, lengths and
+    /// times of zigzag and contour fills.
     HatchBench(hatch_bench::HatchBenchArgs),
     /// Order plain point sets (TSPLIB or SVG) with the ordering engine, for comparison with
     /// LKH or Concorde; or write the random point sets the benchmarks use.
@@ -50,7 +51,8 @@ enum Command {
 enum FieldsArg {
     /// Set cover: fewest fields, least overlap, centred.
     Auto,
-    /// Seed 000 §3.1: random fields, removal test, unit moves (slow).
+    /// The scan-field paper's placement (docs/REFERENCES.md): random fields, removal test, unit
+    /// moves (slow).
     Paper,
     /// Greedy serpentine cover (baseline).
     Greedy,
@@ -59,13 +61,14 @@ enum FieldsArg {
 /// Ordering algorithm, as on the command line.
 #[derive(Debug, Clone, Copy, ValueEnum)]
 enum AlgoArg {
-    /// Hierarchical heuristic (seed 000 §3.2) with exact vertices and local search.
+    /// Heuristic ordering (HHA: fields, then geometries in each) with exact start vertices and
+    /// local search.
     Hha,
-    /// Hybrid genetic algorithm (seed 000 §3.3), seeded with the HHA plan.
+    /// Genetic algorithm (HGA) on the job's objective, seeded with the HHA plan.
     Hga,
     /// Fields in creation order, nearest neighbour inside each.
     Baseline,
-    /// Fields and geometries in document order, no optimisation (seed 002's reference).
+    /// Fields and geometries in document order, no optimisation (a reference to compare with).
     AsIs,
 }
 
@@ -87,9 +90,9 @@ enum StageRouteArg {
     /// galvoplan's own: per axis the stage tracks the laser point within the scanner's reach at
     /// the axis limits (the taut string, blended, where tracking does not settle).
     Taut,
-    /// Seed 001's benchmark: the polyline through the line-simplified pattern points.
+    /// Line-simplified route: the polyline through the simplified pattern points.
     Lsa,
-    /// Seed 001's genetic algorithm (close-enough TSP on the LSA points).
+    /// Genetic-algorithm route: a close-enough TSP through circles around the simplified points.
     CetspGa,
 }
 
@@ -98,7 +101,7 @@ enum StageRouteArg {
 enum CostArg {
     /// Machine time of the lowered toolpath (stage trapezoids and settling, scanner jumps).
     Time,
-    /// Idle travel in mm (seed 000's objective).
+    /// Idle travel in mm (laser-off distance, the machine's dynamics ignored).
     Distance,
 }
 
@@ -107,7 +110,8 @@ enum CostArg {
 enum VertexArg {
     /// VEA, then the exact layered-graph shortest path.
     Exact,
-    /// Seed 000's vertex enhancement algorithm only.
+    /// The vertex estimate alone (each start vertex nearest the next geometry, improved in
+    /// passes).
     Vea,
 }
 
@@ -133,28 +137,29 @@ struct JobOpts {
     /// The stage route on the fly.
     #[arg(long, value_enum, default_value = "taut")]
     stage_route: StageRouteArg,
-    /// cetsp-ga: population size (seed 001: 50).
+    /// cetsp-ga: population size (the route paper's: 50).
     #[arg(long, default_value_t = 50)]
     route_population: usize,
-    /// cetsp-ga: generations (seed 001: 500).
+    /// cetsp-ga: generations (the route paper's: 500).
     #[arg(long, default_value_t = 500)]
     route_generations: usize,
-    /// cetsp-ga: crossover rate p_c (seed 001: 1.0).
+    /// cetsp-ga: crossover rate p_c (the route paper's: 1.0).
     #[arg(long, default_value_t = 1.0)]
     route_crossover: f64,
-    /// cetsp-ga: mutation rate p_m (seed 001: 0.5).
+    /// cetsp-ga: mutation rate p_m (the route paper's: 0.5).
     #[arg(long, default_value_t = 0.5)]
     route_mutation: f64,
     /// lsa and cetsp-ga: padding radius in mm (default: half the field, its inscribed circle).
     #[arg(long)]
     padding_radius_mm: Option<f64>,
-    /// Start vertices: exact (layered-graph DP after VEA) or vea (seed 000 only).
+    /// Start vertices: exact (layered-graph DP after the estimate) or vea (the estimate only).
     #[arg(long, value_enum, default_value = "exact")]
     vertex: VertexArg,
-    /// Directional penalty weight w (seed 000 Eq. 7; 0.1 is used with one field).
+    /// Directional penalty weight w of the heuristic's field ordering (0.1 is used with one
+    /// field).
     #[arg(long, default_value_t = 0.5)]
     direction_weight: f64,
-    /// HGA: do not put the HHA plan into the initial population (seed 000's HGA; it may then
+    /// HGA: do not put the HHA plan into the initial population (the paper's HGA; it may then
     /// end worse than HHA).
     #[arg(long)]
     no_hha_seed: bool,
@@ -167,7 +172,8 @@ struct JobOpts {
     /// HGA: initial population size (between its min 16 and max 48).
     #[arg(long, value_name = "N", default_value_t = galvoplan::document::GaParams::default().population)]
     ga_population: usize,
-    /// Run HHA as seed 000 describes it (no local search, no alternation), for comparison.
+    /// Run HHA as the scan-field paper describes it (no local search, no alternation), for
+    /// comparison.
     #[arg(long)]
     seed_hha: bool,
     /// Random seed.

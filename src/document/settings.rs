@@ -12,7 +12,8 @@ pub enum FieldsMode {
     /// Set cover: fewest fields, then least overlap, then best centring.
     #[default]
     Auto,
-    /// Seed 000 §3.1: random fields, removal test, unit moves.
+    /// The scan-field paper's placement (seed 000 §3.1 in docs/REFERENCES.md): random fields,
+    /// removal test, unit moves.
     Paper,
 }
 
@@ -20,7 +21,7 @@ pub enum FieldsMode {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "lowercase")]
 pub enum Algo {
-    /// Fields and geometries in document order, no optimisation (seed 002's reference).
+    /// Fields and geometries in document order, no optimisation (a reference to compare with).
     #[serde(rename = "as-is")]
     AsIs,
     /// Fields in creation order, nearest neighbour inside each field.
@@ -113,7 +114,7 @@ impl SolverSettings {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "lowercase")]
 pub enum VertexMode {
-    /// Seed 000's vertex enhancement algorithm only.
+    /// The vertex estimate alone (seed 000's VEA, docs/REFERENCES.md).
     Vea,
     /// VEA followed by the exact layered-graph shortest path.
     #[default]
@@ -124,7 +125,7 @@ pub enum VertexMode {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "lowercase")]
 pub enum CostModel {
-    /// Idle distance in mm (seed 000's objective).
+    /// Idle distance in mm (laser-off travel, the machine's dynamics ignored).
     Distance,
     /// Machine time from the profile's dynamics (seed 002): the toolpath's job time.
     #[default]
@@ -205,10 +206,11 @@ pub enum StageRouteKind {
     #[default]
     #[serde(rename = "taut")]
     Taut,
-    /// Seed 001's benchmark: the polyline through the line-simplified pattern points.
+    /// Line-simplified route: the polyline through the simplified pattern points (seed 001's
+    /// benchmark, docs/REFERENCES.md).
     #[serde(rename = "lsa")]
     Lsa,
-    /// Seed 001's genetic algorithm on the close-enough TSP of those points.
+    /// Genetic-algorithm route: a close-enough TSP through those points (seed 001's GA).
     #[serde(rename = "cetsp-ga")]
     CetspGa,
 }

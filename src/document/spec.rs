@@ -629,7 +629,7 @@ pub fn settings_specs() -> Vec<FieldSpec<SolverSettings>> {
             "Direction weight",
             "",
             "direction_weight",
-            "seed 000 Eq. 7 penalty weight w",
+            "the heuristic's directional penalty weight w",
             NonNegative,
             |t| t.direction_weight
         ),
@@ -758,7 +758,7 @@ pub fn settings_specs() -> Vec<FieldSpec<SolverSettings>> {
         ),
         choice!("Scan fields", "fields", |t| match t.fields {
             FieldsMode::Auto => "automatic".into(),
-            FieldsMode::Paper => "seed 000's placement".into(),
+            FieldsMode::Paper => "the scan-field paper's placement".into(),
             FieldsMode::Greedy => "greedy".into(),
         }),
         choice!("Split oversize geometries", "split_oversize", |t| yes_no(
