@@ -19,6 +19,7 @@
 
 use crate::document::{CodeKind, CodeSpec, Ecc, Geometry, Run, RunOrder, Source, CODE_LAYER};
 use crate::geom::Pt;
+use thiserror::Error;
 
 /// A Code 128's bar height as a share of the symbol's width (without quiet zones).
 pub const BAR_HEIGHT_OF_WIDTH: f64 = 0.3;
@@ -53,9 +54,77 @@ impl Symbol {
     }
 }
 
+/// Why a code cannot be made: its content does not encode, or its modules are too small to mark.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum CodeError {
+    /// The content is too long for the kind at any size.
+    #[error("\"{content}\" does not fit a{shape} at any size")]
+    DoesNotFit {
+        /// The content.
+        content: String,
+        /// The symbol it does not fit, with its article's tail: ` square DataMatrix`,
+        /// ` rectangular DataMatrix`.
+        shape: String,
+    },
+    /// The content is too long for a QR code at any size with this error correction.
+    #[error("\"{content}\" does not fit a QR code at any size with error correction {ecc:?}")]
+    QrDoesNotFit {
+        /// The content.
+        content: String,
+        /// The error correction asked for.
+        ecc: Ecc,
+    },
+    /// A character Code 128 (set B) cannot encode: printable ASCII only.
+    #[error(
+        "Code 128 (set B) cannot encode '{character}' in \"{content}\" (printable ASCII only)"
+    )]
+    CannotEncode {
+        /// The character, escaped when it is a control character.
+        character: String,
+        /// The content.
+        content: String,
+    },
+    /// The Code 128 encoder refused the content.
+    #[error("Code 128 cannot encode \"{content}\": {why}")]
+    Encoder {
+        /// The content.
+        content: String,
+        /// The encoder's reason.
+        why: String,
+    },
+    /// Modules too small to fill at the pen's spacing with the spot.
+    #[error(
+        "modules of {module_mm:.3} mm are smaller than twice the fill spacing ({spacing_mm} mm) \
+         or the spot ({spot_mm} mm): make it at least {least_width_mm:.2} mm wide"
+    )]
+    ModulesTooSmall {
+        /// The module's width, mm.
+        module_mm: f64,
+        /// The fill's line spacing, mm.
+        spacing_mm: f64,
+        /// The spot's diameter, mm.
+        spot_mm: f64,
+        /// The smallest symbol width that can be filled, mm.
+        least_width_mm: f64,
+    },
+    /// Dots (one spot per module) on modules smaller than the spot: they would run together.
+    #[error(
+        "modules of {module_mm:.3} mm are smaller than the spot ({spot_mm} mm), so the dots \
+         would run together: make it at least {least_width_mm:.2} mm wide"
+    )]
+    DotsTooSmall {
+        /// The module's width, mm.
+        module_mm: f64,
+        /// The spot's diameter, mm.
+        spot_mm: f64,
+        /// The smallest symbol width whose dots stay apart, mm.
+        least_width_mm: f64,
+    },
+}
+
 /// Encodes `content` as `spec` says; `Err` says why it cannot be (too long for the kind at
 /// any size, a character the kind cannot encode).
-pub fn symbol(spec: &CodeSpec, content: &str) -> Result<Symbol, String> {
+pub fn symbol(spec: &CodeSpec, content: &str) -> Result<Symbol, CodeError> {
     match spec.kind {
         CodeKind::DataMatrix => {
             use datamatrix::{DataMatrix, SymbolList};
@@ -69,15 +138,14 @@ pub fn symbol(spec: &CodeSpec, content: &str) -> Result<Symbol, String> {
             } else {
                 DataMatrix::encode_str(content, list)
             };
-            let dm = made.map_err(|_| {
-                format!(
-                    "\"{content}\" does not fit a{} DataMatrix at any size",
-                    if spec.options.rect {
-                        " rectangular"
-                    } else {
-                        " square"
-                    }
-                )
+            let dm = made.map_err(|_| CodeError::DoesNotFit {
+                content: content.into(),
+                shape: if spec.options.rect {
+                    " rectangular DataMatrix"
+                } else {
+                    " square DataMatrix"
+                }
+                .into(),
             })?;
             let bitmap = dm.bitmap();
             Ok(Symbol {
@@ -98,10 +166,10 @@ pub fn symbol(spec: &CodeSpec, content: &str) -> Result<Symbol, String> {
             };
             let qr =
                 QrCode::with_error_correction_level(content.as_bytes(), ecc).map_err(|_| {
-                    format!(
-                    "\"{content}\" does not fit a QR code at any size with error correction {:?}",
-                    spec.options.ecc
-                )
+                    CodeError::QrDoesNotFit {
+                        content: content.into(),
+                        ecc: spec.options.ecc,
+                    }
                 })?;
             let n = qr.width();
             Ok(Symbol {
@@ -119,14 +187,19 @@ pub fn symbol(spec: &CodeSpec, content: &str) -> Result<Symbol, String> {
                 } else {
                     c.to_string()
                 };
-                return Err(format!(
-                    "Code 128 (set B) cannot encode '{shown}' in \"{content}\" (printable ASCII \
-                     only)"
-                ));
+                return Err(CodeError::CannotEncode {
+                    character: shown,
+                    content: content.into(),
+                });
             }
             // set B: every printable ASCII character
-            let code = barcoders::sym::code128::Code128::new(format!("Ɓ{content}"))
-                .map_err(|e| format!("Code 128 cannot encode \"{content}\": {e}"))?;
+            let code =
+                barcoders::sym::code128::Code128::new(format!("Ɓ{content}")).map_err(|e| {
+                    CodeError::Encoder {
+                        content: content.into(),
+                        why: e.to_string(),
+                    }
+                })?;
             let dark: Vec<bool> = code.encode().into_iter().map(|b| b == 1).collect();
             Ok(Symbol {
                 cols: dark.len(),
@@ -188,25 +261,23 @@ pub fn marks(
     part: u32,
     element: &str,
     run_id: u32,
-) -> Result<Vec<Geometry>, String> {
+) -> Result<Vec<Geometry>, CodeError> {
     let (mx, my) = module_mm(spec, sym);
     if spec.options.dots && mx < fill.spot_mm - 1e-9 {
-        return Err(format!(
-            "modules of {mx:.3} mm are smaller than the spot ({} mm), so the dots would run \
-             together: make it at least {:.2} mm wide",
-            fill.spot_mm,
-            fill.spot_mm * sym.cols as f64
-        ));
+        return Err(CodeError::DotsTooSmall {
+            module_mm: mx,
+            spot_mm: fill.spot_mm,
+            least_width_mm: fill.spot_mm * sym.cols as f64,
+        });
     }
     let least = (2.0 * fill.spacing_mm).max(fill.spot_mm);
     if !spec.options.dots && mx < least - 1e-9 {
-        return Err(format!(
-            "modules of {mx:.3} mm are smaller than twice the fill spacing ({} mm) or the spot \
-             ({} mm): make it at least {:.2} mm wide",
-            fill.spacing_mm,
-            fill.spot_mm,
-            least * sym.cols as f64
-        ));
+        return Err(CodeError::ModulesTooSmall {
+            module_mm: mx,
+            spacing_mm: fill.spacing_mm,
+            spot_mm: fill.spot_mm,
+            least_width_mm: least * sym.cols as f64,
+        });
     }
     // the grid that is marked: the symbol, or (inverted) the symbol in its quiet zone
     let q = if spec.options.inverted { sym.quiet } else { 0 };
@@ -364,9 +435,28 @@ mod tests {
         let c = symbol(&spec(CodeKind::Code128, 30.0), "SN1001").unwrap();
         assert!(c.bars && c.rows == 1 && c.cols > 60);
         let e = symbol(&spec(CodeKind::Code128, 30.0), "Grüße").unwrap_err();
-        assert!(e.contains("cannot encode 'ü'"), "{e}");
+        assert_eq!(
+            e.to_string(),
+            "Code 128 (set B) cannot encode 'ü' in \"Grüße\" (printable ASCII only)"
+        );
         let e = symbol(&spec(CodeKind::Qr, 9.0), &"x".repeat(5000)).unwrap_err();
-        assert!(e.contains("does not fit a QR code at any size"), "{e}");
+        assert!(
+            e.to_string()
+                .contains("does not fit a QR code at any size with error correction"),
+            "{e}"
+        );
+        let mut square = spec(CodeKind::DataMatrix, 9.0);
+        let e = symbol(&square, &"x".repeat(5000)).unwrap_err().to_string();
+        assert!(
+            e.ends_with("\" does not fit a square DataMatrix at any size"),
+            "{e}"
+        );
+        square.options.rect = true;
+        let e = symbol(&square, &"x".repeat(5000)).unwrap_err().to_string();
+        assert!(
+            e.ends_with("\" does not fit a rectangular DataMatrix at any size"),
+            "{e}"
+        );
     }
 
     #[test]
@@ -397,7 +487,11 @@ mod tests {
         let e = marks(&tiny, &sym, Pt::new(0.0, 0.0), fill, 1, "code", 1).unwrap_err();
         // 12 modules of at least 2 × 0.05 mm
         assert_eq!(sym.cols, 12);
-        assert!(e.contains("at least 1.20 mm wide"), "{e}");
+        assert_eq!(
+            e.to_string(),
+            "modules of 0.083 mm are smaller than twice the fill spacing (0.05 mm) or the spot \
+             (0.05 mm): make it at least 1.20 mm wide"
+        );
     }
 
     #[test]

@@ -8,7 +8,9 @@
 //! export see one job. `doc.parts` records what each part carries.
 
 use crate::codes::{marks, quiet_box, symbol, Fill};
-use crate::document::production::{parse_template, render, Field, PartValues, Piece};
+use crate::document::production::{
+    parse_template, render, Field, PartValues, Piece, TemplateError,
+};
 use crate::document::{
     sync_layers, Document, Geometry, PartRecord, PartSlot, Production, ProductionError, Stamp,
     CODE_LAYER,
@@ -40,23 +42,18 @@ fn read_checked(
     parts: usize,
     bad: impl Fn(String) -> ProductionError,
 ) -> Result<Vec<Piece>, ProductionError> {
-    let p = parse_template(text).map_err(&bad)?;
+    let wrong = |e: TemplateError| bad(e.to_string());
+    let p = parse_template(text).map_err(wrong)?;
     for f in &p {
         let Piece::Field(Field::Csv(column)) = f else {
             continue;
         };
         let Some(data) = &prod.data else {
-            return Err(bad(format!(
-                "{{csv:{column}}} needs a data file (--data FILE.csv)"
-            )));
+            return Err(wrong(TemplateError::NoData {
+                column: column.clone(),
+            }));
         };
-        if !data.header.iter().any(|h| h == column) {
-            return Err(bad(format!(
-                "{}: no column '{column}' (columns: {})",
-                data.file,
-                data.header.join(", ")
-            )));
-        }
+        data.check_column(column).map_err(wrong)?;
         if data.rows.len() < parts {
             return Err(ProductionError::Data(format!(
                 "{}: {} data rows for {parts} marked parts (row k is part k's)",
@@ -152,7 +149,7 @@ fn make_part(job: &Job, slot: PartSlot) -> Result<Made, ProductionError> {
             text: t.text.clone(),
             why,
         };
-        let text = render(p, &values).map_err(bad)?;
+        let text = render(p, &values).map_err(|e| bad(e.to_string()))?;
         let (g, w) = shape_template(
             &t.moved(slot.offset),
             &text,
@@ -160,7 +157,7 @@ fn make_part(job: &Job, slot: PartSlot) -> Result<Made, ProductionError> {
             &job.opts,
             MAX_POINTS,
         )
-        .map_err(bad)?;
+        .map_err(|e| bad(e.to_string()))?;
         geometries.extend(g);
         warnings.extend(w);
         texts.push(text);
@@ -171,8 +168,8 @@ fn make_part(job: &Job, slot: PartSlot) -> Result<Made, ProductionError> {
             text: format!("{}:{}", spec.kind, spec.content),
             why,
         };
-        let content = render(p, &values).map_err(bad)?;
-        let sym = symbol(spec, &content).map_err(bad)?;
+        let content = render(p, &values).map_err(|e| bad(e.to_string()))?;
+        let sym = symbol(spec, &content).map_err(|e| bad(e.to_string()))?;
         let at = job
             .origin
             .plus(Pt::new(spec.at_mm[0], spec.at_mm[1]))
@@ -180,8 +177,10 @@ fn make_part(job: &Job, slot: PartSlot) -> Result<Made, ProductionError> {
         let element = format!("{} code {}", spec.kind, k + 1);
         // a run id of its own for each code of each part
         let run_id = slot.part.wrapping_mul(64).wrapping_add(k as u32);
-        geometries
-            .extend(marks(spec, &sym, at, job.fill, slot.part, &element, run_id).map_err(bad)?);
+        geometries.extend(
+            marks(spec, &sym, at, job.fill, slot.part, &element, run_id)
+                .map_err(|e| bad(e.to_string()))?,
+        );
         codes.push(content);
     }
     let record = PartRecord {

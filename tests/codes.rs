@@ -273,7 +273,9 @@ fn dots_put_one_spot_at_each_marked_module_centre() {
         spacing_mm: SPOT_MM,
         spot_mm: 0.1,
     };
-    let e = marks(&spec, &sym, Pt::new(0.0, 0.0), big_spot, 1, "code", 1).unwrap_err();
+    let e = marks(&spec, &sym, Pt::new(0.0, 0.0), big_spot, 1, "code", 1)
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("at least 1.20 mm wide"), "{e}");
     spec.size_mm = 1.2;
     assert!(marks(&spec, &sym, Pt::new(0.0, 0.0), big_spot, 1, "code", 1).is_ok());

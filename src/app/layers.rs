@@ -80,10 +80,10 @@ impl Col {
             if !s.optional && text.trim().is_empty() {
                 return Err(format!("{} needs a value", s.words()));
             }
-            s.set_text(h, text)
+            s.set_text(h, text).map_err(|e| e.to_string())
         } else {
             match find(&spec::pen_specs(), self.key()) {
-                Some(s) => s.set_text(p, text),
+                Some(s) => s.set_text(p, text).map_err(|e| e.to_string()),
                 None => Ok(()),
             }
         }

@@ -147,6 +147,7 @@ impl<T: Clone + PartialEq> Form<T> {
         let mut candidate = value.clone();
         let result = self.specs[k]
             .set_text(&mut candidate, &self.text[k])
+            .map_err(|e| e.to_string())
             .and_then(|()| validate(&candidate));
         match result {
             Ok(()) => {

@@ -313,7 +313,7 @@ fn parse_date(s: &str) -> Result<Stamp, String> {
 
 /// Parses `--seam`.
 fn parse_seam(s: &str) -> Result<SeamForm, String> {
-    SeamForm::parse(s)
+    SeamForm::parse(s).map_err(|e| e.to_string())
 }
 
 /// Which shapes are filled together, as on the command line.

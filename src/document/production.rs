@@ -380,6 +380,19 @@ impl DataTable {
         })
     }
 
+    /// `Ok` when the table has `column`; else the error listing the columns it has.
+    pub fn check_column(&self, column: &str) -> Result<(), TemplateError> {
+        if self.header.iter().any(|h| h == column) {
+            Ok(())
+        } else {
+            Err(TemplateError::MissingColumn {
+                file: self.file.clone(),
+                column: column.to_string(),
+                columns: self.header.clone(),
+            })
+        }
+    }
+
     /// The value of `column` for part `part` (from 1).
     pub fn value(&self, column: &str, part: u32) -> Option<&str> {
         let c = self.header.iter().position(|h| h == column)?;
@@ -429,7 +442,7 @@ pub enum Field {
 
 /// Splits a template text into pieces; the error says what is wrong (the caller names the text
 /// and where it is).
-pub fn parse_template(text: &str) -> Result<Vec<Piece>, String> {
+pub fn parse_template(text: &str) -> Result<Vec<Piece>, TemplateError> {
     let mut pieces = Vec::new();
     let mut lit = String::new();
     let mut chars = text.char_indices().peekable();
@@ -443,13 +456,13 @@ pub fn parse_template(text: &str) -> Result<Vec<Piece>, String> {
                 chars.next();
                 lit.push('}');
             }
-            '}' => return Err(format!("an unbalanced '}}' at character {}", i + 1)),
+            '}' => return Err(TemplateError::UnbalancedClose { at: i + 1 }),
             '{' => {
                 let rest = &text[i + 1..];
                 let end = rest
                     .find(['}', '{'])
                     .filter(|&e| rest[e..].starts_with('}'))
-                    .ok_or_else(|| format!("an unbalanced '{{' at character {}", i + 1))?;
+                    .ok_or(TemplateError::UnbalancedOpen { at: i + 1 })?;
                 let body = &rest[..end];
                 if !lit.is_empty() {
                     pieces.push(Piece::Text(std::mem::take(&mut lit)));
@@ -473,16 +486,10 @@ pub fn is_template(text: &str) -> bool {
     text.contains(['{', '}'])
 }
 
-fn field(body: &str) -> Result<Field, String> {
+fn field(body: &str) -> Result<Field, TemplateError> {
     let (name, arg) = match body.split_once(':') {
         Some((n, a)) => (n.trim(), Some(a)),
         None => (body.trim(), None),
-    };
-    let unknown = || {
-        format!(
-            "unknown field {{{body}}} (fields: serial, serial:05, part, row, col, date, time, \
-             csv:COLUMN)"
-        )
     };
     let f = match (name, arg) {
         ("serial", None) => Field::Serial(None),
@@ -492,9 +499,7 @@ fn field(body: &str) -> Result<Field, String> {
                 .parse()
                 .ok()
                 .filter(|&n| n <= MAX_SERIAL_WIDTH)
-                .ok_or_else(|| {
-                    format!("{{{body}}}: a serial's width is a number up to {MAX_SERIAL_WIDTH}, e.g. {{serial:05}}")
-                })?;
+                .ok_or_else(|| TemplateError::SerialWidth { body: body.into() })?;
             Field::Serial(Some(width))
         }
         ("part", None) => Field::Part,
@@ -503,19 +508,20 @@ fn field(body: &str) -> Result<Field, String> {
         ("date", f) => Field::Date(strftime(f.unwrap_or("%Y-%m-%d"), body)?),
         ("time", f) => Field::Time(strftime(f.unwrap_or("%H:%M"), body)?),
         ("csv", Some(c)) if !c.trim().is_empty() => Field::Csv(c.trim().to_string()),
-        ("csv", _) => return Err(format!("{{{body}}}: name the column, e.g. {{csv:lot}}")),
-        _ => return Err(unknown()),
+        ("csv", _) => return Err(TemplateError::NoColumnName { body: body.into() }),
+        _ => return Err(TemplateError::UnknownField { body: body.into() }),
     };
     Ok(f)
 }
 
 /// A strftime format checked in full (chrono panics at display time on a bad one).
-fn strftime(format: &str, body: &str) -> Result<String, String> {
+fn strftime(format: &str, body: &str) -> Result<String, TemplateError> {
     use chrono::format::{Item, StrftimeItems};
     if StrftimeItems::new(format).any(|i| matches!(i, Item::Error)) {
-        return Err(format!(
-            "{{{body}}}: '{format}' is not a strftime format (e.g. %Y-%m-%d)"
-        ));
+        return Err(TemplateError::BadFormat {
+            body: body.into(),
+            format: format.into(),
+        });
     }
     Ok(format.to_string())
 }
@@ -534,7 +540,7 @@ pub struct PartValues<'a> {
 }
 
 /// The text of `pieces` for one part; `Err` names what is missing (a CSV column or row).
-pub fn render(pieces: &[Piece], v: &PartValues) -> Result<String, String> {
+pub fn render(pieces: &[Piece], v: &PartValues) -> Result<String, TemplateError> {
     let mut out = String::new();
     for p in pieces {
         match p {
@@ -547,31 +553,98 @@ pub fn render(pieces: &[Piece], v: &PartValues) -> Result<String, String> {
                 Field::Col => out.push_str(&v.slot.col.to_string()),
                 Field::Date(f) | Field::Time(f) => out.push_str(&v.stamp.0.format(f).to_string()),
                 Field::Csv(c) => {
-                    let data = v.data.ok_or_else(|| {
-                        format!("{{csv:{c}}} needs a data file (--data FILE.csv)")
-                    })?;
-                    if !data.header.iter().any(|h| h == c) {
-                        return Err(format!(
-                            "{}: no column '{c}' (columns: {})",
-                            data.file,
-                            data.header.join(", ")
-                        ));
-                    }
-                    let value = data.value(c, v.slot.part).ok_or_else(|| {
-                        format!(
-                            "{}: {} data rows, but part {} needs row {}",
-                            data.file,
-                            data.rows.len(),
-                            v.slot.part,
-                            v.slot.part
-                        )
-                    })?;
+                    let data = v
+                        .data
+                        .ok_or_else(|| TemplateError::NoData { column: c.clone() })?;
+                    data.check_column(c)?;
+                    let value =
+                        data.value(c, v.slot.part)
+                            .ok_or_else(|| TemplateError::MissingRow {
+                                file: data.file.clone(),
+                                rows: data.rows.len(),
+                                part: v.slot.part,
+                            })?;
                     out.push_str(value);
                 }
             },
         }
     }
     Ok(out)
+}
+
+/// Why a template text cannot be read or rendered for a part. The messages say what is wrong
+/// with the field; the caller names the text and where it is.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+pub enum TemplateError {
+    /// A `}` that closes no field (write `}}` for a brace).
+    #[error("an unbalanced '}}' at character {at}")]
+    UnbalancedClose {
+        /// Where it is in the text, from 1.
+        at: usize,
+    },
+    /// A `{` whose field is never closed (write `{{` for a brace).
+    #[error("an unbalanced '{{' at character {at}")]
+    UnbalancedOpen {
+        /// Where it is in the text, from 1.
+        at: usize,
+    },
+    /// A field that is none of the known ones.
+    #[error(
+        "unknown field {{{body}}} (fields: serial, serial:05, part, row, col, date, time, \
+         csv:COLUMN)"
+    )]
+    UnknownField {
+        /// The field as written between its braces.
+        body: String,
+    },
+    /// A serial's width that is not a number up to [`MAX_SERIAL_WIDTH`].
+    #[error(
+        "{{{body}}}: a serial's width is a number up to {MAX_SERIAL_WIDTH}, e.g. {{serial:05}}"
+    )]
+    SerialWidth {
+        /// The field as written between its braces.
+        body: String,
+    },
+    /// A date or time field whose format is not strftime.
+    #[error("{{{body}}}: '{format}' is not a strftime format (e.g. %Y-%m-%d)")]
+    BadFormat {
+        /// The field as written between its braces.
+        body: String,
+        /// The format it gives.
+        format: String,
+    },
+    /// A `{csv:}` field without a column name.
+    #[error("{{{body}}}: name the column, e.g. {{csv:lot}}")]
+    NoColumnName {
+        /// The field as written between its braces.
+        body: String,
+    },
+    /// A `{csv:COLUMN}` field with no data file given.
+    #[error("{{csv:{column}}} needs a data file (--data FILE.csv)")]
+    NoData {
+        /// The column the field names.
+        column: String,
+    },
+    /// A `{csv:COLUMN}` field naming a column the data file does not have.
+    #[error("{file}: no column '{column}' (columns: {})", columns.join(", "))]
+    MissingColumn {
+        /// The data file.
+        file: String,
+        /// The column the field names.
+        column: String,
+        /// The columns the file has.
+        columns: Vec<String>,
+    },
+    /// A part beyond the data file's rows.
+    #[error("{file}: {rows} data rows, but part {part} needs row {part}")]
+    MissingRow {
+        /// The data file.
+        file: String,
+        /// The rows it has.
+        rows: usize,
+        /// The part (its row number).
+        part: u32,
+    },
 }
 
 /// How a template's lines sit on its anchor, along the baseline.
@@ -926,7 +999,11 @@ mod tests {
     #[test]
     fn bad_templates_say_what_is_wrong() {
         for (t, says) in [
-            ("SN {seriall}", "unknown field {seriall}"),
+            (
+                "SN {seriall}",
+                "unknown field {seriall} (fields: serial, serial:05, part, row, col, date, time, \
+                 csv:COLUMN)",
+            ),
             ("SN {serial", "unbalanced '{'"),
             ("SN serial}", "unbalanced '}'"),
             ("{date:%Q}", "not a strftime format"),
@@ -934,7 +1011,7 @@ mod tests {
             ("{serial:abc}", "width"),
             ("a {b {c}", "unbalanced '{'"),
         ] {
-            let e = parse_template(t).unwrap_err();
+            let e = parse_template(t).unwrap_err().to_string();
             assert!(e.contains(says), "{t}: {e}");
         }
         let data = DataTable {
@@ -943,13 +1020,17 @@ mod tests {
             rows: vec![vec!["A1".into()]],
         };
         let p = parse_template("{csv:op}").unwrap();
-        assert!(render(&p, &values(Some(&data)))
-            .unwrap_err()
-            .contains("no column 'op'"));
+        assert_eq!(
+            render(&p, &values(Some(&data))).unwrap_err().to_string(),
+            "lots.csv: no column 'op' (columns: lot)"
+        );
         let p = parse_template("{csv:lot}").unwrap();
-        let e = render(&p, &values(Some(&data))).unwrap_err();
+        let e = render(&p, &values(Some(&data))).unwrap_err().to_string();
         assert!(e.contains("1 data rows, but part 2"), "{e}");
-        assert!(render(&p, &values(None)).unwrap_err().contains("--data"));
+        assert_eq!(
+            render(&p, &values(None)).unwrap_err().to_string(),
+            "{csv:lot} needs a data file (--data FILE.csv)"
+        );
     }
 
     #[test]

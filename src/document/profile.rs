@@ -57,17 +57,29 @@ fn default_velocity_mm_s() -> f64 {
     AxisLimits::default().max_velocity_mm_s
 }
 
+/// Why an axis table of a profile file cannot be read (serde adds the table's place).
+#[derive(Debug, Clone, PartialEq, Error)]
+enum AxisLimitsError {
+    /// Both ways of giving the acceleration.
+    #[error("give max_accel_mm_s2 or ramp_s, not both")]
+    AccelAndRamp,
+    /// A ramp time that is not a positive number.
+    #[error("ramp_s = {ramp_s} must be a positive number")]
+    Ramp {
+        /// The ramp time given, s.
+        ramp_s: f64,
+    },
+}
+
 impl TryFrom<AxisLimitsFile> for AxisLimits {
-    type Error = String;
-    fn try_from(f: AxisLimitsFile) -> Result<Self, String> {
+    type Error = AxisLimitsError;
+    fn try_from(f: AxisLimitsFile) -> Result<Self, AxisLimitsError> {
         let max_accel_mm_s2 = match (f.max_accel_mm_s2, f.ramp_s) {
-            (Some(_), Some(_)) => {
-                return Err("give max_accel_mm_s2 or ramp_s, not both".into());
-            }
+            (Some(_), Some(_)) => return Err(AxisLimitsError::AccelAndRamp),
             (Some(a), None) => a,
             (None, Some(ramp_s)) => {
                 if !(ramp_s.is_finite() && ramp_s > 0.0) {
-                    return Err(format!("ramp_s = {ramp_s} must be a positive number"));
+                    return Err(AxisLimitsError::Ramp { ramp_s });
                 }
                 f.max_velocity_mm_s / ramp_s
             }

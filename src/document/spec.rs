@@ -8,6 +8,7 @@ use super::{
     MotionMode, Pen, SolverSettings, StageRouteKind, MAX_PASSES,
 };
 use crate::geom::MAX_COORD_MM;
+use thiserror::Error;
 
 /// What a value must be.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -58,7 +59,7 @@ pub struct FieldSpec<T> {
     /// The number the rule checks (none: unset, or not a number).
     pub number: fn(&T) -> Option<f64>,
     /// Sets the value from text (a choice is not set from text).
-    pub parse: fn(&mut T, &str) -> Result<(), String>,
+    pub parse: fn(&mut T, &str) -> Result<(), ValueError>,
 }
 
 impl<T> Clone for FieldSpec<T> {
@@ -119,9 +120,61 @@ impl<T> FieldSpec<T> {
         }
     }
     /// Sets the value from the text an operator typed; the message names the setting.
-    pub fn set_text(&self, t: &mut T, text: &str) -> Result<(), String> {
-        (self.parse)(t, text).map_err(|e| format!("{} {e}", self.words()))
+    pub fn set_text(&self, t: &mut T, text: &str) -> Result<(), InvalidText> {
+        (self.parse)(t, text).map_err(|error| InvalidText {
+            setting: self.words(),
+            error,
+        })
     }
+}
+
+/// Why a typed text is not a value; the message follows the setting's words (`Passes must be
+/// a whole number (0 or more), not 'x'`).
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum ValueError {
+    /// Not a number.
+    #[error("must be a number, not '{text}'")]
+    NotANumber {
+        /// The text, trimmed.
+        text: String,
+    },
+    /// A number that is not finite (`inf`, `NaN`).
+    #[error("must be a finite number, not '{text}'")]
+    NotFinite {
+        /// The text, trimmed.
+        text: String,
+    },
+    /// Not a whole number of 0 or more.
+    #[error("must be a whole number (0 or more), not '{text}'")]
+    NotWhole {
+        /// The text, trimmed.
+        text: String,
+    },
+    /// A whole number too large for the value's type.
+    #[error("must be smaller, not {value}")]
+    TooLarge {
+        /// The number typed.
+        value: u64,
+    },
+    /// A seam width that is not a number.
+    #[error("'{text}' is not a number")]
+    NotAWidth {
+        /// The text, trimmed.
+        text: String,
+    },
+    /// A value chosen from a list, which text does not set.
+    #[error("chosen from a list")]
+    Chosen,
+}
+
+/// A typed text that is not a value of the setting: the setting's words and why.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[error("{setting} {error}")]
+pub struct InvalidText {
+    /// The setting in words with its unit, as the editors show it (`Passes`).
+    pub setting: String,
+    /// What is wrong with the text.
+    pub error: ValueError,
 }
 
 /// Checks every value of `t` against its table.
@@ -152,20 +205,22 @@ pub fn differences<T>(specs: &[FieldSpec<T>], old: &T, new: &T) -> Vec<String> {
 }
 
 /// A number typed by the operator.
-pub fn parse_number(s: &str) -> Result<f64, String> {
-    let v: f64 = s
-        .trim()
-        .parse()
-        .map_err(|_| format!("must be a number, not '{}'", s.trim()))?;
+pub fn parse_number(s: &str) -> Result<f64, ValueError> {
+    let text = s.trim();
+    let v: f64 = text.parse().map_err(|_| ValueError::NotANumber {
+        text: text.to_string(),
+    })?;
     if v.is_finite() {
         Ok(v)
     } else {
-        Err(format!("must be a finite number, not '{}'", s.trim()))
+        Err(ValueError::NotFinite {
+            text: text.to_string(),
+        })
     }
 }
 
 /// An optional number: empty text is none.
-pub fn parse_optional(s: &str) -> Result<Option<f64>, String> {
+pub fn parse_optional(s: &str) -> Result<Option<f64>, ValueError> {
     if s.trim().is_empty() {
         Ok(None)
     } else {
@@ -174,10 +229,11 @@ pub fn parse_optional(s: &str) -> Result<Option<f64>, String> {
 }
 
 /// A whole number typed by the operator.
-pub fn parse_whole(s: &str) -> Result<u64, String> {
-    s.trim()
-        .parse()
-        .map_err(|_| format!("must be a whole number (0 or more), not '{}'", s.trim()))
+pub fn parse_whole(s: &str) -> Result<u64, ValueError> {
+    let text = s.trim();
+    text.parse().map_err(|_| ValueError::NotWhole {
+        text: text.to_string(),
+    })
 }
 
 fn show(v: f64) -> String {
@@ -188,8 +244,8 @@ fn show_opt(v: Option<f64>) -> String {
     v.map(show).unwrap_or_default()
 }
 
-fn no_text<T>(_: &mut T, _: &str) -> Result<(), String> {
-    Err("chosen from a list".into())
+fn no_text<T>(_: &mut T, _: &str) -> Result<(), ValueError> {
+    Err(ValueError::Chosen)
 }
 
 fn no_number<T>(_: &T) -> Option<f64> {
@@ -253,7 +309,7 @@ macro_rules! whole {
             number: |$t| Some($place as f64),
             parse: |$t, s| {
                 let v = parse_whole(s)?;
-                $place = <$ty>::try_from(v).map_err(|_| format!("must be smaller, not {v}"))?;
+                $place = <$ty>::try_from(v).map_err(|_| ValueError::TooLarge { value: v })?;
                 Ok(())
             },
         }
@@ -544,7 +600,7 @@ pub fn profile_specs() -> Vec<FieldSpec<MachineProfile>> {
                     None
                 } else {
                     let v = parse_whole(s)?;
-                    Some(u32::try_from(v).map_err(|_| format!("must be smaller, not {v}"))?)
+                    Some(u32::try_from(v).map_err(|_| ValueError::TooLarge { value: v })?)
                 };
                 Ok(())
             },
@@ -704,7 +760,7 @@ pub fn settings_specs() -> Vec<FieldSpec<SolverSettings>> {
                     None
                 } else {
                     let v = parse_whole(s)?;
-                    Some(usize::try_from(v).map_err(|_| format!("must be smaller, not {v}"))?)
+                    Some(usize::try_from(v).map_err(|_| ValueError::TooLarge { value: v })?)
                 };
                 Ok(())
             },
@@ -858,7 +914,9 @@ fn seam_width_spec() -> FieldSpec<Pen> {
             if s.is_empty() {
                 return Ok(());
             }
-            let w: f64 = s.parse().map_err(|_| format!("'{s}' is not a number"))?;
+            let w: f64 = s.parse().map_err(|_| ValueError::NotAWidth {
+                text: s.to_string(),
+            })?;
             p.seam = match p.seam {
                 SeamForm::Straight => SeamForm::Straight,
                 SeamForm::Overlap { doubled, .. } => SeamForm::Overlap {
@@ -1048,8 +1106,38 @@ mod tests {
         let passes = pen.iter().find(|s| s.key == "passes").unwrap();
         let mut bad = Pen::default();
         assert_eq!(
-            passes.set_text(&mut bad, "x").unwrap_err(),
+            passes.set_text(&mut bad, " x ").unwrap_err().to_string(),
             "Passes must be a whole number (0 or more), not 'x'"
+        );
+        assert_eq!(
+            passes
+                .set_text(&mut bad, "5000000000")
+                .unwrap_err()
+                .to_string(),
+            "Passes must be smaller, not 5000000000"
+        );
+        let speed = pen.iter().find(|s| s.key == "mark_speed_mm_s").unwrap();
+        assert_eq!(
+            speed.set_text(&mut bad, "fast").unwrap_err().to_string(),
+            "Mark speed (mm/s) must be a number, not 'fast'"
+        );
+        assert_eq!(
+            speed.set_text(&mut bad, "inf").unwrap_err().to_string(),
+            "Mark speed (mm/s) must be a finite number, not 'inf'"
+        );
+        let marked = pen.iter().find(|s| s.key == "enabled").unwrap();
+        assert_eq!(
+            marked.set_text(&mut bad, "yes").unwrap_err().to_string(),
+            "Marked chosen from a list"
+        );
+        let mut seamed = Pen {
+            seam: crate::geom::seam::SeamForm::Interlocked { band_mm: 0.5 },
+            ..Pen::default()
+        };
+        let width = pen.iter().find(|s| s.key == "seam_mm").unwrap();
+        assert_eq!(
+            width.set_text(&mut seamed, "wide").unwrap_err().to_string(),
+            "Seam width (mm) 'wide' is not a number"
         );
         bad.passes = 0;
         assert!(passes.check(&bad).is_err());

@@ -29,6 +29,7 @@ use super::{polyline_length, Pt};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
+use thiserror::Error;
 
 /// Pieces shorter than this are dropped, mm: below the resolution of the exported G-code (a
 /// crumb where a cut passes near a vertex would print as no move at all).
@@ -82,30 +83,33 @@ impl SeamForm {
 
     /// Parses `straight`, `overlap:D[:doubled]`, `interlocked:BAND` or `staggered:BAND[:SEED]`
     /// (mm).
-    pub fn parse(spec: &str) -> Result<Self, String> {
+    pub fn parse(spec: &str) -> Result<Self, SeamParseError> {
         let parts: Vec<&str> = spec.trim().split(':').map(str::trim).collect();
-        let mm = |k: usize, what: &str| -> Result<f64, String> {
-            let text = parts
-                .get(k)
-                .ok_or_else(|| format!("seam '{spec}': {what} missing (mm)"))?;
-            let v: f64 = text
-                .parse()
-                .map_err(|_| format!("seam '{spec}': {what} '{text}' is not a number"))?;
+        let mm = |k: usize, what: &'static str| -> Result<f64, SeamParseError> {
+            let text = parts.get(k).ok_or_else(|| SeamParseError::Missing {
+                spec: spec.into(),
+                what,
+            })?;
+            let v: f64 = text.parse().map_err(|_| SeamParseError::NotANumber {
+                spec: spec.into(),
+                what,
+                text: (*text).into(),
+            })?;
             if !(v > 0.0 && v <= MAX_SEAM_BAND_MM) {
-                return Err(format!(
-                    "seam '{spec}': {what} must be above 0 and at most {MAX_SEAM_BAND_MM} mm"
-                ));
+                return Err(SeamParseError::OutOfRange {
+                    spec: spec.into(),
+                    what,
+                });
             }
             Ok(v)
         };
-        let extra = |n: usize| -> Result<(), String> {
-            if parts.len() > n {
-                Err(format!(
-                    "seam '{spec}': unexpected '{}'",
-                    parts[n..].join(":")
-                ))
-            } else {
-                Ok(())
+        let extra = |n: usize| -> Result<(), SeamParseError> {
+            match parts.get(n..) {
+                Some(rest) if !rest.is_empty() => Err(SeamParseError::Unexpected {
+                    spec: spec.into(),
+                    rest: rest.join(":"),
+                }),
+                _ => Ok(()),
             }
         };
         let form = match parts[0] {
@@ -118,9 +122,10 @@ impl SeamForm {
                     None | Some("kept") => false,
                     Some("doubled") => true,
                     Some(other) => {
-                        return Err(format!(
-                            "seam '{spec}': '{other}' is neither 'kept' nor 'doubled'"
-                        ))
+                        return Err(SeamParseError::OverlapKind {
+                            spec: spec.into(),
+                            word: other.into(),
+                        })
                     }
                 };
                 extra(3)?;
@@ -138,9 +143,10 @@ impl SeamForm {
             "staggered" => {
                 let seed = match parts.get(2) {
                     None => 1,
-                    Some(s) => s
-                        .parse()
-                        .map_err(|_| format!("seam '{spec}': seed '{s}' is not a whole number"))?,
+                    Some(s) => s.parse().map_err(|_| SeamParseError::Seed {
+                        spec: spec.into(),
+                        text: (*s).into(),
+                    })?,
                 };
                 extra(3)?;
                 SeamForm::Staggered {
@@ -148,11 +154,7 @@ impl SeamForm {
                     seed,
                 }
             }
-            other => {
-                return Err(format!(
-                    "seam '{other}': expected straight, overlap:D[:doubled], interlocked:BAND or staggered:BAND[:SEED]"
-                ))
-            }
+            other => return Err(SeamParseError::UnknownForm { form: other.into() }),
         };
         Ok(form)
     }
@@ -199,10 +201,74 @@ impl std::fmt::Display for SeamForm {
 }
 
 impl TryFrom<String> for SeamForm {
-    type Error = String;
-    fn try_from(s: String) -> Result<Self, String> {
+    type Error = SeamParseError;
+    fn try_from(s: String) -> Result<Self, SeamParseError> {
         SeamForm::parse(&s)
     }
+}
+
+/// Why a seam form (`--seam`, a pen's `seam`) does not read; every message quotes it.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum SeamParseError {
+    /// The form's width is not given.
+    #[error("seam '{spec}': {what} missing (mm)")]
+    Missing {
+        /// The seam form as given.
+        spec: String,
+        /// The width it lacks (`overlap`, `band`).
+        what: &'static str,
+    },
+    /// The form's width is not a number.
+    #[error("seam '{spec}': {what} '{text}' is not a number")]
+    NotANumber {
+        /// The seam form as given.
+        spec: String,
+        /// The width (`overlap`, `band`).
+        what: &'static str,
+        /// Its text.
+        text: String,
+    },
+    /// The form's width is 0 or less, or beyond [`MAX_SEAM_BAND_MM`].
+    #[error("seam '{spec}': {what} must be above 0 and at most {MAX_SEAM_BAND_MM} mm")]
+    OutOfRange {
+        /// The seam form as given.
+        spec: String,
+        /// The width (`overlap`, `band`).
+        what: &'static str,
+    },
+    /// More parts than the form takes.
+    #[error("seam '{spec}': unexpected '{rest}'")]
+    Unexpected {
+        /// The seam form as given.
+        spec: String,
+        /// The parts beyond the form, as written.
+        rest: String,
+    },
+    /// An overlap's third part that is neither `kept` nor `doubled`.
+    #[error("seam '{spec}': '{word}' is neither 'kept' nor 'doubled'")]
+    OverlapKind {
+        /// The seam form as given.
+        spec: String,
+        /// The word given.
+        word: String,
+    },
+    /// A staggered seam's seed that is not a whole number.
+    #[error("seam '{spec}': seed '{text}' is not a whole number")]
+    Seed {
+        /// The seam form as given.
+        spec: String,
+        /// The seed's text.
+        text: String,
+    },
+    /// None of the forms.
+    #[error(
+        "seam '{form}': expected straight, overlap:D[:doubled], interlocked:BAND or \
+         staggered:BAND[:SEED]"
+    )]
+    UnknownForm {
+        /// The form's name as given.
+        form: String,
+    },
 }
 
 impl From<SeamForm> for String {
@@ -744,8 +810,32 @@ mod tests {
             let f = SeamForm::parse(s).unwrap();
             assert_eq!(SeamForm::parse(&f.to_string()).unwrap(), f);
         }
-        assert!(SeamForm::parse("overlap").unwrap_err().contains("missing"));
-        assert!(SeamForm::parse("interlocked:-1").is_err());
-        assert!(SeamForm::parse("comb:1").unwrap_err().contains("expected"));
+        let says = |spec: &str| SeamForm::parse(spec).unwrap_err().to_string();
+        assert_eq!(says("overlap"), "seam 'overlap': overlap missing (mm)");
+        assert_eq!(
+            says("interlocked:-1"),
+            "seam 'interlocked:-1': band must be above 0 and at most 10 mm"
+        );
+        assert_eq!(
+            says("interlocked:x"),
+            "seam 'interlocked:x': band 'x' is not a number"
+        );
+        assert_eq!(
+            says("straight:1:2"),
+            "seam 'straight:1:2': unexpected '1:2'"
+        );
+        assert_eq!(
+            says("overlap:1:twice"),
+            "seam 'overlap:1:twice': 'twice' is neither 'kept' nor 'doubled'"
+        );
+        assert_eq!(
+            says("staggered:1:-3"),
+            "seam 'staggered:1:-3': seed '-3' is not a whole number"
+        );
+        assert_eq!(
+            says("comb:1"),
+            "seam 'comb': expected straight, overlap:D[:doubled], interlocked:BAND or \
+             staggered:BAND[:SEED]"
+        );
     }
 }

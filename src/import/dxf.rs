@@ -14,7 +14,7 @@
 //! that is off still shows its block's entities on other layers (those on layer 0 take the
 //! insert's layer, and are off with it); an INSERT on a frozen layer shows nothing.
 
-use super::curves::{bulge_arc, fit_point_spline, Affine, ConicArc, Nurbs};
+use super::curves::{bulge_arc, fit_point_spline, Affine, ConicArc, Nurbs, SplineProblem};
 use super::dxf_scan::{self, ScannedEntity};
 use super::dxf_text::{self, TextRun};
 use super::fonts::BUNDLED_CAP_HEIGHT_EM;
@@ -514,7 +514,7 @@ impl<'d> Walk<'d> {
         let tol = self.opts.chord_tol_mm.max(1e-6);
         match curve_paths(&e.specific, m, tol) {
             Ok(Some(paths)) => return self.push_paths(paths, &element, &layer),
-            Err(why) if why == BEYOND => return Err(self.beyond(&element, &layer)),
+            Err(CurveError::Beyond) => return Err(self.beyond(&element, &layer)),
             Err(why) => {
                 self.warn(element, &layer, format!("{why}; skipped"));
                 return Ok(());
@@ -814,10 +814,43 @@ impl<'d> Walk<'d> {
     }
 }
 
+/// Why a curve entity is not imported: [`CurveError::Beyond`] refuses the file, the others skip
+/// the entity with a warning.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+enum CurveError {
+    /// A point, radius or text height past [`MAX_COORD_MM`].
+    #[error("{}", BEYOND)]
+    Beyond,
+    /// Not in the XY plane.
+    #[error("{}", OFF_PLANE)]
+    OffPlane,
+    /// A spline of negative degree.
+    #[error("negative degree")]
+    NegativeDegree,
+    /// A spline whose definition does not hold (counts, knots, weights).
+    #[error("invalid spline: {0}")]
+    InvalidSpline(SplineProblem),
+    /// A spline that cannot be flattened (its reason).
+    #[error("{0}")]
+    Flatten(&'static str),
+    /// A fit-point spline that flattens to more than [`MAX_POINTS`] vertices.
+    #[error(
+        "flattens to more than {MAX_POINTS} vertices at a chord tolerance of {tol} drawing \
+         units; raise the chord tolerance"
+    )]
+    TooManyPoints {
+        /// The chord tolerance, drawing units.
+        tol: f64,
+    },
+    /// A spline with neither control points nor fit points.
+    #[error("spline without control points or fit points")]
+    Empty,
+}
+
 /// The paths of a curve entity (LINE, LWPOLYLINE, ARC, CIRCLE, ELLIPSE, SPLINE) under `m`,
 /// flattened within `tol` mm; `Ok(None)` for other entities, `Err` with the reason to skip one.
-fn curve_paths(t: &EntityType, m: &Affine, tol: f64) -> Result<Option<Vec<Outline>>, String> {
-    let planar = |n: &::dxf::Vector| ocs(n).map(|o| m.then(o)).ok_or(OFF_PLANE);
+fn curve_paths(t: &EntityType, m: &Affine, tol: f64) -> Result<Option<Vec<Outline>>, CurveError> {
+    let planar = |n: &::dxf::Vector| ocs(n).map(|o| m.then(o)).ok_or(CurveError::OffPlane);
     let path = match t {
         EntityType::Line(l) => (vec![m.apply(pt(&l.p1)), m.apply(pt(&l.p2))], false),
         EntityType::LwPolyline(p) => {
@@ -854,8 +887,12 @@ fn curve_paths(t: &EntityType, m: &Affine, tol: f64) -> Result<Option<Vec<Outlin
 }
 
 /// An ELLIPSE (WCS centre and major axis; the normal's sign sets the direction).
-fn ellipse_path(el: &::dxf::entities::Ellipse, m: &Affine, tol: f64) -> Result<Outline, String> {
-    ocs(&el.normal).ok_or(OFF_PLANE)?;
+fn ellipse_path(
+    el: &::dxf::entities::Ellipse,
+    m: &Affine,
+    tol: f64,
+) -> Result<Outline, CurveError> {
+    ocs(&el.normal).ok_or(CurveError::OffPlane)?;
     let major = Pt::new(el.major_axis.x, el.major_axis.y);
     let side = if el.normal.z < 0.0 { -1.0 } else { 1.0 };
     let minor = Pt::new(-major.y, major.x).scale(el.minor_axis_ratio * side);
@@ -920,13 +957,13 @@ fn bounded(p: Pt) -> bool {
 }
 
 /// The arc when it lies within the coordinate limit (checked before it is flattened).
-fn bounded_arc(arc: ConicArc) -> Result<ConicArc, String> {
+fn bounded_arc(arc: ConicArc) -> Result<ConicArc, CurveError> {
     let reach = arc.u.norm() + arc.v.norm();
     let ok = arc.t0.is_finite() && arc.t1.is_finite() && reach <= MAX_COORD_MM && bounded(arc.c);
     if ok {
         Ok(arc)
     } else {
-        Err(BEYOND.into())
+        Err(CurveError::Beyond)
     }
 }
 
@@ -942,21 +979,26 @@ fn closed_conic(arc: &ConicArc, tol: f64) -> Vec<Pt> {
     out
 }
 
-fn spline_paths(s: &::dxf::entities::Spline, m: &Affine, tol: f64) -> Result<Vec<Outline>, String> {
+fn spline_paths(
+    s: &::dxf::entities::Spline,
+    m: &Affine,
+    tol: f64,
+) -> Result<Vec<Outline>, CurveError> {
     if s.normal.x.abs() > NORMAL_TOL || s.normal.y.abs() > NORMAL_TOL {
-        return Err("not parallel to the XY plane (3D)".into());
+        return Err(CurveError::OffPlane);
     }
     let closed = s.flags & 1 != 0;
     if !s.control_points.is_empty() {
-        let degree =
-            usize::try_from(s.degree_of_curve).map_err(|_| "negative degree".to_string())?;
+        let degree = usize::try_from(s.degree_of_curve).map_err(|_| CurveError::NegativeDegree)?;
         let ctrl: Vec<Pt> = s.control_points.iter().map(|p| m.apply(pt(p))).collect();
         if !ctrl.iter().all(|&p| bounded(p)) {
-            return Err(BEYOND.into());
+            return Err(CurveError::Beyond);
         }
         let nurbs = Nurbs::new(degree, s.knot_values.clone(), &ctrl, &s.weight_values)
-            .map_err(|why| format!("invalid spline: {why}"))?;
-        let paths = nurbs.flatten(tol, MAX_POINTS)?;
+            .map_err(CurveError::InvalidSpline)?;
+        let paths = nurbs
+            .flatten(tol, MAX_POINTS)
+            .map_err(CurveError::Flatten)?;
         let closed = closed && paths.len() == 1;
         Ok(paths.into_iter().map(|p| (p, closed)).collect())
     } else if s.fit_points.len() >= 2 {
@@ -968,16 +1010,13 @@ fn spline_paths(s: &::dxf::entities::Spline, m: &Affine, tol: f64) -> Result<Vec
         let spans = fit_point_spline(&fit, tangent(&s.start_tangent), tangent(&s.end_tangent));
         let mapped: Vec<[Pt; 4]> = spans.iter().map(|b| b.map(|p| m.apply(p))).collect();
         if !mapped.iter().flatten().all(|&p| bounded(p)) {
-            return Err(BEYOND.into());
+            return Err(CurveError::Beyond);
         }
         let chords = mapped.iter().fold(0usize, |n, &[p0, p1, p2, p3]| {
             n.saturating_add(cubic_chords(p0, p1, p2, p3, tol))
         });
         if chords > MAX_POINTS {
-            return Err(format!(
-                "flattens to more than {MAX_POINTS} vertices at a chord tolerance of {tol} \
-                 drawing units; raise the chord tolerance"
-            ));
+            return Err(CurveError::TooManyPoints { tol });
         }
         let mut out = vec![m.apply(fit[0])];
         for [p0, p1, p2, p3] in mapped {
@@ -985,7 +1024,7 @@ fn spline_paths(s: &::dxf::entities::Spline, m: &Affine, tol: f64) -> Result<Vec
         }
         Ok(vec![(out, closed)])
     } else {
-        Err("spline without control points or fit points".into())
+        Err(CurveError::Empty)
     }
 }
 

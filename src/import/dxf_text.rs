@@ -9,7 +9,7 @@
 use super::curves::Affine;
 use super::fonts::{database, BUNDLED_CAP_HEIGHT_EM, BUNDLED_FAMILY};
 use super::svg::{text_outlines, Outline, PX_TO_MM};
-use super::{ImportOptions, Warning};
+use super::{ImportOptions, TextError, Warning};
 use crate::document::TextAlign;
 use crate::geom::Pt;
 use ::dxf::entities::{MText, Text};
@@ -22,7 +22,7 @@ const MTEXT_LINE_PITCH: f64 = 5.0 / 3.0;
 /// DejaVu Sans' descent (483 / 2048 em): the bottom of TEXT's "bottom" justification.
 const DESCENT_EM: f64 = 483.0 / 2048.0;
 /// Longest text laid out per entity (characters): more is not a marking job.
-const MAX_TEXT_CHARS: usize = 10_000;
+pub(super) const MAX_TEXT_CHARS: usize = 10_000;
 
 /// Horizontal anchor of the lines.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -305,16 +305,13 @@ pub fn outlines(
     opts: &ImportOptions,
     tol: f64,
     budget: usize,
-) -> Result<(Vec<Outline>, Vec<Warning>), String> {
+) -> Result<(Vec<Outline>, Vec<Warning>), TextError> {
     if !(run.height.is_finite() && run.height > 0.0) {
-        return Err(format!(
-            "text height {} is not a positive number",
-            run.height
-        ));
+        return Err(TextError::Height { height: run.height });
     }
     let chars: usize = run.lines.iter().map(|l| l.chars().count()).sum();
     if chars > MAX_TEXT_CHARS {
-        return Err(format!("{chars} characters (more than {MAX_TEXT_CHARS})"));
+        return Err(TextError::TooLong { chars });
     }
     let (h, v) = run.anchor;
     let align = match h {
@@ -370,7 +367,7 @@ pub fn glyph_outlines(
     opts: &ImportOptions,
     tol: f64,
     budget: usize,
-) -> Result<(Vec<Outline>, Vec<Warning>), String> {
+) -> Result<(Vec<Outline>, Vec<Warning>), TextError> {
     // the SVG is in px: 1 frame unit = 1 mm of the SVG importer's output
     let px = 1.0 / PX_TO_MM;
     let anchor = match layout.align {

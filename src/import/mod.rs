@@ -24,6 +24,7 @@ pub use svg::{import_svg, import_svg_file};
 pub use svg_bounds::USER_MAX;
 pub use template::shape_template;
 
+use crate::document::production::TemplateError;
 use crate::document::{Geometry, TextTemplate};
 use crate::geom::{polyline_length, Pt};
 
@@ -282,6 +283,76 @@ pub enum ImportError {
         file: String,
         /// Why.
         source: PlaceError,
+    },
+}
+
+/// Why a text cannot be laid out as glyph outlines, or why a text with fields does not read. A
+/// DXF import skips a text with its reason; a tray refuses the part with it.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum TextError {
+    /// The text's height is not a positive number.
+    #[error("text height {height} is not a positive number")]
+    Height {
+        /// The height, in drawing units.
+        height: f64,
+    },
+    /// More characters than one text may have.
+    #[error("{chars} characters (more than {})", dxf_text::MAX_TEXT_CHARS)]
+    TooLong {
+        /// The text's characters.
+        chars: usize,
+    },
+    /// The template's frame maps the text to nothing (a zero or infinite scale).
+    #[error("{element}: the text's frame is degenerate")]
+    DegenerateFrame {
+        /// The template's element.
+        element: String,
+    },
+    /// A glyph point beyond [`MAX_COORD_MM`] on the machine.
+    #[error("{element}: a glyph point at ({x:e}, {y:e}) mm is beyond ±{MAX_COORD_MM:e} mm")]
+    GlyphBeyond {
+        /// The template's element.
+        element: String,
+        /// The point's x, mm.
+        x: f64,
+        /// The point's y, mm.
+        y: f64,
+    },
+    /// The glyphs take more vertices than the import has left.
+    #[error("more than {budget} vertices")]
+    TooManyPoints {
+        /// The vertices that were left.
+        budget: usize,
+    },
+    /// The SVG the text is laid out in does not read (the XML parser's reason).
+    #[error("{why}")]
+    Markup {
+        /// The parser's message.
+        why: String,
+    },
+    /// The text cannot be laid out (usvg's reason).
+    #[error("{why}")]
+    Layout {
+        /// usvg's message.
+        why: String,
+    },
+    /// A laid-out point beyond [`MAX_COORD_MM`]: the element and the point.
+    #[error("{detail}")]
+    Beyond {
+        /// The element, the point and the bound.
+        detail: String,
+    },
+    /// An SVG `<text>` whose fields do not read: an unknown field, an unbalanced brace.
+    #[error("{element} (line {line}) text \"{text}\": {why}")]
+    Field {
+        /// The element, as the file writes its start tag.
+        element: String,
+        /// Its line in the file.
+        line: u32,
+        /// The text, trimmed.
+        text: String,
+        /// What is wrong with its fields.
+        why: TemplateError,
     },
 }
 

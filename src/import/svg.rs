@@ -14,8 +14,8 @@ use super::svg_bounds;
 use super::svg_scan;
 use super::template::{self, svg_template, SvgChunk};
 use super::{
-    normalise, nothing_to_mark, placed, short_list, ImportError, ImportOptions, Imported, Warning,
-    MAX_COORD_MM, MAX_POINTS,
+    normalise, nothing_to_mark, placed, short_list, ImportError, ImportOptions, Imported,
+    TextError, Warning, MAX_COORD_MM, MAX_POINTS,
 };
 use crate::document::production::is_template;
 use crate::document::{Geometry, Source, TextAlign, TextTemplate};
@@ -83,13 +83,13 @@ pub fn import_svg(bytes: &[u8], file: &str, opts: &ImportOptions) -> Result<Impo
             root.tag_name().name()
         )));
     }
-    svg_bounds::check(&xml).map_err(|detail| ImportError::Bounds {
+    svg_bounds::check(&xml).map_err(|e| ImportError::Bounds {
         file: file.into(),
-        detail,
+        detail: e.to_string(),
     })?;
-    template::check_svg_texts(&xml).map_err(|detail| ImportError::Field {
+    template::check_svg_texts(&xml).map_err(|e| ImportError::Field {
         file: file.into(),
-        detail,
+        detail: e.to_string(),
     })?;
     let scan = svg_scan::scan(&xml, &opts.hidden_layers);
     // hidden layers the options include: shown by editing their display (same lines)
@@ -209,12 +209,14 @@ pub(super) fn text_outlines(
     opts: &ImportOptions,
     tol_mm: f64,
     budget: usize,
-) -> Result<(Vec<Outline>, Vec<Warning>), String> {
-    let xml = roxmltree::Document::parse(svg).map_err(|e| e.to_string())?;
+) -> Result<(Vec<Outline>, Vec<Warning>), TextError> {
+    let xml =
+        roxmltree::Document::parse(svg).map_err(|e| TextError::Markup { why: e.to_string() })?;
     let (geometries, _, warnings, _) =
         tree_geometries(&xml, opts, tol_mm, budget, false).map_err(|e| match e {
-            TreeError::Malformed(cause) | TreeError::Beyond(cause) => cause,
-            TreeError::TooLarge(_) => format!("more than {budget} vertices"),
+            TreeError::Malformed(why) => TextError::Layout { why },
+            TreeError::Beyond(detail) => TextError::Beyond { detail },
+            TreeError::TooLarge(_) => TextError::TooManyPoints { budget },
         })?;
     let outlines = geometries
         .into_iter()
@@ -236,6 +238,26 @@ fn layer_names(xml: &roxmltree::Document) -> FxHashMap<String, String> {
             Some((id.to_string(), label.to_string()))
         })
         .collect()
+}
+
+/// What makes a mask more than a plain clip (its content is then skipped with a warning).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+enum MaskError {
+    /// A group in the mask with opacity, a mask or filters of its own.
+    #[error("groups with opacity, masks or filters")]
+    GroupEffects,
+    /// A stroked shape in the mask.
+    #[error("a stroked shape")]
+    Stroked,
+    /// A luminance mask's shape that is not opaque white.
+    #[error("a shape that is not opaque white")]
+    NotOpaqueWhite,
+    /// An alpha mask's shape that is not opaque.
+    #[error("a shape that is not opaque")]
+    NotOpaque,
+    /// An image in the mask.
+    #[error("an image")]
+    Image,
 }
 
 struct Walker<'w> {
@@ -426,7 +448,7 @@ impl Walker<'_> {
     /// The region a mask lets through when it is a plain clip (opaque white shapes; for
     /// `mask-type:alpha` any opaque shapes), for an element whose transform is `base`; `Err`
     /// with what makes it more than a clip.
-    fn mask_region(&mut self, m: &usvg::Mask, base: usvg::Transform) -> Result<Region, String> {
+    fn mask_region(&mut self, m: &usvg::Mask, base: usvg::Transform) -> Result<Region, MaskError> {
         let r = m.rect();
         let corner = |x: f32, y: f32| to_mm(base)(usvg::tiny_skia_path::Point::from_xy(x, y));
         let rect = Region::quad([
@@ -448,7 +470,7 @@ impl Walker<'_> {
         g: &usvg::Group,
         base: usvg::Transform,
         kind: usvg::MaskType,
-    ) -> Result<Region, String> {
+    ) -> Result<Region, MaskError> {
         let mut region = Region::default();
         for node in g.children() {
             let r = match node {
@@ -457,7 +479,7 @@ impl Walker<'_> {
                         || child.mask().is_some()
                         || !child.filters().is_empty()
                     {
-                        return Err("groups with opacity, masks or filters".into());
+                        return Err(MaskError::GroupEffects);
                     }
                     let mut r = self.mask_content(child, base, kind)?;
                     if let Some(cp) = child.clip_path() {
@@ -473,7 +495,7 @@ impl Walker<'_> {
                         continue;
                     }
                     if p.stroke().is_some() {
-                        return Err("a stroked shape".into());
+                        return Err(MaskError::Stroked);
                     }
                     let Some(f) = p.fill() else {
                         continue;
@@ -488,8 +510,8 @@ impl Walker<'_> {
                     };
                     if !opaque_white {
                         return Err(match kind {
-                            usvg::MaskType::Luminance => "a shape that is not opaque white".into(),
-                            usvg::MaskType::Alpha => "a shape that is not opaque".into(),
+                            usvg::MaskType::Luminance => MaskError::NotOpaqueWhite,
+                            usvg::MaskType::Alpha => MaskError::NotOpaque,
                         });
                     }
                     let map = to_mm(base.pre_concat(p.abs_transform()));
@@ -500,7 +522,7 @@ impl Walker<'_> {
                     Region::filled(&contours, rule(f.rule()))
                 }
                 usvg::Node::Text(t) => self.mask_content(t.flattened(), base, kind)?,
-                usvg::Node::Image(_) => return Err("an image".into()),
+                usvg::Node::Image(_) => return Err(MaskError::Image),
             };
             region = region.union(&r);
         }

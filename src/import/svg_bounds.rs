@@ -15,6 +15,7 @@
 
 use super::svg_scan::describe;
 use super::{MAX_COORD_MM, MAX_GLYPHS};
+use thiserror::Error;
 use usvg::roxmltree::{Document, Node};
 
 /// Largest coordinate, radius or size in user units, as written in the file (10⁹: 264 km in
@@ -41,9 +42,39 @@ const LENGTHS: &[&str] = &[
     "stroke-width",
 ];
 
-/// Checks every number of every element and the text of the file; `Err` is one line naming the
-/// element, its line and the number.
-pub(super) fn check(xml: &Document) -> Result<(), String> {
+/// An SVG refused before usvg reads it; each message is one line naming the element and its
+/// line.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub(super) enum BoundsError {
+    /// A coordinate, radius or length beyond [`USER_MAX`] user units.
+    #[error(
+        "{element}: {what} of {value:.4e} user units is beyond ±{USER_MAX:e} (a drawing lies \
+         within ±{MAX_COORD_MM:e} mm)"
+    )]
+    Number {
+        /// The element and its line: `<path id="p"> (line 2)`.
+        element: String,
+        /// What the number is: `a coordinate`, `an arc radius`, `the width`.
+        what: String,
+        /// The number, as the file writes it.
+        value: f64,
+    },
+    /// More characters of text than [`MAX_GLYPHS`] in the file, reached at this element.
+    #[error(
+        "{element}: the file's text reaches {glyphs} characters, beyond the {MAX_GLYPHS} \
+         galvoplan lays out in one file; split the text into several files"
+    )]
+    Text {
+        /// The element and its line.
+        element: String,
+        /// The characters counted up to and with it.
+        glyphs: usize,
+    },
+}
+
+/// Checks every number of every element and the text of the file; `Err` names the element,
+/// its line and the number.
+pub(super) fn check(xml: &Document) -> Result<(), BoundsError> {
     let mut glyphs = 0usize;
     for node in xml.descendants().filter(|n| n.is_element()) {
         let where_ = || {
@@ -51,13 +82,12 @@ pub(super) fn check(xml: &Document) -> Result<(), String> {
             format!("{} (line {line})", describe(&node))
         };
         if let Some(d) = node.attribute("d") {
-            path_data(d).map_err(|e| format!("{}: {e}", where_()))?;
+            path_data(d, &where_)?;
         }
         if let Some(points) = node.attribute("points") {
             for (x, y) in svgtypes::PointsParser::from(points) {
-                within(x, "a coordinate")
-                    .and(within(y, "a coordinate"))
-                    .map_err(|e| format!("{}: {e}", where_()))?;
+                within(x, "a coordinate", &where_)?;
+                within(y, "a coordinate", &where_)?;
             }
         }
         for &name in LENGTHS {
@@ -66,18 +96,16 @@ pub(super) fn check(xml: &Document) -> Result<(), String> {
             };
             // a list (`x="1 2 3"` on text) or a single length; what does not parse is usvg's
             for length in svgtypes::LengthListParser::from(value).flatten() {
-                within(length.number, &format!("the {name}"))
-                    .map_err(|e| format!("{}: {e}", where_()))?;
+                within(length.number, &format!("the {name}"), &where_)?;
             }
         }
         if node.tag_name().name() == "text" {
             glyphs += text_chars(&node);
             if glyphs > MAX_GLYPHS {
-                return Err(format!(
-                    "{}: the file's text reaches {glyphs} characters, beyond the {MAX_GLYPHS} \
-                     galvoplan lays out in one file; split the text into several files",
-                    where_()
-                ));
+                return Err(BoundsError::Text {
+                    element: where_(),
+                    glyphs,
+                });
             }
         }
     }
@@ -93,22 +121,24 @@ fn text_chars(node: &Node) -> usize {
         .sum()
 }
 
-/// `v` is finite and within [`USER_MAX`]; `what` names it in the error.
-fn within(v: f64, what: &str) -> Result<(), String> {
+/// `v` is finite and within [`USER_MAX`]; `what` names it in the error, `element` (called only
+/// on an error) the element and its line.
+fn within(v: f64, what: &str, element: &dyn Fn() -> String) -> Result<(), BoundsError> {
     if v.is_finite() && v.abs() <= USER_MAX {
         Ok(())
     } else {
-        Err(format!(
-            "{what} of {v:.4e} user units is beyond ±{USER_MAX:e} (a drawing lies within \
-             ±{MAX_COORD_MM:e} mm)"
-        ))
+        Err(BoundsError::Number {
+            element: element(),
+            what: what.to_string(),
+            value: v,
+        })
     }
 }
 
 /// Checks path data: every point, made absolute as the path is followed, and every arc radius.
 /// Path data that does not parse is left to usvg (which keeps the part before the error, as the
-/// SVG specification asks).
-fn path_data(d: &str) -> Result<(), String> {
+/// SVG specification asks). `element` names the element in the error.
+fn path_data(d: &str, element: &dyn Fn() -> String) -> Result<(), BoundsError> {
     use svgtypes::PathSegment as S;
     let (mut cur, mut start) = ((0.0f64, 0.0f64), (0.0f64, 0.0f64));
     let at = |abs: bool, cur: (f64, f64), x: f64, y: f64| {
@@ -118,7 +148,10 @@ fn path_data(d: &str) -> Result<(), String> {
             (cur.0 + x, cur.1 + y)
         }
     };
-    let point = |p: (f64, f64)| within(p.0, "a coordinate").and(within(p.1, "a coordinate"));
+    let point = |p: (f64, f64)| {
+        within(p.0, "a coordinate", element)?;
+        within(p.1, "a coordinate", element)
+    };
     for segment in svgtypes::PathParser::from(d) {
         let Ok(segment) = segment else {
             break;
@@ -155,7 +188,8 @@ fn path_data(d: &str) -> Result<(), String> {
             S::EllipticalArc {
                 abs, rx, ry, x, y, ..
             } => {
-                within(rx, "an arc radius").and(within(ry, "an arc radius"))?;
+                within(rx, "an arc radius", element)?;
+                within(ry, "an arc radius", element)?;
                 (at(abs, cur, x, y), Vec::new())
             }
             S::ClosePath { .. } => (start, Vec::new()),
@@ -177,9 +211,9 @@ mod tests {
         format!("<svg xmlns=\"http://www.w3.org/2000/svg\">\n{body}\n</svg>")
     }
 
-    fn checked(body: &str) -> Result<(), String> {
+    fn checked(body: &str) -> Result<(), BoundsError> {
         let text = doc(body);
-        let xml = Document::parse(&text).map_err(|e| e.to_string())?;
+        let xml = Document::parse(&text).unwrap();
         check(&xml)
     }
 
@@ -223,7 +257,7 @@ mod tests {
             ),
             ("<text id=\"p\" font-size=\"1e99\">a</text>", "font-size"),
         ] {
-            let e = checked(body).unwrap_err();
+            let e = checked(body).unwrap_err().to_string();
             assert!(
                 e.starts_with("<") && e.contains("id=\"p\"> (line 2)"),
                 "{e}"
@@ -234,13 +268,25 @@ mod tests {
     }
 
     #[test]
+    fn a_number_beyond_says_the_bound_in_one_line() {
+        assert_eq!(
+            checked("<circle id=\"c\" r=\"1e300\"/>")
+                .unwrap_err()
+                .to_string(),
+            "<circle id=\"c\"> (line 2): the r of 1.0000e300 user units is beyond ±1e9 (a \
+             drawing lies within ±1e6 mm)"
+        );
+    }
+
+    #[test]
     fn text_is_bounded_per_file() {
         let a = "x".repeat(MAX_GLYPHS / 2 + 1);
         assert!(checked(&format!("<text>{a}</text>")).is_ok());
         let e = checked(&format!(
             "<text>{a}</text><text id=\"t2\"><tspan>{a}</tspan></text>"
         ))
-        .unwrap_err();
+        .unwrap_err()
+        .to_string();
         assert!(
             e.contains("<text id=\"t2\"> (line 2)") && e.contains("characters"),
             "{e}"

@@ -7,15 +7,15 @@
 
 use super::dxf_text::{glyph_outlines, Layout};
 use super::svg_scan::describe;
-use super::{normalise, ImportOptions, Warning};
+use super::{normalise, ImportOptions, TextError, Warning};
 use crate::document::production::{is_template, parse_template};
 use crate::document::{Geometry, Source, TextAlign, TextTemplate};
-use crate::geom::{within_reach_bound, Pt, MAX_COORD_MM};
+use crate::geom::{within_reach_bound, Pt};
 use usvg::roxmltree::Document;
 
 /// Checks the fields of every SVG `<text>` that holds a brace; `Err` is one line naming the
 /// element, its line and the text.
-pub(super) fn check_svg_texts(xml: &Document) -> Result<(), String> {
+pub(super) fn check_svg_texts(xml: &Document) -> Result<(), TextError> {
     for node in xml
         .descendants()
         .filter(|n| n.is_element() && n.tag_name().name() == "text")
@@ -30,11 +30,12 @@ pub(super) fn check_svg_texts(xml: &Document) -> Result<(), String> {
         }
         if let Err(why) = parse_template(&text) {
             let line = xml.text_pos_at(node.range().start).row;
-            return Err(format!(
-                "{} (line {line}) text \"{}\": {why}",
-                describe(&node),
-                text.trim()
-            ));
+            return Err(TextError::Field {
+                element: describe(&node),
+                line,
+                text: text.trim().to_string(),
+                why,
+            });
         }
     }
     Ok(())
@@ -55,10 +56,12 @@ pub fn shape_template(
     part: u32,
     opts: &ImportOptions,
     budget: usize,
-) -> Result<(Vec<Geometry>, Vec<Warning>), String> {
+) -> Result<(Vec<Geometry>, Vec<Warning>), TextError> {
     let scale = frame_scale(&t.frame);
     if !(scale.is_finite() && scale > 0.0) {
-        return Err(format!("{}: the text's frame is degenerate", t.element));
+        return Err(TextError::DegenerateFrame {
+            element: t.element.clone(),
+        });
     }
     let lines: Vec<String> = text.split('\n').map(str::to_string).collect();
     let layout = Layout {
@@ -78,10 +81,11 @@ pub fn shape_template(
             .map(|q| Pt::new(a * q.x + c * q.y + e, b * q.x + d * q.y + f))
             .collect();
         if let Some(p) = pts.iter().find(|p| !within_reach_bound(**p)) {
-            return Err(format!(
-                "{}: a glyph point at ({:e}, {:e}) mm is beyond ±{MAX_COORD_MM:e} mm",
-                t.element, p.x, p.y
-            ));
+            return Err(TextError::GlyphBeyond {
+                element: t.element.clone(),
+                x: p.x,
+                y: p.y,
+            });
         }
         // a glyph with an empty contour (DejaVu Sans' "u") is no loss
         let Ok((pts, closed)) = normalise(pts, closed) else {
