@@ -132,7 +132,19 @@ impl Words<'_> {
 }
 
 /// The G-code is handed to the writer in pieces of about this many bytes.
-const CHUNK_BYTES: usize = 1 << 16;
+pub(super) const CHUNK_BYTES: usize = 1 << 16;
+
+/// Any writer, sized or not, as a `dyn Write` (the LinuxCNC writer keeps one).
+struct Sink<'a, W: std::io::Write + ?Sized>(&'a mut W);
+
+impl<W: std::io::Write + ?Sized> std::io::Write for Sink<'_, W> {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.0.write(buf)
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.0.flush()
+    }
+}
 
 /// Writes the toolpath of `plan` as G-code in the dialect of the plan's profile; Y is mirrored
 /// about `page_height_mm` when the dialect says `flip_y`. Fields are numbered 1…n in visiting
@@ -157,17 +169,22 @@ pub fn write_gcode_to(
     page_height_mm: f64,
     title: &str,
 ) -> Result<(), GcodeError> {
-    let mut flush = |buf: &mut String| -> Result<(), GcodeError> {
-        sink.write_all(buf.as_bytes())
-            .map_err(|e| GcodeError::Write(e.to_string()))?;
-        buf.clear();
-        Ok(())
-    };
     let profile = &plan.profile;
     let d = &profile.gcode;
     let w = Words {
         profile,
         page_height_mm,
+    };
+    if d.mode == GcodeMode::Linuxcnc {
+        let mut head = String::new();
+        header(&mut head, toolpath, plan, title, true);
+        return super::linuxcnc::write_program(&mut Sink(sink), toolpath, plan, &w, &head);
+    }
+    let mut flush = |buf: &mut String| -> Result<(), GcodeError> {
+        sink.write_all(buf.as_bytes())
+            .map_err(|e| GcodeError::Write(e.to_string()))?;
+        buf.clear();
+        Ok(())
     };
     // one set of words per layer of the plan, and the profile's for strokes without a pen
     let pens: Vec<PenWords> = plan
@@ -184,12 +201,6 @@ pub fn write_gcode_to(
         return Err(GcodeError::StageScannerOnTheFly);
     }
     let scan_axes = [d.scanner_axes[0].as_str(), d.scanner_axes[1].as_str()];
-    if d.mode == GcodeMode::Linuxcnc {
-        let mut head = String::new();
-        header(&mut head, toolpath, plan, title, true);
-        let mut program = super::linuxcnc::write_program(toolpath, plan, &w, &head)?;
-        return flush(&mut program);
-    }
     let mut out = String::with_capacity(CHUNK_BYTES + 4096);
     header(&mut out, toolpath, plan, title, false);
     let _ = writeln!(out, "{}", d.laser_off);

@@ -19,7 +19,7 @@
 //! start and the end, then `M2`. Power goes to an analog output (`M67 E<n> Q<power>`,
 //! synchronised) or, without one, on the profile's power word.
 
-use super::gcode::{GcodeError, PenWords, Words};
+use super::gcode::{GcodeError, PenWords, Words, CHUNK_BYTES};
 use crate::document::{MachineProfile, MarkTiming, Plan};
 use crate::geom::Pt;
 use crate::motion::controller::otf_lines;
@@ -29,15 +29,18 @@ use std::fmt::Write;
 /// Dwells shorter than this are not written, s (LinuxCNC's `G4` takes at least a servo period).
 const MIN_DWELL_S: f64 = 1e-7;
 
-/// Writes `toolpath` as a LinuxCNC program (see the module documentation).
+/// Writes `toolpath` as a LinuxCNC program (see the module documentation) to `sink`, in
+/// pieces of about [`CHUNK_BYTES`] as the other dialects are written: a million strokes make
+/// hundreds of MB of program, never held whole.
 pub(super) fn write_program(
+    sink: &mut dyn std::io::Write,
     toolpath: &Toolpath,
     plan: &Plan,
     w: &Words<'_>,
     header: &str,
-) -> Result<String, GcodeError> {
+) -> Result<(), GcodeError> {
     let profile = &plan.profile;
-    let mut p = Program::new(profile, w, toolpath.segments.len() * 48 + 1024);
+    let mut p = Program::new(profile, w, sink);
     p.out.push_str(header);
     p.start(toolpath.route.is_some());
     if toolpath.route.is_some() {
@@ -46,13 +49,15 @@ pub(super) fn write_program(
         p.step_and_scan(toolpath, plan)?;
     }
     p.end();
-    Ok(p.out)
+    p.spill(0)
 }
 
 /// A program being written, and the machine state its lines leave.
 struct Program<'a, 'w> {
     profile: &'a MachineProfile,
     w: &'a Words<'w>,
+    /// Where the program goes; `out` holds the lines not yet written there.
+    sink: &'a mut dyn std::io::Write,
     out: String,
     /// The laser output is (or will be, at the next move) on.
     lit: bool,
@@ -67,11 +72,16 @@ struct Program<'a, 'w> {
 }
 
 impl<'a, 'w> Program<'a, 'w> {
-    fn new(profile: &'a MachineProfile, w: &'a Words<'w>, capacity: usize) -> Self {
+    fn new(
+        profile: &'a MachineProfile,
+        w: &'a Words<'w>,
+        sink: &'a mut dyn std::io::Write,
+    ) -> Self {
         Self {
             profile,
             w,
-            out: String::with_capacity(capacity),
+            sink,
+            out: String::with_capacity(CHUNK_BYTES + 4096),
             lit: false,
             dwell_s: 0.0,
             pen: None,
@@ -106,6 +116,17 @@ impl<'a, 'w> Program<'a, 'w> {
             let _ = writeln!(self.out, "M68 E{e} Q0");
         }
         self.out.push_str("G94\n(end)\nM2\n");
+    }
+
+    /// Writes the lines held to the sink once they are `at_least` bytes (0: whatever is held).
+    fn spill(&mut self, at_least: usize) -> Result<(), GcodeError> {
+        if self.out.len() >= at_least && !self.out.is_empty() {
+            self.sink
+                .write_all(self.out.as_bytes())
+                .map_err(|e| GcodeError::Write(e.to_string()))?;
+            self.out.clear();
+        }
+        Ok(())
     }
 
     /// A pause at rest, written as one dwell with the pauses next to it.
@@ -224,6 +245,7 @@ impl<'a, 'w> Program<'a, 'w> {
             );
         }
         for seg in &toolpath.segments {
+            self.spill(CHUNK_BYTES)?;
             match (seg.kind, seg.stage, seg.scan) {
                 (SegmentKind::StageMove, StageMotion::Move(m), scan) => {
                     let Some(mv) = toolpath.stage_moves.get(m) else {
@@ -300,6 +322,7 @@ impl<'a, 'w> Program<'a, 'w> {
         );
         self.out.push_str("G93\n");
         for line in &lines {
+            self.spill(CHUNK_BYTES)?;
             if let Some(stroke) = line.stroke {
                 let layer = toolpath.strokes.get(stroke).and_then(|s| s.layer);
                 let _ = self.pen_for(plan, layer, stroke)?;

@@ -55,15 +55,12 @@ pub(crate) fn resolve(contours: &[Vec<Pt>], rule: FillRule) -> Vec<Vec<Pt>> {
 }
 
 #[cfg(test)]
-/// Signed area of a closed loop (positive when counter-clockwise in x-right, y-up terms).
+/// Signed area of a closed loop (positive when counter-clockwise in x-right, y-up terms), by
+/// geo's [`geo::Area`].
 pub(crate) fn signed_area(pts: &[Pt]) -> f64 {
-    let n = pts.len();
-    let mut a = 0.0;
-    for i in 0..n {
-        let (p, q) = (pts[i], pts[(i + 1) % n]);
-        a += p.x * q.y - q.x * p.y;
-    }
-    a / 2.0
+    use geo::Area;
+    let ring: geo::LineString<f64> = pts.iter().map(|p| geo::coord! { x: p.x, y: p.y }).collect();
+    geo::Polygon::new(ring, vec![]).signed_area()
 }
 
 /// The scaled frame of one region: `units = (mm - origin) * k`.

@@ -256,12 +256,9 @@ mod tests {
     }
 
     fn area(l: &[Pt]) -> f64 {
-        let n = l.len();
-        (0..n)
-            .map(|i| l[i].x * l[(i + 1) % n].y - l[(i + 1) % n].x * l[i].y)
-            .sum::<f64>()
-            .abs()
-            / 2.0
+        use geo::Area;
+        let ring: geo::LineString<f64> = l.iter().map(|p| geo::coord! { x: p.x, y: p.y }).collect();
+        geo::Polygon::new(ring, vec![]).unsigned_area()
     }
 
     #[test]

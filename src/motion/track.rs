@@ -28,6 +28,7 @@
 //! the acceleration on it is capped so that this stays within [`Limits::sag_mm`]: a long step
 //! never eats the tube.
 
+use geo::ConvexHull;
 use std::fmt;
 
 /// Most vertices a reachable set keeps (see the module documentation).
@@ -387,32 +388,32 @@ fn sum_with_segment(poly: &[State], d: State) -> Vec<State> {
     out
 }
 
-/// Convex hull, counter-clockwise, without collinear points (Andrew's monotone chain). One or
-/// two distinct points stay as they are.
+/// Convex hull, counter-clockwise from the least point (least x, then least y), without
+/// collinear points: geo's [`ConvexHull`] (quickhull on robust orientation predicates), its
+/// ring opened and started at the least point so that equal sets give equal lists. Collinear
+/// points give the two ends; one or two distinct points stay as they are, in that order.
 fn convex_hull(mut points: Vec<State>) -> Vec<State> {
-    points.sort_by(|p, q| p[0].total_cmp(&q[0]).then(p[1].total_cmp(&q[1])));
+    let least = |p: &State, q: &State| p[0].total_cmp(&q[0]).then(p[1].total_cmp(&q[1]));
+    points.sort_by(least);
     points.dedup();
     if points.len() <= 2 {
         return points;
     }
-    let chain = |pts: &mut dyn Iterator<Item = State>| {
-        let mut out: Vec<State> = Vec::new();
-        for p in pts {
-            while out.len() >= 2 && cross(out[out.len() - 2], out[out.len() - 1], p) <= 0.0 {
-                out.pop();
-            }
-            out.push(p);
-        }
-        out.pop();
-        out
-    };
-    let mut hull = chain(&mut points.iter().copied());
-    hull.extend(chain(&mut points.iter().rev().copied()));
-    if hull.len() < 3 {
-        // all collinear: the two ends
-        return vec![points[0], points[points.len() - 1]];
+    let set: geo::MultiPoint<f64> = points.iter().map(|p| geo::Point::new(p[0], p[1])).collect();
+    let mut ring: Vec<State> = set
+        .convex_hull()
+        .exterior()
+        .coords()
+        .map(|c| [c.x, c.y])
+        .collect();
+    if ring.len() > 1 && ring.first() == ring.last() {
+        ring.pop();
     }
-    hull
+    ring.dedup();
+    if let Some(start) = (0..ring.len()).min_by(|&i, &j| least(&ring[i], &ring[j])) {
+        ring.rotate_left(start);
+    }
+    ring
 }
 
 /// The part of `poly` (convex, in order) with coordinate `axis` at least `bound` (`keep_above`)

@@ -6,41 +6,23 @@
 
 use super::{LsaParams, PatternPt};
 use crate::geom::{point_segment_dist, Pt};
+use geo::SimplifyIdx;
 
 /// Ramer–Douglas–Peucker (Algorithm 1): the indices of the points kept for distance threshold
-/// `epsilon_mm`. The farthest point from the chord is kept when it is farther than `epsilon_mm`
-/// and both halves are simplified again.
+/// `epsilon_mm`, by geo's [`SimplifyIdx`]. The farthest point from the chord is kept when it is
+/// farther than `epsilon_mm` and both halves are simplified again.
 ///
-/// The distance is to the chord *segment* (the paper's perpendicular distance wherever the foot
-/// falls on the chord): a branch that runs out and back within one segment keeps its tip, which
-/// the distance to the infinite line could lose.
+/// The distance is to the chord *segment* (geo's point–`Line` distance: the paper's
+/// perpendicular distance wherever the foot falls on the chord): a branch that runs out and
+/// back within one segment keeps its tip, which the distance to the infinite line could lose.
+/// On a tie for the farthest point geo keeps the last one. geo recurses; [`lsa_indices`] calls
+/// this on segments of `segment_points` (100) points, so the depth stays below that.
 pub fn rdp(points: &[Pt], epsilon_mm: f64) -> Vec<usize> {
-    let n = points.len();
-    if n <= 2 {
-        return (0..n).collect();
-    }
-    let mut keep = vec![false; n];
-    keep[0] = true;
-    keep[n - 1] = true;
-    // explicit stack instead of the paper's recursion: a long pattern cannot overflow it
-    let mut stack = vec![(0, n - 1)];
-    while let Some((first, last)) = stack.pop() {
-        let (a, b) = (points[first], points[last]);
-        let farthest = (first + 1..last)
-            .map(|i| (i, point_segment_dist(points[i], a, b)))
-            .fold(None, |best: Option<(usize, f64)>, (i, d)| match best {
-                Some((_, bd)) if bd >= d => best,
-                _ => Some((i, d)),
-            });
-        if let Some((index, d_max)) = farthest {
-            if d_max > epsilon_mm {
-                keep[index] = true;
-                stack.push((index, last));
-                stack.push((first, index));
-            }
-        }
-    }
-    (0..n).filter(|&i| keep[i]).collect()
+    let line: geo::LineString<f64> = points
+        .iter()
+        .map(|p| geo::coord! { x: p.x, y: p.y })
+        .collect();
+    line.simplify_idx(epsilon_mm)
 }
 
 /// Twice the area of the triangle `a b c`, mm².
