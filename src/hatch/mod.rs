@@ -216,143 +216,201 @@ pub fn hatch_contours(
     }
     let region = Region::new(&loops, Frame::new(&loops, s));
     let tol = s * FLATTEN_TOL_SPACING;
-    let stroke = |kind, family, level, points, closed| HatchStroke {
-        kind,
-        family,
-        level,
-        points,
-        closed,
-        run: None,
-    };
-    let mut runs = 0u32;
-    let mut new_run = |order| {
-        runs += 1;
-        Run { id: runs, order }
-    };
     if settings.style == HatchStyle::Contour {
-        ctx.check()?;
-        let levels =
-            contour::contour_levels(&region, settings.edge_offset(), s, tol, MAX_LINES, ctx)?;
-        out.offset_loops = levels.first().map(|l| l.rings.clone()).unwrap_or_default();
-        out.stats.levels = levels.len();
-        for (k, level) in levels.into_iter().enumerate() {
-            for r in level.rings {
-                out.strokes
-                    .push(stroke(StrokeKind::Ring, 0, k as u32, r, true));
-            }
-            for (g, closed) in level.gaps {
-                out.strokes
-                    .push(stroke(StrokeKind::Gap, 0, k as u32, g, closed));
-            }
-        }
-    } else {
-        let o = region.offset(settings.edge_offset());
-        if o.is_empty() {
-            return Ok(out);
-        }
-        ctx.check()?;
-        let flat = o.flatten(tol);
-        let a = settings.angle_deg.to_radians();
-        let angles = if settings.style == HatchStyle::Cross {
-            vec![a, a + std::f64::consts::FRAC_PI_2]
-        } else {
-            vec![a]
-        };
-        let scans = angles
-            .iter()
-            .map(|&a| scan::scan(&flat, a, s, MAX_LINES))
-            .collect::<Result<Vec<_>, _>>()
-            .map_err(|e| HatchError::TooFine {
-                element: "region".into(),
-                spacing_mm: s,
-                lines: e.0,
-            })?;
-        ctx.check()?;
-        if settings.style == HatchStyle::Lines {
-            // consecutive lines of one chord each, overlapping along the lines, are one sweep:
-            // one run, marked in line order, each chord entered at the end next to the last
-            // (the planner flips open strokes anyway); lines of several chords stay loose
-            let sc = &scans[0];
-            let along = Pt::new(a.cos(), a.sin());
-            let first = out.strokes.len();
-            let mut run: Option<Run> = None;
-            let mut last: Option<(f64, f64)> = None;
-            for line in &sc.lines {
-                let span = match line.as_slice() {
-                    [c] => {
-                        let (p, q) = sc.ends(*c);
-                        let (u, v) = (p.dot(along), q.dot(along));
-                        Some((u.min(v), u.max(v)))
-                    }
-                    _ => None,
-                };
-                let continues = matches!((last, span), (Some((a0, a1)), Some((b0, b1))) if b0 <= a1 && a0 <= b1);
-                if !continues {
-                    run = span.map(|_| new_run(RunOrder::Sweep));
-                }
-                for c in line {
-                    let (p, q) = sc.ends(*c);
-                    out.strokes.push(HatchStroke {
-                        run: span.and(run),
-                        ..stroke(StrokeKind::Line, 0, 0, vec![p, q], false)
-                    });
-                }
-                last = span;
-            }
-            lone_runs_loose(&mut out.strokes[first..]);
-            if settings.border {
-                for l in &flat {
-                    out.strokes
-                        .push(stroke(StrokeKind::Border, 0, 0, l.clone(), true));
-                }
-            }
-        } else {
-            let refs: Vec<&scan::Scan> = scans.iter().collect();
-            let mut boundary = Boundary::new(&flat, &refs);
-            for (f, sc) in scans.iter().enumerate() {
-                let mut parts = zigzag::link(sc, f, &mut boundary);
-                // each sweep's parts together, line by line; a sweep of two parts or more is
-                // one run
-                parts.sort_by_key(|p| p.sweep);
-                for sweep in parts.chunk_by_mut(|a, b| a.sweep == b.sweep) {
-                    let run = (sweep.len() > 1).then(|| new_run(RunOrder::Sweep));
-                    for part in sweep {
-                        let points = std::mem::take(&mut part.points);
-                        out.strokes.push(HatchStroke {
-                            run,
-                            ..stroke(StrokeKind::Zigzag, f as u8, 0, points, false)
-                        });
-                    }
-                }
-            }
-            if settings.border {
-                let mut loop_run = (u32::MAX, None);
-                for (loop_id, pts, closed) in boundary.unused_by_loop() {
-                    if loop_run.0 != loop_id {
-                        loop_run = (loop_id, Some(new_run(RunOrder::Loop)));
-                    }
-                    out.strokes.push(HatchStroke {
-                        run: if closed { None } else { loop_run.1 },
-                        ..stroke(StrokeKind::Border, 0, 0, pts, closed)
-                    });
-                }
-            }
-        }
-        out.stats.lines = scans
-            .iter()
-            .flat_map(|sc| sc.lines.iter().flatten().map(move |c| sc.ends(*c)))
-            .map(|(p, q)| p.dist(q))
-            .filter(|&len_mm| len_mm > 0.0 && len_mm >= s * MIN_STROKE_SPACING)
-            .count();
-        out.offset_loops = flat;
+        contour_fill(&region, settings, tol, ctx, &mut out)?;
+    } else if !scan_fill(&region, settings, tol, ctx, &mut out)? {
+        return Ok(out);
     }
     // (a few µm or less: where a line ends next to a corner, a border piece of 0.01 µm is left)
     out.strokes.retain(|st| {
         let len_mm = st.length_mm();
         st.points.len() >= 2 && len_mm > 0.0 && len_mm >= s * MIN_STROKE_SPACING
     });
-    let st = &mut out.stats;
-    for k in &out.strokes {
+    count_strokes(&out.strokes, &mut out.stats);
+    Ok(out)
+}
+
+/// A hatch stroke outside any run.
+fn loose(kind: StrokeKind, family: u8, level: u32, points: Vec<Pt>, closed: bool) -> HatchStroke {
+    HatchStroke {
+        kind,
+        family,
+        level,
+        points,
+        closed,
+        run: None,
+    }
+}
+
+/// The runs of one region, numbered from 1.
+#[derive(Default)]
+struct Runs(u32);
+
+impl Runs {
+    fn next(&mut self, order: RunOrder) -> Run {
+        self.0 += 1;
+        Run { id: self.0, order }
+    }
+}
+
+/// The contour-parallel fill: rings inward from the edge offset, each level's gaps filled.
+fn contour_fill(
+    region: &Region,
+    settings: &HatchSettings,
+    tol: f64,
+    ctx: &JobCtx,
+    out: &mut RegionHatch,
+) -> Result<(), HatchError> {
+    ctx.check()?;
+    let s = settings.spacing_mm;
+    let levels = contour::contour_levels(region, settings.edge_offset(), s, tol, MAX_LINES, ctx)?;
+    out.offset_loops = levels.first().map(|l| l.rings.clone()).unwrap_or_default();
+    out.stats.levels = levels.len();
+    for (k, level) in levels.into_iter().enumerate() {
+        for r in level.rings {
+            out.strokes
+                .push(loose(StrokeKind::Ring, 0, k as u32, r, true));
+        }
+        for (g, closed) in level.gaps {
+            out.strokes
+                .push(loose(StrokeKind::Gap, 0, k as u32, g, closed));
+        }
+    }
+    Ok(())
+}
+
+/// The scan-line fills (lines, zigzag, cross) of the region offset by the edge offset, with
+/// their border; `false` when the offset leaves nothing to fill.
+fn scan_fill(
+    region: &Region,
+    settings: &HatchSettings,
+    tol: f64,
+    ctx: &JobCtx,
+    out: &mut RegionHatch,
+) -> Result<bool, HatchError> {
+    let s = settings.spacing_mm;
+    let o = region.offset(settings.edge_offset());
+    if o.is_empty() {
+        return Ok(false);
+    }
+    ctx.check()?;
+    let flat = o.flatten(tol);
+    let a = settings.angle_deg.to_radians();
+    let angles = if settings.style == HatchStyle::Cross {
+        vec![a, a + std::f64::consts::FRAC_PI_2]
+    } else {
+        vec![a]
+    };
+    let scans = angles
+        .iter()
+        .map(|&a| scan::scan(&flat, a, s, MAX_LINES))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| HatchError::TooFine {
+            element: "region".into(),
+            spacing_mm: s,
+            lines: e.0,
+        })?;
+    ctx.check()?;
+    let mut runs = Runs::default();
+    if settings.style == HatchStyle::Lines {
+        line_strokes(&scans[0], a, &mut runs, &mut out.strokes);
+        if settings.border {
+            for l in &flat {
+                out.strokes
+                    .push(loose(StrokeKind::Border, 0, 0, l.clone(), true));
+            }
+        }
+    } else {
+        zigzag_strokes(&scans, &flat, settings.border, &mut runs, &mut out.strokes);
+    }
+    out.stats.lines = scans
+        .iter()
+        .flat_map(|sc| sc.lines.iter().flatten().map(move |c| sc.ends(*c)))
+        .map(|(p, q)| p.dist(q))
+        .filter(|&len_mm| len_mm > 0.0 && len_mm >= s * MIN_STROKE_SPACING)
+        .count();
+    out.offset_loops = flat;
+    Ok(true)
+}
+
+/// Parallel lines at angle `a` (rad): consecutive lines of one chord each, overlapping along the
+/// lines, are one sweep: one run, marked in line order, each chord entered at the end next to
+/// the last (the planner flips open strokes anyway); lines of several chords stay loose.
+fn line_strokes(sc: &scan::Scan, a: f64, runs: &mut Runs, strokes: &mut Vec<HatchStroke>) {
+    let along = Pt::new(a.cos(), a.sin());
+    let first = strokes.len();
+    let mut run: Option<Run> = None;
+    let mut last: Option<(f64, f64)> = None;
+    for line in &sc.lines {
+        let span = match line.as_slice() {
+            [c] => {
+                let (p, q) = sc.ends(*c);
+                let (u, v) = (p.dot(along), q.dot(along));
+                Some((u.min(v), u.max(v)))
+            }
+            _ => None,
+        };
+        let continues =
+            matches!((last, span), (Some((a0, a1)), Some((b0, b1))) if b0 <= a1 && a0 <= b1);
+        if !continues {
+            run = span.map(|_| runs.next(RunOrder::Sweep));
+        }
+        for c in line {
+            let (p, q) = sc.ends(*c);
+            strokes.push(HatchStroke {
+                run: span.and(run),
+                ..loose(StrokeKind::Line, 0, 0, vec![p, q], false)
+            });
+        }
+        last = span;
+    }
+    lone_runs_loose(&mut strokes[first..]);
+}
+
+/// Zigzag (and cross) fills: each family's chords linked along the boundary `flat`, a sweep of
+/// two parts or more one run; with `border`, the boundary the links left unused, one run per
+/// loop.
+fn zigzag_strokes(
+    scans: &[scan::Scan],
+    flat: &[Vec<Pt>],
+    border: bool,
+    runs: &mut Runs,
+    strokes: &mut Vec<HatchStroke>,
+) {
+    let refs: Vec<&scan::Scan> = scans.iter().collect();
+    let mut boundary = Boundary::new(flat, &refs);
+    for (f, sc) in scans.iter().enumerate() {
+        let mut parts = zigzag::link(sc, f, &mut boundary);
+        // each sweep's parts together, line by line
+        parts.sort_by_key(|p| p.sweep);
+        for sweep in parts.chunk_by_mut(|a, b| a.sweep == b.sweep) {
+            let run = (sweep.len() > 1).then(|| runs.next(RunOrder::Sweep));
+            for part in sweep {
+                let points = std::mem::take(&mut part.points);
+                strokes.push(HatchStroke {
+                    run,
+                    ..loose(StrokeKind::Zigzag, f as u8, 0, points, false)
+                });
+            }
+        }
+    }
+    if border {
+        let mut loop_run = (u32::MAX, None);
+        for (loop_id, pts, closed) in boundary.unused_by_loop() {
+            if loop_run.0 != loop_id {
+                loop_run = (loop_id, Some(runs.next(RunOrder::Loop)));
+            }
+            strokes.push(HatchStroke {
+                run: if closed { None } else { loop_run.1 },
+                ..loose(StrokeKind::Border, 0, 0, pts, closed)
+            });
+        }
+    }
+}
+
+/// Counts and lengths of `strokes` by kind into `st`.
+fn count_strokes(strokes: &[HatchStroke], st: &mut HatchStats) {
+    for k in strokes {
         let len = k.length_mm();
         match k.kind {
             StrokeKind::Line => st.fill_mm += len,
@@ -375,5 +433,4 @@ pub fn hatch_contours(
         }
     }
     st.total_mm = st.fill_mm + st.border_mm + st.gap_mm;
-    Ok(out)
 }
