@@ -603,6 +603,38 @@ impl Stages<'_> {
     }
 }
 
+/// HHA's time budgets: a time limit is HHA's own only when HHA is the algorithm (HGA spends
+/// it on generations); under the time objective the refinement is preliminary too (the time
+/// objective's search of each field's path comes last and gets the full budget).
+struct Budgets<'a> {
+    settings: &'a SolverSettings,
+    t0: Instant,
+    time_follows: bool,
+}
+
+impl Budgets<'_> {
+    /// The deadline of a stage given `share` of the time limit, when HHA has one.
+    fn limited(&self, share: f64) -> Option<Instant> {
+        (self.settings.algo == crate::document::Algo::Hha)
+            .then(|| deadline(self.settings, self.t0, share))
+            .flatten()
+    }
+    /// The search budget of a field of `m` geometries in refinement round `round`.
+    fn refine(&self, m: usize, round: usize) -> IlsBudget {
+        let share = if self.time_follows {
+            REFINE_SHARE
+        } else {
+            LAST_SEARCH_SHARE
+        };
+        let budget = IlsBudget::until(m, self.limited(share));
+        if round > 0 || self.time_follows {
+            budget.divided(PRELIMINARY_KICK_DIVISOR)
+        } else {
+            budget
+        }
+    }
+}
+
 /// Runs HHA on allocated fields. `stage_s` receives the time of each sub-stage.
 pub fn hha_order(
     geometries: &[Geometry],
@@ -613,34 +645,17 @@ pub fn hha_order(
     stage_s: &mut Vec<(String, f64)>,
 ) -> Result<Ordering, OrderError> {
     let t = Instant::now();
-    // a time limit is HHA's own only when HHA is the algorithm (HGA spends it on generations)
-    let t0 = t;
-    let limited = |share: f64| {
-        (settings.algo == crate::document::Algo::Hha)
-            .then(|| deadline(settings, t0, share))
-            .flatten()
-    };
-    // under the time objective the refinement is preliminary too: the time objective's search
-    // of each field's path comes last and gets the full budget
     let time_follows = settings.cost_model == crate::document::CostModel::Time;
-    let refine_share = if time_follows {
-        REFINE_SHARE
-    } else {
-        LAST_SEARCH_SHARE
-    };
-    let refine_budget = |m: usize, round: usize, until: Option<Instant>| {
-        let budget = IlsBudget::until(m, until);
-        if round > 0 || time_follows {
-            budget.divided(PRELIMINARY_KICK_DIVISOR)
-        } else {
-            budget
-        }
+    let budgets = Budgets {
+        settings,
+        t0: t,
+        time_follows,
     };
     let live: Vec<&ScanField> = fields.iter().filter(|f| !f.geometries.is_empty()).collect();
     let live_owned: Vec<ScanField> = live.iter().map(|f| (*f).clone()).collect();
     // a lone field under the time objective: HHA's sweep direction and start/end rules mean
     // nothing once the time objective frees both ends and searches the path with its full
-    // budget, so HHA only gives it a start along a Hilbert curve (BENCHMARKS, issue 16)
+    // budget, so HHA only gives it a start along a Hilbert curve (BENCHMARKS)
     // (on the fly no time search follows: `order_plan` runs it for step-and-scan only)
     let lone_before_time =
         time_follows && settings.motion != crate::document::MotionMode::OnTheFly && live.len() == 1;
@@ -659,7 +674,7 @@ pub fn hha_order(
         cent: &cent,
         profile,
         settings,
-        until: limited(FIELD_PATHS_SHARE),
+        until: budgets.limited(FIELD_PATHS_SHARE),
         start_only: lone_before_time || lone_free,
     };
     let slots = |fo: &[usize]| -> Vec<&ScanField> { fo.iter().map(|&k| live[k]).collect() };
@@ -682,31 +697,8 @@ pub fn hha_order(
         ..
     } = best;
     ctx.progress("order", 3, 4, "HHA: refine");
-    let single = ordered.len() == 1;
-    let weight = stages.weight(single);
-
     if settings.hha_improve {
         let t = Instant::now();
-        let lambda = weight * 2.0;
-        // rounds are judged by the same directional objective the local search optimises
-        let cent_dir: Vec<f64> = {
-            let runs = field_runs(&steps);
-            let mut p = vec![0.0; geometries.len()];
-            for (j, &(a, b)) in runs.iter().enumerate() {
-                for s in &steps[a..b] {
-                    p[s.geometry] = cent[s.geometry].dot(dirs[j]);
-                }
-            }
-            p
-        };
-        let objective = |st: &[Step], idle: f64| -> f64 {
-            idle + lambda
-                * st.windows(2)
-                    .filter(|w| w[0].field == w[1].field)
-                    .map(|w| (cent_dir[w[0].geometry] - cent_dir[w[1].geometry]).max(0.0))
-                    .sum::<f64>()
-        };
-        let mut best = objective(&steps, super::metrics::idle_mm(geometries, &steps));
         let rounds = if lone_before_time || lone_free {
             0
         } else if time_follows {
@@ -714,44 +706,71 @@ pub fn hha_order(
         } else {
             REFINE_ROUNDS
         };
+        let refine = Refine {
+            geometries,
+            cent: &cent,
+            dirs: &dirs,
+            lambda: stages.weight(ordered.len() == 1) * 2.0,
+            budgets: &budgets,
+        };
+        steps = refine.rounds(steps, rounds, ctx)?;
+        stage_s.push(("refine".into(), t.elapsed().as_secs_f64()));
+    }
+    if lone_free {
+        let t = Instant::now();
+        let until = budgets.limited(LAST_SEARCH_SHARE);
+        let seeds = LONE_FREE_SEEDS.map(|s| settings.seed ^ s);
+        steps = super::time::best_free_field_path(geometries, &steps, &seeds, until, ctx)?;
+        stage_s.push(("free path".into(), t.elapsed().as_secs_f64()));
+    }
+    ctx.progress("order", 4, 4, "HHA: done");
+    Ok(Ordering {
+        field_order: ordered.iter().map(|f| f.id).collect(),
+        steps,
+    })
+}
+
+/// HHA's refinement: every field's path searched again between its neighbours' ends, on the
+/// directional objective (idle travel plus `lambda` times the backward steps along each
+/// field's sweep direction), alternate fields in parallel.
+struct Refine<'a> {
+    geometries: &'a [Geometry],
+    cent: &'a [Pt],
+    /// Each field's sweep direction, in visiting order.
+    dirs: &'a [Pt],
+    lambda: f64,
+    budgets: &'a Budgets<'a>,
+}
+
+impl Refine<'_> {
+    /// Up to `rounds` rounds, each kept while it gains (another only while it gains at least
+    /// 0.1 %).
+    fn rounds(
+        &self,
+        mut steps: Vec<Step>,
+        rounds: usize,
+        ctx: &JobCtx,
+    ) -> Result<Vec<Step>, OrderError> {
+        let g = self.geometries;
+        // rounds are judged by the same directional objective the local search optimises
+        let cent_dir = self.sweep_positions(&steps);
+        let objective = |st: &[Step], idle: f64| -> f64 {
+            idle + self.lambda
+                * st.windows(2)
+                    .filter(|w| w[0].field == w[1].field)
+                    .map(|w| (cent_dir[w[0].geometry] - cent_dir[w[1].geometry]).max(0.0))
+                    .sum::<f64>()
+        };
+        let mut best = objective(&steps, super::metrics::idle_mm(g, &steps));
+        let vertex = self.budgets.settings.vertex;
         for round in 0..rounds {
             let mut next = steps.clone();
-            for parity in 0..2 {
-                let runs = field_runs(&next);
-                let updates: Vec<Result<(usize, Vec<Step>), Cancelled>> = runs
-                    .par_iter()
-                    .enumerate()
-                    .filter(|(j, _)| j % 2 == parity)
-                    .map(|(j, &(a, b))| {
-                        let before =
-                            (a > 0).then(|| super::metrics::step_ends(geometries, &next[a - 1]).1);
-                        let after = (b < next.len())
-                            .then(|| super::metrics::step_ends(geometries, &next[b]).0);
-                        let seed = settings.seed ^ ((j as u64) << 32) ^ ((round as u64) << 16);
-                        refine_field(
-                            geometries,
-                            &next[a..b],
-                            before,
-                            after,
-                            dirs[j],
-                            lambda,
-                            seed,
-                            refine_budget(b - a, round, limited(refine_share)),
-                            ctx,
-                        )
-                        .map(|r| (a, r))
-                    })
-                    .collect();
-                for u in updates {
-                    let (a, r) = u?;
-                    next[a..a + r.len()].copy_from_slice(&r);
-                }
-            }
-            let idle = if settings.vertex == VertexMode::Exact {
-                optimal_vertices(geometries, &mut next, ctx)?
+            self.round(&mut next, round, ctx)?;
+            let idle = if vertex == VertexMode::Exact {
+                optimal_vertices(g, &mut next, ctx)?
             } else {
-                vea(geometries, &mut next, ctx)?;
-                super::metrics::idle_mm(geometries, &next)
+                vea(g, &mut next, ctx)?;
+                super::metrics::idle_mm(g, &next)
             };
             let idle = objective(&next, idle);
             if idle >= best - 1e-9 {
@@ -765,20 +784,56 @@ pub fn hha_order(
                 break;
             }
         }
-        stage_s.push(("refine".into(), t.elapsed().as_secs_f64()));
+        Ok(steps)
     }
-    if lone_free {
-        let t = Instant::now();
-        let until = limited(LAST_SEARCH_SHARE);
-        let seeds = LONE_FREE_SEEDS.map(|s| settings.seed ^ s);
-        steps = super::time::best_free_field_path(geometries, &steps, &seeds, until, ctx)?;
-        stage_s.push(("free path".into(), t.elapsed().as_secs_f64()));
+
+    /// Each geometry's centroid along its field's sweep direction.
+    fn sweep_positions(&self, steps: &[Step]) -> Vec<f64> {
+        let mut p = vec![0.0; self.geometries.len()];
+        for (j, &(a, b)) in field_runs(steps).iter().enumerate() {
+            for s in &steps[a..b] {
+                p[s.geometry] = self.cent[s.geometry].dot(self.dirs[j]);
+            }
+        }
+        p
     }
-    ctx.progress("order", 4, 4, "HHA: done");
-    Ok(Ordering {
-        field_order: ordered.iter().map(|f| f.id).collect(),
-        steps,
-    })
+
+    /// One round: the even fields, then the odd ones (each between its neighbours as they
+    /// are then), searched in parallel.
+    fn round(&self, next: &mut [Step], round: usize, ctx: &JobCtx) -> Result<(), OrderError> {
+        let g = self.geometries;
+        let seed0 = self.budgets.settings.seed;
+        for parity in 0..2 {
+            let runs = field_runs(next);
+            let updates: Vec<Result<(usize, Vec<Step>), Cancelled>> = runs
+                .par_iter()
+                .enumerate()
+                .filter(|(j, _)| j % 2 == parity)
+                .map(|(j, &(a, b))| {
+                    let before = (a > 0).then(|| super::metrics::step_ends(g, &next[a - 1]).1);
+                    let after = (b < next.len()).then(|| super::metrics::step_ends(g, &next[b]).0);
+                    let seed = seed0 ^ ((j as u64) << 32) ^ ((round as u64) << 16);
+                    refine_field(
+                        g,
+                        &next[a..b],
+                        before,
+                        after,
+                        self.dirs[j],
+                        self.lambda,
+                        seed,
+                        self.budgets.refine(b - a, round),
+                        ctx,
+                    )
+                    .map(|r| (a, r))
+                })
+                .collect();
+            for u in updates {
+                let (a, r) = u?;
+                next[a..a + r.len()].copy_from_slice(&r);
+            }
+        }
+        Ok(())
+    }
 }
 
 /// Position ranges `[a, b)` of each field's run in a step list (in order).
