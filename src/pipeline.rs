@@ -591,58 +591,16 @@ fn whole_or_cut(
     };
     let (mut made, lower_bound, note) = if judge.settings.stage_route != StageRouteKind::Taut {
         let whole = order_whole()?;
-        // seed 001's routes are made for the whole pattern (cut, lissajous on lsa took 75.6 s
-        // against 11.09 s whole)
+        // the route paper's routes are made for the whole pattern (cut, lissajous on lsa took
+        // 75.6 s against 11.09 s whole)
         doc.fields = whole_region.fields;
         let note =
             "marked whole on the fly: the lsa and cetsp-ga stage routes follow the whole pattern"
                 .to_string();
         (whole, whole_region.lower_bound, note)
     } else {
-        // cut: fields on the pieces, every motion allowed; on the document's tiling and, when
-        // nothing is cut yet and no seam was set by hand, also on the plain field grid
-        // anchored at the corner (on the fly its pieces can run faster: oversize.svg on the
-        // LinuxCNC clock 18.36 s against 20.71 s)
-        let mut tilings = vec![("cut", doc.tiling.clone())];
-        if doc.seams.cuts == 0 && doc.tiling_set.is_none() {
-            let extent = doc
-                .geometries
-                .iter()
-                .filter(|g| crate::fields::is_oversize(g, doc.profile.field_mm))
-                .fold(crate::geom::BBox::EMPTY, |b, g| b.union(g.bbox()));
-            // cells a hair under the field (the seam forms' reach does not apply: no overlap)
-            let [fw, fh] = doc.profile.field_mm;
-            let cell = [fw - FIELD_GRID_SLACK_MM, fh - FIELD_GRID_SLACK_MM];
-            tilings.push((
-                "cut on the field grid",
-                Some(Tiling::anchored(extent, cell)),
-            ));
-        }
-        let cut = |(label, tiling): (&'static str, Option<Tiling>)| {
-            let mut pieces = doc.geometries.clone();
-            let (warnings, seams, tiling) = split_oversize(
-                &mut pieces,
-                tiling.as_ref(),
-                &doc.layers,
-                doc.profile.field_mm,
-            );
-            let placement = place_fields(&pieces, &doc.profile, &judge.settings, locked, ctx)
-                .map_err(|source| PipelineError::Fields {
-                    file: file.clone(),
-                    source,
-                })?;
-            let made =
-                order_plan(&pieces, &placement.fields, &judge, ctx).map_err(as_order_error)?;
-            Ok(CutCandidate {
-                label,
-                pieces,
-                warnings,
-                seams,
-                tiling,
-                placement,
-                made,
-            })
-        };
+        let tilings = cut_tilings(doc);
+        let cut = |tiling| plan_cut(doc, locked, &judge, tiling, &file, ctx);
         // the candidates are independent: planned side by side (each is deterministic)
         let started = Instant::now();
         let (whole, cuts_made) = rayon::join(order_whole, || {
@@ -654,39 +612,7 @@ fn whole_or_cut(
         let (whole, cuts_made) = (whole?, cuts_made?);
         // the order stage's wall time (the candidates' own times, in the detail, overlap)
         let order_s = started.elapsed().as_secs_f64();
-        // the chosen plan's order stage: every candidate's ordering
-        let mut detail = vec![("whole".to_string(), whole.0.metrics.solve_s.order)];
-        detail.extend(
-            cuts_made
-                .iter()
-                .map(|c| (c.label.to_string(), c.made.0.metrics.solve_s.order)),
-        );
-        let best = cuts_made
-            .into_iter()
-            .min_by(|a, b| a.job_s().total_cmp(&b.job_s()));
-        let whole_s = format_s(whole.1.duration_s());
-        let (mut made, lower_bound, note) = match best {
-            Some(c) if c.job_s() < whole.1.duration_s() => {
-                let cut_s = format_s(c.job_s());
-                cut_geometries(doc, c.pieces, c.warnings, c.seams, c.tiling);
-                doc.fields = c.placement.fields;
-                let note = format!("cut at field borders: the job takes {cut_s} s cut against {whole_s} s marked whole on the fly");
-                (c.made, c.placement.lower_bound, note)
-            }
-            best => {
-                let cut_s = best.map_or_else(|| "–".into(), |c| format_s(c.job_s()));
-                doc.fields = whole_region.fields;
-                let note = format!("marked whole on the fly: the job takes {whole_s} s against {cut_s} s cut at field borders");
-                (whole, whole_region.lower_bound, note)
-            }
-        };
-        let solve = &mut made.0.metrics.solve_s;
-        solve.order_detail = detail
-            .into_iter()
-            .chain(solve.order_detail.drain(..))
-            .collect();
-        solve.order = order_s;
-        (made, lower_bound, note)
+        choose_whole_or_cut(doc, whole, whole_region, cuts_made, order_s)
     };
     // this choice replaces the last one's words
     doc.warnings
@@ -697,6 +623,112 @@ fn whole_or_cut(
     made.0.settings.motion = doc.settings.motion;
     made.0.name = doc.settings.title_of(&made.0);
     Ok((lower_bound, reusable.then_some(made)))
+}
+
+/// The tilings a cut is tried on: the document's and, when nothing is cut yet and no seam was
+/// set by hand, also the plain field grid anchored at the corner (on the fly its pieces can run
+/// faster: oversize.svg on the LinuxCNC clock 18.36 s against 20.71 s).
+fn cut_tilings(doc: &Document) -> Vec<(&'static str, Option<Tiling>)> {
+    let mut tilings = vec![("cut", doc.tiling.clone())];
+    if doc.seams.cuts == 0 && doc.tiling_set.is_none() {
+        let extent = doc
+            .geometries
+            .iter()
+            .filter(|g| crate::fields::is_oversize(g, doc.profile.field_mm))
+            .fold(crate::geom::BBox::EMPTY, |b, g| b.union(g.bbox()));
+        // cells a hair under the field (the seam forms' reach does not apply: no overlap)
+        let [fw, fh] = doc.profile.field_mm;
+        let cell = [fw - FIELD_GRID_SLACK_MM, fh - FIELD_GRID_SLACK_MM];
+        tilings.push((
+            "cut on the field grid",
+            Some(Tiling::anchored(extent, cell)),
+        ));
+    }
+    tilings
+}
+
+/// The document's geometries cut on `tiling`, fields placed on the pieces and the plan made on
+/// them with `judge` (every motion allowed).
+fn plan_cut(
+    doc: &Document,
+    locked: &[ScanField],
+    judge: &PlanInputs,
+    (label, tiling): (&'static str, Option<Tiling>),
+    file: &str,
+    ctx: &JobCtx,
+) -> Result<CutCandidate, PipelineError> {
+    let mut pieces = doc.geometries.clone();
+    let (warnings, seams, tiling) = split_oversize(
+        &mut pieces,
+        tiling.as_ref(),
+        &doc.layers,
+        doc.profile.field_mm,
+    );
+    let placement =
+        place_fields(&pieces, &doc.profile, &judge.settings, locked, ctx).map_err(|source| {
+            PipelineError::Fields {
+                file: file.to_string(),
+                source,
+            }
+        })?;
+    let made = order_plan(&pieces, &placement.fields, judge, ctx).map_err(|source| {
+        PipelineError::Order {
+            file: file.to_string(),
+            source,
+        }
+    })?;
+    Ok(CutCandidate {
+        label,
+        pieces,
+        warnings,
+        seams,
+        tiling,
+        placement,
+        made,
+    })
+}
+
+/// Keeps the faster of `whole` (one region, on the fly) and the best cut candidate on the
+/// lowered job time, installs its geometries and fields in `doc`, and says why; the plan's
+/// order stage gets every candidate's ordering time in its detail and `order_s` as its time.
+fn choose_whole_or_cut(
+    doc: &mut Document,
+    whole: (Plan, Toolpath),
+    whole_region: Placement,
+    cuts: Vec<CutCandidate>,
+    order_s: f64,
+) -> ((Plan, Toolpath), usize, String) {
+    let mut detail = vec![("whole".to_string(), whole.0.metrics.solve_s.order)];
+    detail.extend(
+        cuts.iter()
+            .map(|c| (c.label.to_string(), c.made.0.metrics.solve_s.order)),
+    );
+    let best = cuts
+        .into_iter()
+        .min_by(|a, b| a.job_s().total_cmp(&b.job_s()));
+    let whole_s = format_s(whole.1.duration_s());
+    let (mut made, lower_bound, note) = match best {
+        Some(c) if c.job_s() < whole.1.duration_s() => {
+            let cut_s = format_s(c.job_s());
+            cut_geometries(doc, c.pieces, c.warnings, c.seams, c.tiling);
+            doc.fields = c.placement.fields;
+            let note = format!("cut at field borders: the job takes {cut_s} s cut against {whole_s} s marked whole on the fly");
+            (c.made, c.placement.lower_bound, note)
+        }
+        best => {
+            let cut_s = best.map_or_else(|| "–".into(), |c| format_s(c.job_s()));
+            doc.fields = whole_region.fields;
+            let note = format!("marked whole on the fly: the job takes {whole_s} s against {cut_s} s cut at field borders");
+            (whole, whole_region.lower_bound, note)
+        }
+    };
+    let solve = &mut made.0.metrics.solve_s;
+    solve.order_detail = detail
+        .into_iter()
+        .chain(solve.order_detail.drain(..))
+        .collect();
+    solve.order = order_s;
+    (made, lower_bound, note)
 }
 
 /// How the warning about the whole-or-cut choice begins (a placement replaces the last one's).
