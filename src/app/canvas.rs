@@ -119,6 +119,10 @@ pub struct CanvasState {
     drag: Drag,
     /// The tray cell the context menu is open for: (cell, it is skipped).
     context_cell: Option<(u32, bool)>,
+    /// The undo group of the field drag under way (one undo step per drag).
+    pub drag_group: u64,
+    /// A field is being dragged.
+    pub dragging: bool,
 }
 
 /// What the operator did on an editable canvas.

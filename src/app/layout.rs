@@ -47,11 +47,11 @@ impl App {
                     let revision = self.canvas_revision();
                     compare::show(
                         ui,
-                        &mut self.view.compare,
+                        &mut self.panels.compare,
                         &self.session.doc,
                         &self.session.toolpaths,
                         &self.session.stale,
-                        self.view.layers,
+                        self.prefs.layers,
                         revision,
                     );
                 } else {
@@ -78,10 +78,10 @@ impl App {
                     self.request_open(None, &ctx);
                 }
                 ui.menu_button("Open recent", |ui| {
-                    if self.view.recent.0.is_empty() {
+                    if self.prefs.recent.0.is_empty() {
                         ui.label("(none)");
                     }
-                    for p in self.view.recent.0.clone() {
+                    for p in self.prefs.recent.0.clone() {
                         if ui.button(p.display().to_string()).clicked() {
                             self.request_open(Some(p), &ctx);
                         }
@@ -168,22 +168,22 @@ impl App {
                     .add(egui::Button::new("Fit to view").shortcut_text("F"))
                     .clicked()
                 {
-                    self.view.workbench.fit_requested = true;
-                    self.view.compare.canvas.fit_requested = true;
+                    self.panels.workbench.fit_requested = true;
+                    self.panels.compare.canvas.fit_requested = true;
                 }
             });
         });
     }
 
     fn layer_toggles(&mut self, ui: &mut egui::Ui) {
-        let l = &mut self.view.layers;
+        let l = &mut self.prefs.layers;
         ui.checkbox(&mut l.fields, "Scan fields");
         ui.checkbox(&mut l.path, "Planned path");
         ui.checkbox(&mut l.arrows, "Direction arrows");
         ui.checkbox(&mut l.base_path, "Base path / stage route");
         ui.checkbox(&mut l.order_colours, "Colour marks by order");
         ui.checkbox(
-            &mut self.view.frame_times,
+            &mut self.prefs.frame_times,
             "Frame timings in the status bar",
         );
     }
@@ -313,8 +313,8 @@ impl App {
                     ui.label(if u > 0 { t.color(ERROR) } else { t });
                     ui.separator();
                 }
-                if self.view.frame_times {
-                    let f = &self.view.frames;
+                if self.prefs.frame_times {
+                    let f = &self.diagnostics.frames;
                     let cpu = f
                         .cpu_ms
                         .map_or(String::new(), |c| format!(", whole frame {c:.1} ms"));
@@ -364,7 +364,7 @@ impl App {
     fn layers_ui(&mut self, ui: &mut egui::Ui) {
         let busy = self.runtime.job.as_ref().map(|j| j.name.clone());
         let import = (self.session.can_reimport).then_some(&self.session.doc.import);
-        let action = self.view.layer_editor.ui(
+        let action = self.panels.layer_editor.ui(
             ui,
             &self.session.doc.layers,
             &self.session.layer_counts,
@@ -396,7 +396,7 @@ impl App {
             Section::Layers => self.layers_ui(ui),
             Section::Settings => {
                 if let Some(cmd) = self
-                    .view
+                    .panels
                     .editors
                     .settings_ui(ui, &self.session.doc.settings)
                 {
@@ -412,10 +412,10 @@ impl App {
             }
             Section::Tray => self.tray_ui(ui),
             Section::Profile => {
-                if let Some(cmd) = self.view.editors.profile_ui(ui, &self.session.doc.profile) {
+                if let Some(cmd) = self.panels.editors.profile_ui(ui, &self.session.doc.profile) {
                     let _ = self.execute(cmd);
                 }
-                if let Some(a) = self.view.editors.take_file_request() {
+                if let Some(a) = self.panels.editors.take_file_request() {
                     let ctx = ui.ctx().clone();
                     self.choose_path(a, &ctx);
                 }
@@ -530,7 +530,7 @@ impl App {
         };
         // a new id per import: the list opens on each import that has warnings
         egui::CollapsingHeader::new(title)
-            .id_salt(("warnings", self.view.imports))
+            .id_salt(("warnings", self.session.imports))
             .default_open(n > 0)
             .show(ui, |ui| {
                 if n == 0 {
@@ -548,7 +548,7 @@ impl App {
         egui::CollapsingHeader::new("Recent files")
             .default_open(false)
             .show(ui, |ui| {
-                for p in self.view.recent.0.clone() {
+                for p in self.prefs.recent.0.clone() {
                     if ui.link(p.display().to_string()).clicked() {
                         let ctx = ui.ctx().clone();
                         self.request_open(Some(p), &ctx);
@@ -641,8 +641,8 @@ impl App {
             });
         }
         if let Some(p) = remove.and_then(|k| self.session.remove_plan(k)) {
-            self.view.compare = super::CompareState {
-                canvas: std::mem::take(&mut self.view.compare.canvas),
+            self.panels.compare = super::CompareState {
+                canvas: std::mem::take(&mut self.panels.compare.canvas),
                 ..Default::default()
             };
             self.set_status(format!("removed {}", p.name), false);
@@ -666,14 +666,14 @@ impl App {
             .session
             .active
             .and_then(|k| self.session.toolpaths.get(k));
-        playback::controls(ui, "workbench", &mut self.view.playback, lowered, true);
+        playback::controls(ui, "workbench", &mut self.panels.playback, lowered, true);
         let stale = self
             .session
             .active
             .map_or_else(Vec::new, |k| self.plan_staleness(k).to_vec());
         let playback_t_s = lowered
             .and_then(Result::ok)
-            .and_then(|_| self.view.playback.shown_t_s());
+            .and_then(|_| self.panels.playback.shown_t_s());
         let canvas = Canvas {
             label: "Work area",
             geometries: &self.session.doc.geometries,
@@ -694,7 +694,7 @@ impl App {
                     .layers
                     .iter()
                     .any(|l| l.pen.hatch.is_some()))
-            .then_some(self.view.colours.as_slice()),
+            .then_some(self.session.colours.as_slice()),
             out_of_reach: &self.session.out_of_reach,
             paths: plan
                 .zip(lowered)
@@ -709,7 +709,7 @@ impl App {
             selected: self.view.selected,
             editable: true,
             add_tool: self.view.add_tool,
-            layers: self.view.layers,
+            layers: self.prefs.layers,
             stale: &stale,
             playback_t_s,
             parts: &self.session.part_boxes,
@@ -720,24 +720,24 @@ impl App {
         let header_px = 2.0 * ui.spacing().interact_size.y;
         let plots_px = motion_plots::PLOTS_HEIGHT_PX.min(ui.available_height() * 0.4);
         let below_px = match motion {
-            Some(_) if self.view.motion_plots_open => header_px + plots_px,
+            Some(_) if self.panels.plots_open => header_px + plots_px,
             Some(_) => header_px,
             None => 0.0,
         };
         let below = (
             motion.is_some(),
-            motion.is_some() && self.view.motion_plots_open,
+            motion.is_some() && self.panels.plots_open,
         );
-        if below != self.view.workbench_below {
+        if below != self.panels.plots_below {
             // the canvas changes height when the plots come or go: fit the content again
-            self.view.workbench_below = below;
-            self.view.workbench.fit_requested = true;
+            self.panels.plots_below = below;
+            self.panels.workbench.fit_requested = true;
         }
         let size = ui.available_size() - egui::Vec2::Y * below_px;
-        let (_, actions) = canvas.show(ui, &mut self.view.workbench, Some(size));
+        let (_, actions) = canvas.show(ui, &mut self.panels.workbench, Some(size));
         if let Some(samples) = motion {
-            motion_plots_header(ui, &mut self.view.motion_plots_open);
-            if self.view.motion_plots_open {
+            motion_plots_header(ui, &mut self.panels.plots_open);
+            if self.panels.plots_open {
                 motion_plots::show(
                     ui,
                     samples,

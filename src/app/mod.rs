@@ -101,7 +101,7 @@ pub fn run(file: Option<PathBuf>) -> anyhow::Result<()> {
                 .and_then(|s| eframe::get_value::<Prefs>(s, PREFS_KEY))
                 .unwrap_or_default();
             let mut app = App::with_prefs(prefs);
-            app.view.frame_log =
+            app.diagnostics.frame_log =
                 std::env::var_os("GALVOPLAN_FRAME_LOG").and_then(|p| std::fs::File::create(p).ok());
             if let Some(f) = file {
                 app.open_in_background(&f, &cc.egui_ctx);
@@ -173,74 +173,75 @@ struct Status {
     error: bool,
 }
 
-/// The window: the session (document and what derives from it, no egui), the view state
-/// (panels, canvases, prompts, status, preferences shown) and the job runtime (the background
-/// work and what follows it).
+/// The window, in rooms: the session (the document and what derives from it), the view (what
+/// is shown where), the panels (each with its own state), the preferences (read from this one
+/// place and stored), the diagnostics (frame timing) and the job runtime (the background work
+/// and what follows it).
 pub struct App {
     /// The open document, its history, plans and caches.
     pub session: Session,
     view: ViewState,
+    panels: Panels,
+    prefs: Prefs,
+    diagnostics: Diagnostics,
     runtime: Runtime,
 }
 
-/// What the window shows and how: panels, canvases, prompts, the status line, preferences.
+/// What the window shows and where: the central tab, the left panel's section, the field
+/// selected and the add tool, the status line, the title, and the quit and font state.
 struct ViewState {
-    editors: panels::Editors,
-    compare: CompareState,
-    workbench: CanvasState,
     selected: Option<usize>,
     add_tool: bool,
     tab: Tab,
-    /// Playback on the workbench canvas.
-    playback: Playback,
-    /// The motion plots below the workbench canvas are shown (on-the-fly plans).
-    motion_plots_open: bool,
-    /// What was under the workbench canvas in the last frame: (plots header, plots).
-    workbench_below: (bool, bool),
-    recent: Recent,
-    layers: Layers,
-    status: Status,
-    frames: FrameStats,
-    drag_group: u64,
-    dragging: bool,
-    title: String,
-    /// Per-frame timing log (`GALVOPLAN_FRAME_LOG=path`), for measuring responsiveness.
-    frame_log: Option<std::fs::File>,
-    /// The layers panel's edit buffers.
-    layer_editor: layers::LayerEditor,
-    /// The Tray section.
-    tray: tray_panel::TrayPanel,
     /// The section shown in the left panel.
     section: Section,
-    /// Show frame timings in the status bar.
-    frame_times: bool,
-    /// A question or path field waiting for the operator.
-    prompt: Option<Prompt>,
-    /// Native file dialogs can be shown (else a path field is offered).
-    dialogs: bool,
+    status: Status,
+    title: String,
     /// The operator chose to quit without saving.
     quit_confirmed: bool,
-    /// Counts imports: the warnings list opens again on each one.
-    imports: u64,
-    /// Each geometry's layer colour.
-    colours: Vec<egui::Color32>,
-    /// Counts refreshes of what the canvases draw (with the session's revision: the canvases'
-    /// raster caches are redrawn when it changes).
-    canvas_revision: u64,
-    /// The folder last exported to, per kind of export.
-    export_dirs: files::ExportDirs,
     /// DejaVu Sans is installed as the fallback font (arrows, symbols, layer names in other
     /// scripts would otherwise miss glyphs).
     fonts_installed: bool,
 }
 
-/// The background work and what is to follow it.
+/// The panels and windows, each owning its state (edit buffers, what it shows).
+struct Panels {
+    /// The profile and settings editors' buffers.
+    editors: panels::Editors,
+    /// The layers panel's edit buffers.
+    layer_editor: layers::LayerEditor,
+    /// The Tray section.
+    tray: tray_panel::TrayPanel,
+    /// The Compare tab.
+    compare: CompareState,
+    /// The workbench canvas (view, gestures, the drag under way).
+    workbench: CanvasState,
+    /// Playback on the workbench canvas.
+    playback: Playback,
+    /// The motion plots below the workbench canvas are shown (on-the-fly plans).
+    plots_open: bool,
+    /// What was under the workbench canvas in the last frame: (plots header, plots).
+    plots_below: (bool, bool),
+    /// A question or path field waiting for the operator.
+    prompt: Option<Prompt>,
+}
+
+/// How responsive the window is: recent frame times and the optional per-frame log.
 #[derive(Default)]
+struct Diagnostics {
+    frames: FrameStats,
+    /// Per-frame timing log (`GALVOPLAN_FRAME_LOG=path`), for measuring responsiveness.
+    frame_log: Option<std::fs::File>,
+}
+
+/// The background work and what is to follow it.
 struct Runtime {
     /// The running job (one at a time).
     job: Option<Job>,
     /// An export to write once the solve running now ends (re-solve and export).
     export_after_solve: Option<(ExportKind, PathBuf)>,
+    /// Native file dialogs can be shown (else a path field is offered).
+    dialogs: bool,
 }
 
 impl Default for App {
@@ -255,48 +256,44 @@ impl App {
         Self {
             session: Session {
                 doc: Document {
-                    profile: prefs.profile,
-                    settings: prefs.settings,
+                    profile: prefs.profile.clone(),
+                    settings: prefs.settings.clone(),
                     ..Document::default()
                 },
                 ..Session::default()
             },
             view: ViewState {
-                editors: panels::Editors::default(),
-                compare: CompareState::default(),
-                workbench: CanvasState::default(),
                 selected: None,
                 add_tool: false,
                 tab: Tab::Workbench,
-                playback: Playback::default(),
-                motion_plots_open: true,
-                workbench_below: (false, false),
-                recent: prefs.recent,
-                layers: prefs.layers,
+                section: Section::Layers,
                 status: Status {
                     text: "Open an SVG, a DXF or a project (File menu, or drag and drop) to start."
                         .into(),
                     error: false,
                 },
-                frames: FrameStats::default(),
-                drag_group: 0,
-                dragging: false,
                 title: String::new(),
-                frame_log: None,
-                layer_editor: layers::LayerEditor::default(),
-                tray: tray_panel::TrayPanel::default(),
-                section: Section::Layers,
-                frame_times: prefs.frame_times,
-                prompt: None,
-                dialogs: files::native_dialogs_available(),
                 quit_confirmed: false,
-                imports: 0,
-                colours: Vec::new(),
-                canvas_revision: 0,
-                export_dirs: prefs.export_dirs,
                 fonts_installed: false,
             },
-            runtime: Runtime::default(),
+            panels: Panels {
+                editors: panels::Editors::default(),
+                layer_editor: layers::LayerEditor::default(),
+                tray: tray_panel::TrayPanel::default(),
+                compare: CompareState::default(),
+                workbench: CanvasState::default(),
+                playback: Playback::default(),
+                plots_open: true,
+                plots_below: (false, false),
+                prompt: None,
+            },
+            prefs,
+            diagnostics: Diagnostics::default(),
+            runtime: Runtime {
+                job: None,
+                export_after_solve: None,
+                dialogs: files::native_dialogs_available(),
+            },
         }
     }
 
@@ -305,22 +302,19 @@ impl App {
         Prefs {
             profile: self.session.doc.profile.clone(),
             settings: self.session.doc.settings.clone(),
-            recent: self.view.recent.clone(),
-            layers: self.view.layers,
-            frame_times: self.view.frame_times,
-            export_dirs: self.view.export_dirs.clone(),
+            ..self.prefs.clone()
         }
     }
 
     /// Whether native file dialogs are tried (without them every file action asks for a path
     /// in a text field).
     pub fn set_native_dialogs(&mut self, on: bool) {
-        self.view.dialogs = on;
+        self.runtime.dialogs = on;
     }
 
     /// The question or path field shown, if any.
     pub fn prompt(&self) -> Option<&Prompt> {
-        self.view.prompt.as_ref()
+        self.panels.prompt.as_ref()
     }
 
     /// True when the document has changes that are not saved in a project file.
@@ -393,12 +387,12 @@ impl App {
         self.session.history.clear();
         self.view.selected = None;
         self.session.active = self.session.doc.plans.len().checked_sub(1);
-        self.view.compare = CompareState::default();
-        self.view.playback = Playback::default();
-        self.view.workbench.fit_requested = true;
-        self.view.compare.canvas.fit_requested = true;
-        self.view.recent.push(path);
-        self.view.imports += 1;
+        self.panels.compare = CompareState::default();
+        self.panels.playback = Playback::default();
+        self.panels.workbench.fit_requested = true;
+        self.panels.compare.canvas.fit_requested = true;
+        self.prefs.recent.push(path);
+        self.session.imports += 1;
         self.refresh();
         self.changed();
         self.session.saved_revision = self.session.revision;
@@ -537,7 +531,7 @@ impl App {
         crate::document::save_project(&self.session.doc, path).map_err(|e| e.to_string())?;
         self.session.project_path = Some(path.to_path_buf());
         self.session.saved_revision = self.session.revision;
-        self.view.recent.push(path);
+        self.prefs.recent.push(path);
         self.set_status(format!("saved {}", path.display()), false);
         Ok(())
     }
@@ -570,7 +564,7 @@ impl App {
             .and_then(Result::ok)
             .map(|l| &l.toolpath);
         files::export(&self.session.doc, plan, toolpath, kind, path)?;
-        self.view.export_dirs.remember(kind, path);
+        self.prefs.export_dirs.remember(kind, path);
         let note = match self.session.stale.get(k) {
             Some(why) if !why.is_empty() => " as planned (stale: the document changed since)",
             _ => "",
@@ -599,7 +593,7 @@ impl App {
             artwork: Vec::new(),
             ..self.session.doc.clone()
         };
-        self.view.export_dirs.remember(kind, path);
+        self.prefs.export_dirs.remember(kind, path);
         let file = path.to_path_buf();
         let name = format!("exporting {}", path.display());
         self.start_job(name, "export", repaint, move |_| {
@@ -677,7 +671,7 @@ impl App {
     /// What the canvases' raster caches are keyed by besides what they compare by value: the
     /// document's revision and the view's refreshes.
     fn canvas_revision(&self) -> u64 {
-        self.session.revision ^ self.view.canvas_revision.rotate_left(32)
+        self.session.revision ^ self.session.canvas_revision.rotate_left(32)
     }
 
     /// Recomputes what derives from the document after a change.
@@ -688,7 +682,7 @@ impl App {
 
     /// The view's part of a refresh (the session's is done): layer colours, the selection.
     fn refresh_view(&mut self) {
-        self.view.canvas_revision += 1;
+        self.session.canvas_revision += 1;
         let doc = &self.session.doc;
         let rgb: std::collections::HashMap<&str, egui::Color32> = doc
             .layers
@@ -698,7 +692,7 @@ impl App {
                 (l.name.as_str(), egui::Color32::from_rgb(r, g, b))
             })
             .collect();
-        self.view.colours = doc
+        self.session.colours = doc
             .geometries
             .iter()
             .map(|g| {
@@ -760,12 +754,12 @@ impl App {
 
     /// The workbench playback (time, playing, speed).
     pub fn playback(&self) -> &Playback {
-        &self.view.playback
+        &self.panels.playback
     }
 
     /// The compare view's state (plans shown, playback).
     pub fn compare_state(&self) -> &CompareState {
-        &self.view.compare
+        &self.panels.compare
     }
 
     /// The central view shown.
@@ -789,7 +783,7 @@ impl App {
 
     /// Frame durations.
     pub fn frame_stats(&self) -> &FrameStats {
-        &self.view.frames
+        &self.diagnostics.frames
     }
 
     /// Screen position of a tray part's centre on the workbench canvas (after the first frame).
@@ -805,24 +799,24 @@ impl App {
     /// Screen position of a tray cell's centre (marked or skipped) on the workbench canvas.
     pub fn cell_screen_pos(&self, cell: u32) -> Option<egui::Pos2> {
         let b = self.session.part_boxes.iter().find(|b| b.cell == cell)?;
-        let rect = self.view.workbench.rect?;
+        let rect = self.panels.workbench.rect?;
         let c = crate::geom::Pt::new(
             (b.bbox.min_x + b.bbox.max_x) / 2.0,
             (b.bbox.min_y + b.bbox.max_y) / 2.0,
         );
-        Some(self.view.workbench.view.to_screen(rect, c))
+        Some(self.panels.workbench.view.to_screen(rect, c))
     }
 
     /// Screen position of machine point `p` (mm) on the workbench canvas (after the first
     /// frame).
     pub fn mm_screen_pos(&self, p: crate::geom::Pt) -> Option<egui::Pos2> {
-        let rect = self.view.workbench.rect?;
-        Some(self.view.workbench.view.to_screen(rect, p))
+        let rect = self.panels.workbench.rect?;
+        Some(self.panels.workbench.view.to_screen(rect, p))
     }
 
     /// The workbench canvas's zoom: screen pixels per mm.
     pub fn workbench_px_per_mm(&self) -> f32 {
-        self.view.workbench.view.scale
+        self.panels.workbench.view.scale
     }
 
     /// The centre of code `code` (from 0) of part `part` on the machine, mm.
@@ -841,8 +835,8 @@ impl App {
     /// Screen position of a field's centre on the workbench canvas (after the first frame).
     pub fn field_screen_pos(&self, id: usize) -> Option<egui::Pos2> {
         let f = self.session.doc.fields.iter().find(|f| f.id == id)?;
-        let rect = self.view.workbench.rect?;
-        Some(self.view.workbench.view.to_screen(rect, f.center))
+        let rect = self.panels.workbench.rect?;
+        Some(self.panels.workbench.view.to_screen(rect, f.center))
     }
 
     /// Why a solve cannot start now, if it cannot.
@@ -924,10 +918,10 @@ impl App {
                 refit,
             }) => {
                 if self.execute(Command::SetContent { doc, what }).is_ok() {
-                    self.view.layer_editor.clear_error();
+                    self.panels.layer_editor.clear_error();
                     if refit {
-                        self.view.workbench.fit_requested = true;
-                        self.view.compare.canvas.fit_requested = true;
+                        self.panels.workbench.fit_requested = true;
+                        self.panels.compare.canvas.fit_requested = true;
                     }
                     if let Some(p) = problem {
                         self.set_status(format!("scan fields not placed: {p}"), true);
@@ -972,9 +966,9 @@ impl App {
                 );
                 let k = self.session.add_plan(*plan, lowered);
                 // a new plan is shown from its start
-                self.view.playback.t_s = 0.0;
-                self.view.playback.playing = false;
-                self.view.compare.push(k, &self.session.doc.plans);
+                self.panels.playback.t_s = 0.0;
+                self.panels.playback.playing = false;
+                self.panels.compare.push(k, &self.session.doc.plans);
                 match self.session.toolpaths.get(k) {
                     Some(Err(why)) => {
                         let msg = format!("{msg}; {why}");
@@ -1009,17 +1003,17 @@ impl App {
             match a {
                 CanvasAction::Select(id) => self.view.selected = id,
                 CanvasAction::Move { id, center } => {
-                    if !self.view.dragging {
-                        self.view.dragging = true;
-                        self.view.drag_group += 1;
+                    if !self.panels.workbench.dragging {
+                        self.panels.workbench.dragging = true;
+                        self.panels.workbench.drag_group += 1;
                     }
                     let _ = self.execute_grouped(
                         Command::MoveField { id, center },
-                        Some(self.view.drag_group),
+                        Some(self.panels.workbench.drag_group),
                     );
                 }
                 CanvasAction::EndDrag => {
-                    self.view.dragging = false;
+                    self.panels.workbench.dragging = false;
                     self.session.history.close_group();
                     if let Some(f) = self
                         .session
@@ -1121,7 +1115,7 @@ impl App {
                 .send_viewport_cmd(egui::ViewportCommand::Title(title.clone()));
             self.view.title = title;
         }
-        self.view
+        self.diagnostics
             .frames
             .push(t0.elapsed().as_secs_f64() * 1e3, self.runtime.job.is_some());
     }
@@ -1140,9 +1134,9 @@ impl App {
         let closing = ctx.input(|i| i.viewport().close_requested());
         if closing && !self.view.quit_confirmed && self.has_unsaved_changes() {
             ctx.send_viewport_cmd(egui::ViewportCommand::CancelClose);
-            self.view.prompt = Some(Prompt::Unsaved(prompts::Then::Quit));
+            self.panels.prompt = Some(Prompt::Unsaved(prompts::Then::Quit));
         }
-        if ctx.egui_wants_keyboard_input() || self.view.prompt.is_some() {
+        if ctx.egui_wants_keyboard_input() || self.panels.prompt.is_some() {
             return;
         }
         use egui::{Key, KeyboardShortcut, Modifiers};
@@ -1191,8 +1185,8 @@ impl App {
             }
         }
         if fit {
-            self.view.workbench.fit_requested = true;
-            self.view.compare.canvas.fit_requested = true;
+            self.panels.workbench.fit_requested = true;
+            self.panels.compare.canvas.fit_requested = true;
         }
     }
 }
@@ -1329,16 +1323,16 @@ pub fn field_numbers(
 
 impl eframe::App for App {
     fn ui(&mut self, ui: &mut egui::Ui, frame: &mut eframe::Frame) {
-        self.view.frames.cpu_ms = frame.info().cpu_usage.map(|s| f64::from(s) * 1e3);
+        self.diagnostics.frames.cpu_ms = frame.info().cpu_usage.map(|s| f64::from(s) * 1e3);
         App::ui(self, ui);
-        if let Some(log) = &mut self.view.frame_log {
+        if let Some(log) = &mut self.diagnostics.frame_log {
             use std::io::Write;
             // ui ms of this frame, whole-frame CPU ms of the previous one, solving 0/1
             let _ = writeln!(
                 log,
                 "{:.3} {:.3} {}",
-                self.view.frames.last_ms(),
-                self.view.frames.cpu_ms.unwrap_or(f64::NAN),
+                self.diagnostics.frames.last_ms(),
+                self.diagnostics.frames.cpu_ms.unwrap_or(f64::NAN),
                 u8::from(self.runtime.job.is_some())
             );
         }

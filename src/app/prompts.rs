@@ -106,7 +106,7 @@ impl App {
     /// Open (a file, or ask for one), after asking about unsaved changes.
     pub fn request_open(&mut self, path: Option<PathBuf>, ctx: &egui::Context) {
         if self.has_unsaved_changes() {
-            self.view.prompt = Some(Prompt::Unsaved(Then::Open(path)));
+            self.panels.prompt = Some(Prompt::Unsaved(Then::Open(path)));
             return;
         }
         match path {
@@ -118,7 +118,7 @@ impl App {
     /// Start an empty document, after asking about unsaved changes.
     pub fn request_new(&mut self) {
         if self.has_unsaved_changes() {
-            self.view.prompt = Some(Prompt::Unsaved(Then::New));
+            self.panels.prompt = Some(Prompt::Unsaved(Then::New));
             return;
         }
         self.runtime.job = None;
@@ -140,7 +140,7 @@ impl App {
     /// Close the window, after asking about unsaved changes.
     pub fn request_quit(&mut self, ctx: &egui::Context) {
         if self.has_unsaved_changes() && !self.view.quit_confirmed {
-            self.view.prompt = Some(Prompt::Unsaved(Then::Quit));
+            self.panels.prompt = Some(Prompt::Unsaved(Then::Quit));
             return;
         }
         self.view.quit_confirmed = true;
@@ -170,7 +170,7 @@ impl App {
         match self.session.active {
             None => self.set_status("no plan to export: run a solver first (Run HHA)", true),
             Some(k) if !self.plan_staleness(k).is_empty() => {
-                self.view.prompt = Some(Prompt::StaleExport(kind))
+                self.panels.prompt = Some(Prompt::StaleExport(kind))
             }
             Some(_) => self.choose_path(PathAction::Export(kind), ctx),
         }
@@ -201,7 +201,7 @@ impl App {
         };
         let folder = match action {
             PathAction::Export(kind) | PathAction::ResolveExport(kind) => self
-                .view
+                .prefs
                 .export_dirs
                 .get(kind)
                 .map(std::path::Path::to_path_buf),
@@ -216,7 +216,7 @@ impl App {
                 .map(std::path::Path::new)?;
             source.parent().map(std::path::Path::to_path_buf)
         });
-        if self.view.dialogs {
+        if self.runtime.dialogs {
             let t0 = Instant::now();
             let picked = match action {
                 PathAction::Open => files::pick_open(),
@@ -232,7 +232,7 @@ impl App {
                 self.set_status(format!("{title}: cancelled"), false);
                 return;
             }
-            self.view.dialogs = false;
+            self.runtime.dialogs = false;
         }
         let dir = folder.map(|d| {
             d.join(if action.saves() {
@@ -241,7 +241,7 @@ impl App {
                 ""
             })
         });
-        self.view.prompt = Some(Prompt::Path {
+        self.panels.prompt = Some(Prompt::Path {
             action,
             text: dir.map(|d| d.display().to_string()).unwrap_or_default(),
             note: "No file dialog can be shown on this desktop (no desktop portal is running). \
@@ -332,7 +332,7 @@ impl App {
 
     /// Draws the prompt, if any, as a modal window.
     pub(super) fn prompt_ui(&mut self, ui: &mut egui::Ui) {
-        let Some(prompt) = self.view.prompt.take() else {
+        let Some(prompt) = self.panels.prompt.take() else {
             return;
         };
         let ctx = ui.ctx().clone();
@@ -458,7 +458,7 @@ impl App {
             keep = false;
         }
         if keep {
-            self.view.prompt = Some(shown);
+            self.panels.prompt = Some(shown);
         }
         if let Some(f) = next {
             f(self, &ctx);

@@ -46,6 +46,13 @@ pub struct Session {
     pub part_boxes: Vec<super::tray_panel::PartBox>,
     /// Every part's codes, boxed (the canvas drags them).
     pub code_boxes: Vec<super::tray_panel::CodeBox>,
+    /// Each geometry's layer colour.
+    pub colours: Vec<egui::Color32>,
+    /// Counts imports: the warnings list opens again on each one.
+    pub imports: u64,
+    /// Counts refreshes of what the canvases draw (with `revision`: the canvases' raster
+    /// caches are redrawn when it changes).
+    pub canvas_revision: u64,
 }
 
 impl Session {

@@ -376,7 +376,7 @@ impl super::App {
             .session
             .active
             .is_some_and(|k| self.plan_staleness(k).is_empty());
-        match self.view.tray.ui(ui, &self.session.doc, can_export) {
+        match self.panels.tray.ui(ui, &self.session.doc, can_export) {
             Some(TrayAction::Set(setup)) => self.set_tray(setup, ui.ctx()),
             Some(TrayAction::SetCodes(codes)) => {
                 let what = match codes.len() {
@@ -502,7 +502,7 @@ impl super::App {
     /// The parts log *Export and advance* appends to: the section's path, else
     /// `NAME.parts.csv` beside the drawing (or beside the program).
     pub fn parts_log_path(&self, program: &std::path::Path) -> std::path::PathBuf {
-        let typed = self.view.tray.log_path.trim();
+        let typed = self.panels.tray.log_path.trim();
         if !typed.is_empty() {
             return std::path::PathBuf::from(typed);
         }
