@@ -23,7 +23,7 @@ fn demo() -> PathBuf {
 /// uncovered) and its geometry count.
 fn opened_oversize() -> (Harness<'static, App>, usize) {
     let h = opened(&common::root().join("assets/examples/oversize.svg"));
-    let n = h.state().session.doc.geometries.len();
+    let n = h.state().session.doc().geometries.len();
     (h, n)
 }
 
@@ -108,8 +108,8 @@ fn ctrl() -> Modifiers {
 #[test]
 fn open_demo_run_hha_shows_metrics() {
     let mut h = opened(&demo());
-    assert_eq!(h.state().session.doc.geometries.len(), 122);
-    assert!(!h.state().session.doc.fields.is_empty());
+    assert_eq!(h.state().session.doc().geometries.len(), 122);
+    assert!(!h.state().session.doc().fields.is_empty());
     assert!(h.state().uncovered().is_empty());
     assert!(h.query_by_label("Idle travel (mm)").is_none());
     h.get_by_label("Run HHA").click();
@@ -119,7 +119,7 @@ fn open_demo_run_hha_shows_metrics() {
     let plan = h.state().active_plan().expect("a plan").clone();
     assert_eq!(plan.algo, Algo::Hha);
     assert_eq!(plan.name, "HHA · job time · step-and-scan · seed 1");
-    common::check_plan(&h.state().session.doc, &plan);
+    common::check_plan(h.state().session.doc(), &plan);
     // the metrics table: worded rows with units, the job time first with the plan's value
     h.get_by_label("Idle travel (mm)");
     h.get_by_label(&format!("{:.1}", plan.metrics.idle_mm));
@@ -144,7 +144,7 @@ fn dragging_a_field_reallocates_and_undoes() {
     h.step();
     wait_idle(&mut h, Duration::from_secs(120));
     assert!(h.query_by_label("stale").is_none());
-    let field = h.state().session.doc.fields[0].clone();
+    let field = h.state().session.doc().fields[0].clone();
     assert!(!field.geometries.is_empty());
     let p0 = h.state().field_screen_pos(field.id).unwrap();
     let d = Vec2::new(-120.0, 90.0);
@@ -161,7 +161,7 @@ fn dragging_a_field_reallocates_and_undoes() {
     let moved = h
         .state()
         .session
-        .doc
+        .doc()
         .fields
         .iter()
         .find(|f| f.id == field.id)
@@ -186,7 +186,7 @@ fn dragging_a_field_reallocates_and_undoes() {
     let back = h
         .state()
         .session
-        .doc
+        .doc()
         .fields
         .iter()
         .find(|f| f.id == field.id)
@@ -200,7 +200,7 @@ fn dragging_a_field_reallocates_and_undoes() {
     let again = h
         .state()
         .session
-        .doc
+        .doc()
         .fields
         .iter()
         .find(|f| f.id == field.id)
@@ -211,7 +211,7 @@ fn dragging_a_field_reallocates_and_undoes() {
 #[test]
 fn add_lock_delete_and_replace_fields() {
     let mut h = opened(&demo());
-    let n = h.state().session.doc.fields.len();
+    let n = h.state().session.doc().fields.len();
     h.get_by_label("Add field").click();
     settle(&mut h);
     let canvas = h.get_by_label("Work area").rect();
@@ -227,7 +227,7 @@ fn add_lock_delete_and_replace_fields() {
         });
     }
     settle(&mut h);
-    assert_eq!(h.state().session.doc.fields.len(), n + 1);
+    assert_eq!(h.state().session.doc().fields.len(), n + 1);
     let id = h
         .state()
         .selected_field()
@@ -237,7 +237,7 @@ fn add_lock_delete_and_replace_fields() {
     assert!(h
         .state()
         .session
-        .doc
+        .doc()
         .fields
         .iter()
         .any(|f| f.id == id && f.locked));
@@ -248,20 +248,20 @@ fn add_lock_delete_and_replace_fields() {
     assert!(h
         .state()
         .session
-        .doc
+        .doc()
         .fields
         .iter()
         .any(|f| f.id == id && f.locked));
     assert!(h.state().uncovered().is_empty());
     h.get_by_label("Delete field").click();
     settle(&mut h);
-    assert!(!h.state().session.doc.fields.iter().any(|f| f.id == id));
+    assert!(!h.state().session.doc().fields.iter().any(|f| f.id == id));
     // undo the delete, the re-placement, the lock and the add
     for _ in 0..4 {
         h.get_by_label("Undo").click();
         settle(&mut h);
     }
-    assert_eq!(h.state().session.doc.fields.len(), n);
+    assert_eq!(h.state().session.doc().fields.len(), n);
 }
 
 /// Types `text` into the `n`-th field labelled `label` and presses Enter; steps once (a
@@ -294,15 +294,15 @@ fn invalid_profile_and_settings_input_is_rejected() {
     // worded, without file keys
     h.get_by_label("Field width (mm) must be a positive number, not -5");
     assert!(h.query_by_label_contains("field_mm").is_none());
-    assert_eq!(h.state().session.doc.profile.field_mm, [70.0, 70.0]);
+    assert_eq!(h.state().session.doc().profile.field_mm, [70.0, 70.0]);
     set_text(&mut h, "Field width (mm)", "abc");
     h.get_by_label_contains("Field width (mm) must be a number, not 'abc'");
-    assert_eq!(h.state().session.doc.profile.field_mm, [70.0, 70.0]);
+    assert_eq!(h.state().session.doc().profile.field_mm, [70.0, 70.0]);
     section(&mut h, "Solver settings");
     set_text(&mut h, "GA mutation rate", "1.5");
     h.get_by_label("GA mutation rate must be between 0 and 1, not 1.5");
     assert_eq!(
-        h.state().session.doc.settings.ga.mutation_rate,
+        h.state().session.doc().settings.ga.mutation_rate,
         SolverSettings::default().ga.mutation_rate
     );
     // a valid value is applied, resizes the fields and can be undone
@@ -311,30 +311,30 @@ fn invalid_profile_and_settings_input_is_rejected() {
     assert!(h
         .query_by_label_contains("must be a positive number")
         .is_none());
-    assert_eq!(h.state().session.doc.profile.field_mm, [60.0, 70.0]);
+    assert_eq!(h.state().session.doc().profile.field_mm, [60.0, 70.0]);
     assert!(h
         .state()
         .session
-        .doc
+        .doc()
         .fields
         .iter()
         .all(|f| f.size == [60.0, 70.0]));
     h.get_by_label("Undo").click();
     settle(&mut h);
-    assert_eq!(h.state().session.doc.profile.field_mm, [70.0, 70.0]);
+    assert_eq!(h.state().session.doc().profile.field_mm, [70.0, 70.0]);
     // a built-in profile is selectable
     h.get_by_label("Built-in").click();
     settle(&mut h);
     h.get_by_label("small-field").click();
     settle(&mut h);
-    assert_ne!(h.state().session.doc.profile.field_mm, [70.0, 70.0]);
+    assert_ne!(h.state().session.doc().profile.field_mm, [70.0, 70.0]);
     assert!(h
         .state()
         .session
-        .doc
+        .doc()
         .fields
         .iter()
-        .all(|f| f.size == h.state().session.doc.profile.field_mm));
+        .all(|f| f.size == h.state().session.doc().profile.field_mm));
 }
 
 /// Runs the CLI on the demo with `algo` and seed 7, the GUI likewise; the plans must agree.
@@ -360,7 +360,7 @@ fn same_plan_as_cli(algo: &str, button: &str) {
     let mut h = opened(&demo());
     section(&mut h, "Solver settings");
     set_text(&mut h, "Seed", "7");
-    assert_eq!(h.state().session.doc.settings.seed, 7);
+    assert_eq!(h.state().session.doc().settings.seed, 7);
     h.get_by_label(button).click();
     h.step();
     wait_idle(&mut h, Duration::from_secs(300));
@@ -405,7 +405,7 @@ fn gui_and_cli_make_the_same_hga_plan() {
 fn cancel_an_hga_run() {
     let mut h = opened(&demo());
     // settings under which HGA would run for minutes
-    let mut s = h.state().session.doc.settings.clone();
+    let mut s = h.state().session.doc().settings.clone();
     s.ga.stall_generations = 1_000_000;
     s.time_limit_s = Some(600.0);
     h.state_mut()
@@ -438,7 +438,7 @@ fn cancel_an_hga_run() {
     assert_eq!(plan.algo, Algo::Hga);
     assert!(plan.name.contains("stopped"), "{}", plan.name);
     assert!(!plan.history.is_empty());
-    common::check_plan(&h.state().session.doc, &plan);
+    common::check_plan(h.state().session.doc(), &plan);
     // … never slower than its seed, the HHA plan of the same settings
     h.get_by_label("Run HHA").click();
     h.step();
@@ -465,7 +465,7 @@ fn compare_view_shows_both_plans_and_the_difference() {
     h.get_by_label("B vs A");
     // the compare table and the active plan's table in the side panel
     assert_eq!(h.get_all_by_label("Direction changes").count(), 2);
-    let plans = &h.state().session.doc.plans;
+    let plans = &h.state().session.doc().plans;
     let (a, b) = (&plans[0].metrics, &plans[1].metrics);
     let pct = (b.idle_mm - a.idle_mm) / a.idle_mm * 100.0;
     h.get_by_label(&format!("{pct:+.1} %"));
@@ -511,7 +511,7 @@ fn project_round_trip_and_drag_and_drop() {
         .push(std::sync::Arc::new(Dropped(project.clone())));
     h2.step();
     wait_idle(&mut h2, Duration::from_secs(60));
-    let (a, b) = (&h.state().session.doc, &h2.state().session.doc);
+    let (a, b) = (h.state().session.doc(), &h2.state().session.doc());
     assert_eq!(a.fields, b.fields);
     assert_eq!(a.plans, b.plans);
     assert_eq!(
@@ -545,20 +545,20 @@ fn oversize_geometries_are_shown_uncovered_until_split() {
     h.get_by_label("Split oversize geometries (on re-place)")
         .click();
     settle(&mut h);
-    assert!(h.state().session.doc.settings.split_oversize);
+    assert!(h.state().session.doc().settings.split_oversize);
     h.get_by_label("Re-place automatically").click();
     h.step();
     wait_idle(&mut h, Duration::from_secs(60));
-    assert!(h.state().session.doc.geometries.len() > n);
+    assert!(h.state().session.doc().geometries.len() > n);
     assert!(h.state().uncovered().is_empty());
     // the split pieces are reported as warnings in the panel
-    let w = h.state().session.doc.warnings.len();
+    let w = h.state().session.doc().warnings.len();
     assert!(w > 0);
     h.get_by_label(&format!("Warnings ({w})"));
     // undo restores the unsplit geometries
     h.get_by_label("Undo").click();
     settle(&mut h);
-    assert_eq!(h.state().session.doc.geometries.len(), n);
+    assert_eq!(h.state().session.doc().geometries.len(), n);
     assert_eq!(h.state().uncovered().len(), n);
 }
 
@@ -585,7 +585,7 @@ fn switching_to_on_the_fly_places_fields_for_what_was_uncovered() {
         "{}",
         h.state().status()
     );
-    assert!(!h.state().session.doc.fields.is_empty());
+    assert!(!h.state().session.doc().fields.is_empty());
     // counts read as words: "1 geometry", not "1 geometries"
     assert!(h.query_by_label_contains("1 geometries").is_none());
 }
@@ -602,7 +602,7 @@ fn import_warnings_are_listed() {
     )
     .unwrap();
     let h = opened(&svg);
-    assert_eq!(h.state().session.doc.warnings.len(), 1);
+    assert_eq!(h.state().session.doc().warnings.len(), 1);
     h.get_by_label("Warnings (1)");
     h.get_by_label_contains("photo");
 }
@@ -665,12 +665,12 @@ fn frame_time_while_solving() {
 
 /// Runs `button`'s solver to the end; returns the new plan.
 fn solve(h: &mut Harness<'_, App>, button: &str) -> galvoplan::document::Plan {
-    let n = h.state().session.doc.plans.len();
+    let n = h.state().session.doc().plans.len();
     h.get_by_label(button).click();
     h.step();
     wait_idle(h, Duration::from_secs(120));
     assert_eq!(
-        h.state().session.doc.plans.len(),
+        h.state().session.doc().plans.len(),
         n + 1,
         "{}",
         h.state().status()
@@ -681,7 +681,7 @@ fn solve(h: &mut Harness<'_, App>, button: &str) -> galvoplan::document::Plan {
 #[test]
 fn the_cost_switch_decides_what_the_solve_minimises() {
     let mut h = opened(&demo());
-    assert_eq!(h.state().session.doc.settings.cost_model, CostModel::Time);
+    assert_eq!(h.state().session.doc().settings.cost_model, CostModel::Time);
     section(&mut h, "Solver settings");
     h.get_by_label("Cost model").hover();
     settle(&mut h);
@@ -692,7 +692,7 @@ fn the_cost_switch_decides_what_the_solve_minimises() {
     h.get_by_label("Idle travel distance").click();
     settle(&mut h);
     assert_eq!(
-        h.state().session.doc.settings.cost_model,
+        h.state().session.doc().settings.cost_model,
         CostModel::Distance
     );
     let by_distance = solve(&mut h, "Run HHA");
@@ -711,7 +711,7 @@ fn the_cost_switch_decides_what_the_solve_minimises() {
     // the change is one undoable settings step
     h.get_by_label("Undo").click();
     settle(&mut h);
-    assert_eq!(h.state().session.doc.settings.cost_model, CostModel::Time);
+    assert_eq!(h.state().session.doc().settings.cost_model, CostModel::Time);
 }
 
 #[test]
@@ -720,7 +720,7 @@ fn run_as_is_keeps_the_document_order() {
     let plan = solve(&mut h, "Run as-is");
     assert_eq!(plan.algo, Algo::AsIs);
     assert_eq!(plan.name, "As-is · job time · step-and-scan");
-    common::check_plan(&h.state().session.doc, &plan);
+    common::check_plan(h.state().session.doc(), &plan);
     let hha = solve(&mut h, "Run HHA");
     assert!(hha.metrics.job_time_s.unwrap() < plan.metrics.job_time_s.unwrap());
 }
@@ -819,7 +819,7 @@ fn set_motion(h: &mut Harness<'_, App>, option: &str) {
 #[test]
 fn the_motion_switch_plans_on_the_fly() {
     let mut h = opened(&demo());
-    assert_eq!(h.state().session.doc.settings.motion, MotionMode::Step);
+    assert_eq!(h.state().session.doc().settings.motion, MotionMode::Step);
     section(&mut h, "Solver settings");
     h.get_by_label("Motion").hover();
     settle(&mut h);
@@ -827,7 +827,10 @@ fn the_motion_switch_plans_on_the_fly() {
     let step = solve(&mut h, "Run HHA");
     assert!(!h.state().toolpath(0).unwrap().unwrap().on_the_fly());
     set_motion(&mut h, "On the fly (stage moves while marking)");
-    assert_eq!(h.state().session.doc.settings.motion, MotionMode::OnTheFly);
+    assert_eq!(
+        h.state().session.doc().settings.motion,
+        MotionMode::OnTheFly
+    );
     // the step plan keeps the motion it was planned for
     let kept = h.state().toolpath(0).unwrap().unwrap().clone();
     assert!(!kept.on_the_fly());
@@ -859,7 +862,7 @@ fn the_motion_switch_plans_on_the_fly() {
     settle(&mut h);
     h.get_by_label("Undo").click();
     settle(&mut h);
-    assert_eq!(h.state().session.doc.settings.motion, MotionMode::Step);
+    assert_eq!(h.state().session.doc().settings.motion, MotionMode::Step);
     // the on-the-fly plan stays on the fly
     assert!(h.state().toolpath(1).unwrap().unwrap().on_the_fly());
 }
@@ -877,7 +880,7 @@ fn motion_plots_show_an_on_the_fly_plan() {
         "{}",
         s.t_s.len()
     );
-    let reach_mm = 35.0 - h.state().session.doc.profile.otf_margin_mm;
+    let reach_mm = 35.0 - h.state().session.doc().profile.otf_margin_mm;
     assert!(
         s.peak_offset_mm() <= reach_mm + 1e-6,
         "{}",
@@ -920,7 +923,7 @@ fn the_stage_route_switch_plans_seed001_routes() {
         .click();
     settle(&mut h);
     assert_eq!(
-        h.state().session.doc.settings.stage_route,
+        h.state().session.doc().settings.stage_route,
         StageRouteKind::Lsa
     );
     let plan = solve(&mut h, "Run HHA");
@@ -943,13 +946,13 @@ fn hatch_settings_in_the_layers_panel_rehatch_the_document() {
     let names: Vec<String> = h
         .state()
         .session
-        .doc
+        .doc()
         .layers
         .iter()
         .map(|l| l.name.clone())
         .collect();
     assert_eq!(names, ["outline", "fill"]);
-    let outlines = h.state().session.doc.geometries.len();
+    let outlines = h.state().session.doc().geometries.len();
     h.get_by_label("Layers (2)");
     // choose a hatch for the second layer: a background job hatches and places fields again
     nth_by_label(&h, "Hatch", 1).click();
@@ -957,7 +960,7 @@ fn hatch_settings_in_the_layers_panel_rehatch_the_document() {
     h.get_by_label("zigzag").click();
     h.step();
     wait_idle(&mut h, Duration::from_secs(60));
-    let doc = &h.state().session.doc;
+    let doc = h.state().session.doc();
     let hatch = doc.layers[1].pen.hatch.clone().expect("a hatch");
     assert_eq!(hatch.style, galvoplan::hatch::HatchStyle::Zigzag);
     let hatched = doc.geometries.len();
@@ -971,12 +974,12 @@ fn hatch_settings_in_the_layers_panel_rehatch_the_document() {
     // a finer spacing hatches again with more strokes
     enter_nth(&mut h, "Hatch spacing (mm)", 0, "0.25");
     wait_idle(&mut h, Duration::from_secs(60));
-    let finer = h.state().session.doc.geometries.len();
+    let finer = h.state().session.doc().geometries.len();
     let len = |doc: &galvoplan::document::Document| -> f64 {
         doc.geometries.iter().map(|g| g.length_mm()).sum()
     };
     assert_eq!(
-        h.state().session.doc.layers[1]
+        h.state().session.doc().layers[1]
             .pen
             .hatch
             .as_ref()
@@ -985,26 +988,26 @@ fn hatch_settings_in_the_layers_panel_rehatch_the_document() {
         0.25
     );
     assert!(finer >= hatched);
-    let fine_mm = len(&h.state().session.doc);
+    let fine_mm = len(h.state().session.doc());
     // undo goes back to the coarser hatch, then to outlines only
     h.key_press_modifiers(ctrl(), Key::Z);
     settle(&mut h);
-    assert!(len(&h.state().session.doc) < fine_mm);
-    assert_eq!(h.state().session.doc.geometries.len(), hatched);
+    assert!(len(h.state().session.doc()) < fine_mm);
+    assert_eq!(h.state().session.doc().geometries.len(), hatched);
     h.key_press_modifiers(ctrl(), Key::Z);
     settle(&mut h);
-    assert_eq!(h.state().session.doc.geometries.len(), outlines);
-    assert!(h.state().session.doc.layers[1].pen.hatch.is_none());
+    assert_eq!(h.state().session.doc().geometries.len(), outlines);
+    assert!(h.state().session.doc().layers[1].pen.hatch.is_none());
 }
 
 #[test]
 fn a_disabled_layer_is_left_out_and_pens_change_at_once() {
     let mut h = opened(&two_layers());
-    let all = h.state().session.doc.geometries.len();
+    let all = h.state().session.doc().geometries.len();
     let fill = h
         .state()
         .session
-        .doc
+        .doc()
         .geometries
         .iter()
         .filter(|g| g.layer == "fill")
@@ -1012,34 +1015,34 @@ fn a_disabled_layer_is_left_out_and_pens_change_at_once() {
     h.get_by_label("fill").click();
     h.step();
     wait_idle(&mut h, Duration::from_secs(60));
-    assert!(!h.state().session.doc.layers[1].pen.enabled);
-    assert_eq!(h.state().session.doc.geometries.len(), all - fill);
+    assert!(!h.state().session.doc().layers[1].pen.enabled);
+    assert_eq!(h.state().session.doc().geometries.len(), all - fill);
     // a speed is a pen change only: no job, the geometries stay
     enter_nth(&mut h, "Mark speed (mm/s)", 0, "750");
     settle(&mut h);
     assert!(!h.state().is_busy());
     assert_eq!(
-        h.state().session.doc.layers[0].pen.mark_speed_mm_s,
+        h.state().session.doc().layers[0].pen.mark_speed_mm_s,
         Some(750.0)
     );
-    assert_eq!(h.state().session.doc.geometries.len(), all - fill);
+    assert_eq!(h.state().session.doc().geometries.len(), all - fill);
 }
 
 #[test]
 fn a_rejected_pen_value_shows_a_worded_error() {
     let mut h = opened(&two_layers());
-    let before = h.state().session.doc.layers.clone();
+    let before = h.state().session.doc().layers.clone();
     let passes = h.get_all_by_label("Passes").count();
     assert_eq!(passes, 2);
     // the second layer's passes
     enter_nth(&mut h, "Passes", 1, "0");
     settle(&mut h);
     h.get_by_label("Layer 'fill': Passes must be a whole number from 1 to 100, not 0");
-    assert_eq!(h.state().session.doc.layers, before);
+    assert_eq!(h.state().session.doc().layers, before);
     enter_nth(&mut h, "Mark speed (mm/s)", 0, "fast");
     settle(&mut h);
     h.get_by_label("Layer 'outline': Mark speed (mm/s) must be a number, not 'fast'");
-    assert_eq!(h.state().session.doc.layers, before);
+    assert_eq!(h.state().session.doc().layers, before);
 }
 
 #[test]
@@ -1054,7 +1057,7 @@ fn without_a_file_dialog_a_path_field_is_offered() {
     enter_nth(&mut h, "File path", 0, &demo().display().to_string());
     wait_idle(&mut h, Duration::from_secs(60));
     assert!(h.state().prompt().is_none());
-    assert_eq!(h.state().session.doc.geometries.len(), 122);
+    assert_eq!(h.state().session.doc().geometries.len(), 122);
     // Ctrl+S asks for the project's path the same way
     h.key_press_modifiers(ctrl(), Key::S);
     settle(&mut h);
@@ -1077,7 +1080,7 @@ fn without_a_file_dialog_a_path_field_is_offered() {
 fn quitting_after_an_edit_asks_about_unsaved_changes() {
     let mut h = opened(&demo());
     assert!(!h.state().has_unsaved_changes());
-    let id = h.state().session.doc.fields[0].id;
+    let id = h.state().session.doc().fields[0].id;
     h.state_mut()
         .execute(Command::SetLocked { id, locked: true })
         .unwrap();
@@ -1108,8 +1111,8 @@ fn exporting_a_stale_plan_asks_first() {
     h.get_by_label("Run HHA").click();
     h.step();
     wait_idle(&mut h, Duration::from_secs(120));
-    let id = h.state().session.doc.fields[0].id;
-    let c = h.state().session.doc.fields[0].center;
+    let id = h.state().session.doc().fields[0].id;
+    let c = h.state().session.doc().fields[0].center;
     h.state_mut()
         .execute(Command::MoveField {
             id,
@@ -1127,7 +1130,7 @@ fn exporting_a_stale_plan_asks_first() {
 fn fields_are_numbered_from_one_in_placement_then_visiting_order() {
     use galvoplan::app::field_number;
     let mut h = opened(&demo());
-    let fields = h.state().session.doc.fields.clone();
+    let fields = h.state().session.doc().fields.clone();
     for (k, f) in fields.iter().enumerate() {
         assert_eq!(field_number(&fields, None, f.id), k + 1);
     }
@@ -1152,7 +1155,7 @@ fn a_dropped_dxf_opens_with_its_layers() {
         .push(std::sync::Arc::new(Dropped(path)));
     h.step();
     wait_idle(&mut h, Duration::from_secs(60));
-    let doc = &h.state().session.doc;
+    let doc = h.state().session.doc();
     assert_eq!(doc.geometries.len(), 26, "{}", h.state().status());
     assert!(doc.geometries.iter().any(|g| g.source.layer == "CUT"));
     assert!(!doc.fields.is_empty());
@@ -1196,10 +1199,10 @@ fn a_pen_edit_makes_the_plan_stale_and_re_solve_and_export_writes_the_new_feed()
     wait_idle(&mut h, Duration::from_secs(120));
     let g = std::fs::read_to_string(&out).unwrap_or_else(|e| panic!("{e}: {}", h.state().status()));
     assert!(g.contains(" F18000"), "no feed of 300 mm/s in the G-code");
-    assert_eq!(h.state().session.doc.plans.len(), 2);
+    assert_eq!(h.state().session.doc().plans.len(), 2);
     assert!(h.state().plan_staleness(1).is_empty());
     assert!(h.state().plan_staleness(0).len() == 1);
-    let job_s = h.state().session.doc.plans[1].metrics.job_time_s.unwrap();
+    let job_s = h.state().session.doc().plans[1].metrics.job_time_s.unwrap();
     assert!(g.contains(&format!("job time {job_s:.3} s")));
 }
 
@@ -1210,7 +1213,7 @@ fn a_profile_edit_makes_the_headline_stale() {
     set_text(&mut h, "Base X max velocity (mm/s)", "100");
     settle(&mut h);
     assert_eq!(
-        h.state().session.doc.profile.axis_x.max_velocity_mm_s,
+        h.state().session.doc().profile.axis_x.max_velocity_mm_s,
         100.0
     );
     let why = h.state().plan_staleness(0).to_vec();
@@ -1221,7 +1224,7 @@ fn a_profile_edit_makes_the_headline_stale() {
     );
     h.get_by_label("stale");
     // the plan keeps the figures and the toolpath of its own profile
-    let plan = h.state().session.doc.plans[0].clone();
+    let plan = h.state().session.doc().plans[0].clone();
     let l = h.state().toolpath(0).unwrap().unwrap().clone();
     assert_eq!(Some(l.duration_s()), plan.metrics.job_time_s);
 }
@@ -1270,7 +1273,7 @@ fn a_hatch_edit_keeps_the_plans_and_marks_them_stale() {
     h.get_by_label("zigzag").click();
     h.step();
     wait_idle(&mut h, Duration::from_secs(60));
-    assert_eq!(h.state().session.doc.plans.len(), 1);
+    assert_eq!(h.state().session.doc().plans.len(), 1);
     let why = h.state().plan_staleness(0);
     assert!(
         why.iter().any(|w| w.starts_with("the geometries changed")),
@@ -1282,7 +1285,7 @@ fn a_hatch_edit_keeps_the_plans_and_marks_them_stale() {
         "{why:?}"
     );
     // the plan is still drawn and exported on the geometries it was planned on
-    let plan = h.state().session.doc.plans[0].clone();
+    let plan = h.state().session.doc().plans[0].clone();
     assert_eq!(
         Some(h.state().toolpath(0).unwrap().unwrap().duration_s()),
         plan.metrics.job_time_s
@@ -1303,7 +1306,7 @@ fn the_status_of_a_delete_names_the_field_as_the_canvas_does() {
     use galvoplan::app::field_number;
     let mut h = opened(&demo());
     solve(&mut h, "Run HHA");
-    let fields = h.state().session.doc.fields.clone();
+    let fields = h.state().session.doc().fields.clone();
     let visiting = h.state().active_plan().unwrap().fields.clone();
     // a field whose visiting number is not its placement number
     let f = fields
@@ -1323,7 +1326,7 @@ fn the_status_of_a_delete_names_the_field_as_the_canvas_does() {
         "{}",
         h.state().status()
     );
-    assert_eq!(h.state().session.doc.plans.len(), 1);
+    assert_eq!(h.state().session.doc().plans.len(), 1);
 }
 
 #[test]
@@ -1349,7 +1352,7 @@ fn stage_routes_and_settings_are_offered_in_an_operators_words() {
     h.get_by_label("Genetic algorithm route (slow)").click();
     settle(&mut h);
     assert_eq!(
-        h.state().session.doc.settings.stage_route,
+        h.state().session.doc().settings.stage_route,
         galvoplan::document::StageRouteKind::CetspGa
     );
     // the other choices: words, with the command line in the hover
@@ -1375,7 +1378,7 @@ fn layers_named_after_their_colour_show_a_colour_word() {
     let names: Vec<String> = h
         .state()
         .session
-        .doc
+        .doc()
         .layers
         .iter()
         .map(|l| l.name.clone())
@@ -1392,7 +1395,7 @@ fn layers_named_after_their_colour_show_a_colour_word() {
     // ... and a valid edit leaves the document's name (what pens files match) as it was
     enter_nth(&mut h, "Mark speed (mm/s)", k, "400");
     settle(&mut h);
-    let layer = &h.state().session.doc.layers[k];
+    let layer = &h.state().session.doc().layers[k];
     assert_eq!(layer.name, "#1f2937");
     assert_eq!(layer.pen.mark_speed_mm_s, Some(400.0));
     assert!(h.query_by_label_contains("must be a number").is_none());
@@ -1410,7 +1413,7 @@ fn a_rejected_profile_or_settings_value_clears_after_a_valid_edit_of_another() {
     // a valid edit of another value: applied, the rejected one is no longer shown (nor red:
     // its field holds the value in force again) and the hint is back
     set_text(&mut h, "Stroke X (mm)", "290");
-    assert_eq!(h.state().session.doc.profile.stroke_mm[0], 290.0);
+    assert_eq!(h.state().session.doc().profile.stroke_mm[0], 290.0);
     assert!(h
         .query_by_label_contains("must be a positive number")
         .is_none());
@@ -1430,13 +1433,13 @@ fn a_rejected_profile_or_settings_value_clears_after_a_valid_edit_of_another() {
     );
     // the name takes its whole width and commits on Enter like the numbers
     set_text(&mut h, "Name", "bench machine");
-    assert_eq!(h.state().session.doc.profile.name, "bench machine");
+    assert_eq!(h.state().session.doc().profile.name, "bench machine");
     // the settings form behaves the same
     section(&mut h, "Solver settings");
     set_text(&mut h, "GA mutation rate", "1.5");
     h.get_by_label("GA mutation rate must be between 0 and 1, not 1.5");
     set_text(&mut h, "Seed", "3");
-    assert_eq!(h.state().session.doc.settings.seed, 3);
+    assert_eq!(h.state().session.doc().settings.seed, 3);
     assert!(h.query_by_label_contains("must be between").is_none());
     assert_eq!(
         h.get_by_label("GA mutation rate").value().as_deref(),
@@ -1481,11 +1484,11 @@ fn an_on_the_fly_region_larger_than_the_scan_field_is_called_a_region() {
         .click();
     h.step();
     wait_idle(&mut h, Duration::from_secs(60));
-    let field_mm = h.state().session.doc.profile.field_mm;
+    let field_mm = h.state().session.doc().profile.field_mm;
     let region = h
         .state()
         .session
-        .doc
+        .doc()
         .fields
         .iter()
         .find(|f| f.size[0] > field_mm[0])
@@ -1494,7 +1497,7 @@ fn an_on_the_fly_region_larger_than_the_scan_field_is_called_a_region() {
     let n = h.state().field_label(region.id);
     assert_eq!(h.state().field_name(region.id), format!("region {n}"));
     // counted and named as a region in the window's words
-    assert_eq!(h.state().session.doc.fields.len(), 1);
+    assert_eq!(h.state().session.doc().fields.len(), 1);
     h.get_by_label_contains("1 region ·");
     assert!(h.query_by_label_contains("1 field").is_none());
     // selected: its heading and what a region is
@@ -1530,7 +1533,7 @@ fn uncovered_geometries_are_told_apart_from_every_layer_colour() {
     use galvoplan::document::parse_colour;
     let mut h = opened(&two_layers());
     // uncover some geometries: delete a field
-    let id = h.state().session.doc.fields[0].id;
+    let id = h.state().session.doc().fields[0].id;
     h.state_mut().execute(Command::DeleteField { id }).unwrap();
     settle(&mut h);
     assert!(!h.state().uncovered().is_empty());
@@ -1543,10 +1546,10 @@ fn uncovered_geometries_are_told_apart_from_every_layer_colour() {
     for l in h
         .state()
         .session
-        .doc
+        .doc()
         .layers
         .iter()
-        .chain(&demo.state().session.doc.layers)
+        .chain(&demo.state().session.doc().layers)
     {
         let rgb = l.pen.colour.as_deref().and_then(parse_colour).unwrap();
         assert_ne!(rgb, uncovered, "layer {}", l.name);
@@ -1609,7 +1612,7 @@ fn nothing_is_cut_off_on_the_smallest_window() {
 fn hidden_layers_are_listed_greyed_and_included_with_one_click_then_undone() {
     let dxf = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/hidden/hidden-layers.dxf");
     let mut h = opened(&dxf);
-    let before = h.state().session.doc.geometries.len();
+    let before = h.state().session.doc().geometries.len();
     assert_eq!(before, 1);
     assert!(
         h.state()
@@ -1618,7 +1621,7 @@ fn hidden_layers_are_listed_greyed_and_included_with_one_click_then_undone() {
         "{}",
         h.state().status()
     );
-    let layers = format!("Layers ({})", h.state().session.doc.layers.len());
+    let layers = format!("Layers ({})", h.state().session.doc().layers.len());
     section(&mut h, &layers);
     h.get_by_label_contains("OFF: off, 1 item, not marked");
     h.get_by_label_contains("FROZEN: frozen, 1 item, not marked");
@@ -1626,25 +1629,25 @@ fn hidden_layers_are_listed_greyed_and_included_with_one_click_then_undone() {
     h.get_all_by_label("Include").next().unwrap().click();
     h.step();
     wait_idle(&mut h, Duration::from_secs(60));
-    assert_eq!(h.state().session.doc.geometries.len(), 2);
-    assert_eq!(h.state().session.doc.import.included, ["OFF"]);
+    assert_eq!(h.state().session.doc().geometries.len(), 2);
+    assert_eq!(h.state().session.doc().import.included, ["OFF"]);
     h.get_by_label_contains("OFF: off, 1 item, marked");
     assert!(h.state().uncovered().is_empty());
-    let layers = h.state().session.doc.layers.len();
+    let layers = h.state().session.doc().layers.len();
     // left out again: its geometry and its layer (with the pen) go
     h.get_by_label("Leave out").click();
     h.step();
     wait_idle(&mut h, Duration::from_secs(60));
-    assert_eq!(h.state().session.doc.geometries.len(), 1);
-    assert_eq!(h.state().session.doc.layers.len(), layers - 1);
+    assert_eq!(h.state().session.doc().geometries.len(), 1);
+    assert_eq!(h.state().session.doc().layers.len(), layers - 1);
     h.get_by_label_contains("OFF: off, 1 item, not marked");
     // undo brings the included layer back, a second undo the first import
     h.get_by_label("Undo").click();
     settle(&mut h);
-    assert_eq!(h.state().session.doc.geometries.len(), 2);
+    assert_eq!(h.state().session.doc().geometries.len(), 2);
     h.get_by_label("Undo").click();
     settle(&mut h);
-    assert_eq!(h.state().session.doc.geometries.len(), 1);
+    assert_eq!(h.state().session.doc().geometries.len(), 1);
     h.get_by_label_contains("OFF: off, 1 item, not marked");
 }
 
@@ -1655,12 +1658,12 @@ fn placement_centres_the_artwork_on_the_base_stroke() {
     let bbox = |h: &Harness<'_, App>| {
         h.state()
             .session
-            .doc
+            .doc()
             .geometries
             .iter()
             .fold(galvoplan::geom::BBox::EMPTY, |b, g| b.union(g.bbox()))
     };
-    let layers = format!("Layers ({})", h.state().session.doc.layers.len());
+    let layers = format!("Layers ({})", h.state().session.doc().layers.len());
     section(&mut h, &layers);
     // as in the file: out of reach, and the error names the control that helps
     h.get_by_label("Placement").click();
@@ -1680,7 +1683,7 @@ fn placement_centres_the_artwork_on_the_base_stroke() {
     h.step();
     wait_idle(&mut h, Duration::from_secs(60));
     let b = bbox(&h);
-    let stroke = h.state().session.doc.profile.stroke_mm;
+    let stroke = h.state().session.doc().profile.stroke_mm;
     assert!(
         ((b.min_x + b.max_x) / 2.0 - stroke[0] / 2.0).abs() < 1e-3,
         "{b:?}"
@@ -1700,7 +1703,7 @@ fn convergence_plot_speaks_the_tables_figures_and_names_say_what_a_plan_is() {
         h.step();
         wait_idle(&mut h, Duration::from_secs(180));
     }
-    let plans = h.state().session.doc.plans.clone();
+    let plans = h.state().session.doc().plans.clone();
     let (hha, hga) = (&plans[0], &plans[1]);
     assert_eq!(hha.name, "HHA · job time · step-and-scan · seed 1");
     assert_eq!(hga.name, "HGA · job time · step-and-scan · seed 1");
@@ -1729,12 +1732,12 @@ fn convergence_plot_speaks_the_tables_figures_and_names_say_what_a_plan_is() {
 #[test]
 fn a_hostile_file_leaves_the_open_document_and_its_edits() {
     let mut h = opened(&demo());
-    let id = h.state().session.doc.fields[0].id;
+    let id = h.state().session.doc().fields[0].id;
     h.state_mut()
         .execute(Command::SetLocked { id, locked: true })
         .unwrap();
     settle(&mut h);
-    let before = h.state().session.doc.clone();
+    let before = h.state().session.doc().clone();
     let hostile = common::root().join("tests/data/hostile/demo-huge-coordinate.svg");
     h.input_mut()
         .dropped_files
@@ -1753,7 +1756,7 @@ fn a_hostile_file_leaves_the_open_document_and_its_edits() {
         "{status}"
     );
     h.get_by_label_contains("<path> (line 124)");
-    assert!(h.state().session.doc == before, "the document changed");
+    assert!(*h.state().session.doc() == before, "the document changed");
     assert!(h.state().has_unsaved_changes(), "the edits count as saved");
 }
 
@@ -1795,7 +1798,7 @@ fn hover_part(h: &mut Harness<'_, App>, n: u32) {
 #[test]
 fn a_three_by_two_tray_shows_six_numbered_parts_and_their_serials() {
     let mut h = tray("3", "2", "1001");
-    let doc = &h.state().session.doc;
+    let doc = h.state().session.doc();
     assert_eq!(doc.parts.len(), 6);
     let serials: Vec<i64> = doc.parts.iter().map(|p| p.serial).collect();
     assert_eq!(serials, [1001, 1002, 1003, 1004, 1005, 1006]);
@@ -1832,7 +1835,7 @@ fn cell_menu(h: &mut Harness<'_, App>, cell: u32, item: &str) {
 fn a_part_is_skipped_and_marked_again_from_its_context_menu() {
     let mut h = tray("3", "2", "1");
     cell_menu(&mut h, 2, "Skip this part");
-    let doc = &h.state().session.doc;
+    let doc = h.state().session.doc();
     assert_eq!(doc.parts.len(), 5);
     assert!(doc.parts.iter().all(|p| p.cell != 2));
     // the skipped cell takes no serial: cell 3 is part 2
@@ -1840,7 +1843,7 @@ fn a_part_is_skipped_and_marked_again_from_its_context_menu() {
     h.get_by_label_contains("(1 skipped: cells 2)");
     // its context menu marks it again
     cell_menu(&mut h, 2, "Mark this part");
-    assert_eq!(h.state().session.doc.parts.len(), 6);
+    assert_eq!(h.state().session.doc().parts.len(), 6);
 }
 
 #[test]
@@ -1867,10 +1870,10 @@ fn export_and_advance_logs_the_parts_moves_the_serial_on_and_cannot_be_undone() 
         rows.lines().last().unwrap().ends_with(",6,1006,SN 01006"),
         "{rows}"
     );
-    let p = h.state().session.doc.production.clone().unwrap();
+    let p = h.state().session.doc().production.clone().unwrap();
     assert_eq!((p.serial.start, p.logged_through), (1007, Some(1006)));
     // the next tray's texts are made: part 1 now says 1007
-    assert_eq!(h.state().session.doc.parts[0].texts[0], "SN 01007");
+    assert_eq!(h.state().session.doc().parts[0].texts[0], "SN 01007");
     h.get_by_label("Next tray starts at 1013");
     // undo takes back the remade texts, then refuses to hand out the logged serials again
     h.key_press_modifiers(ctrl(), Key::Z);
@@ -1885,7 +1888,7 @@ fn export_and_advance_logs_the_parts_moves_the_serial_on_and_cannot_be_undone() 
     assert_eq!(
         h.state()
             .session
-            .doc
+            .doc()
             .production
             .as_ref()
             .unwrap()
@@ -1920,7 +1923,7 @@ fn a_datamatrix_on_a_three_by_two_tray_is_drawn_and_tells_part_4s_content() {
     h.get_by_label("Apply codes").click();
     h.step();
     wait_idle(&mut h, Duration::from_secs(60));
-    let doc = &h.state().session.doc;
+    let doc = h.state().session.doc();
     assert_eq!(doc.parts[3].codes, ["GP01004"]);
     // its modules are on the canvas: strokes on the codes layer, in part 4 too
     let modules = doc
@@ -1943,7 +1946,7 @@ fn a_datamatrix_on_a_three_by_two_tray_is_drawn_and_tells_part_4s_content() {
         "{}",
         h.state().status()
     );
-    assert_eq!(h.state().session.doc.parts[3].codes, ["GP01004"]);
+    assert_eq!(h.state().session.doc().parts[3].codes, ["GP01004"]);
     // dragging the code on part 4 moves it on every part, in one undoable step
     enter_nth(&mut h, "Code size (mm)", 0, "6");
     settle(&mut h);
@@ -1967,7 +1970,7 @@ fn a_datamatrix_on_a_three_by_two_tray_is_drawn_and_tells_part_4s_content() {
     wait_idle(&mut h, Duration::from_secs(60));
     let status = h.state().status().to_string();
     assert!(status.contains("move code 1 to ("), "{status}");
-    let spec = &h.state().session.doc.production.as_ref().unwrap().codes[0];
+    let spec = &h.state().session.doc().production.as_ref().unwrap().codes[0];
     // the drag's mm on screen, to the canvas's pixel
     let px_mm = 1.0 / f64::from(h.state().workbench_px_per_mm());
     assert!(
@@ -1983,10 +1986,10 @@ fn a_datamatrix_on_a_three_by_two_tray_is_drawn_and_tells_part_4s_content() {
     let after = code_box_of_part(&h, 1);
     assert!((after.0 - before.0 - (spec.at_mm[0] - 3.0)).abs() < 1e-6);
     assert!((after.1 - before.1 - (spec.at_mm[1] - 3.0)).abs() < 1e-6);
-    assert_eq!(h.state().session.doc.parts[3].codes, ["GP01004"]);
+    assert_eq!(h.state().session.doc().parts[3].codes, ["GP01004"]);
     h.key_press_modifiers(ctrl(), Key::Z);
     settle(&mut h);
-    let spec = &h.state().session.doc.production.as_ref().unwrap().codes[0];
+    let spec = &h.state().session.doc().production.as_ref().unwrap().codes[0];
     assert_eq!(spec.at_mm, [3.0, 3.0]);
 }
 
@@ -1994,7 +1997,7 @@ fn a_datamatrix_on_a_three_by_two_tray_is_drawn_and_tells_part_4s_content() {
 fn code_box_of_part(h: &Harness<'_, App>, part: u32) -> (f64, f64) {
     h.state()
         .session
-        .doc
+        .doc()
         .artwork
         .iter()
         .filter(|g| g.layer == "codes" && g.source.part == part)

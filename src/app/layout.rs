@@ -48,9 +48,9 @@ impl App {
                     compare::show(
                         ui,
                         &mut self.panels.compare,
-                        &self.session.doc,
-                        &self.session.toolpaths,
-                        &self.session.stale,
+                        self.session.doc(),
+                        self.session.toolpaths(),
+                        self.session.stale(),
                         self.prefs.layers,
                         revision,
                     );
@@ -135,7 +135,7 @@ impl App {
             ui.menu_button("Edit", |ui| {
                 let u = self
                     .session
-                    .history
+                    .history()
                     .undo_label()
                     .map(|w| format!("Undo {w}"));
                 if ui
@@ -149,7 +149,7 @@ impl App {
                 }
                 let r = self
                     .session
-                    .history
+                    .history()
                     .redo_label()
                     .map(|w| format!("Redo {w}"));
                 if ui
@@ -208,7 +208,7 @@ impl App {
                 self.request_save(false, &ctx);
             }
             ui.separator();
-            let can_undo = self.session.history.undo_label().is_some();
+            let can_undo = self.session.history().undo_label().is_some();
             if ui
                 .add_enabled(can_undo, egui::Button::new("Undo"))
                 .on_hover_text("Ctrl+Z")
@@ -216,7 +216,7 @@ impl App {
             {
                 self.undo();
             }
-            let can_redo = self.session.history.redo_label().is_some();
+            let can_redo = self.session.history().redo_label().is_some();
             if ui
                 .add_enabled(can_redo, egui::Button::new("Redo"))
                 .on_hover_text("Ctrl+Shift+Z")
@@ -236,7 +236,7 @@ impl App {
             let sel = self
                 .view
                 .selected
-                .and_then(|id| self.session.doc.fields.iter().find(|f| f.id == id))
+                .and_then(|id| self.session.doc().fields.iter().find(|f| f.id == id))
                 .map(|f| (f.id, f.locked));
             if ui
                 .add_enabled(sel.is_some(), egui::Button::new("Delete field"))
@@ -304,10 +304,13 @@ impl App {
             }
             ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
                 if self.has_document() {
-                    let u = self.session.uncovered.len();
+                    let u = self.session.uncovered().len();
                     let t = RichText::new(format!(
                         "{} · {} uncovered",
-                        super::fields_count(&self.session.doc.fields, &self.session.doc.profile),
+                        super::fields_count(
+                            &self.session.doc().fields,
+                            &self.session.doc().profile
+                        ),
                         u
                     ));
                     ui.label(if u > 0 { t.color(ERROR) } else { t });
@@ -363,12 +366,12 @@ impl App {
 
     fn layers_ui(&mut self, ui: &mut egui::Ui) {
         let busy = self.runtime.job.as_ref().map(|j| j.name.clone());
-        let import = (self.session.can_reimport).then_some(&self.session.doc.import);
+        let import = (self.session.can_reimport()).then_some(&self.session.doc().import);
         let action = self.panels.layer_editor.ui(
             ui,
-            &self.session.doc.layers,
-            &self.session.layer_counts,
-            &self.session.doc.profile,
+            &self.session.doc().layers,
+            self.session.layer_counts(),
+            &self.session.doc().profile,
             import,
             busy.as_deref(),
         );
@@ -383,7 +386,7 @@ impl App {
 
     fn left_panel(&mut self, ui: &mut egui::Ui) {
         ui.horizontal_wrapped(|ui| {
-            let layers = format!("Layers ({})", self.session.doc.layers.len());
+            let layers = format!("Layers ({})", self.session.doc().layers.len());
             ui.selectable_value(&mut self.view.section, Section::Layers, layers)
                 .on_hover_text("Layers and their pens: speed, power, passes, hatch");
             ui.selectable_value(&mut self.view.section, Section::Settings, "Solver settings");
@@ -398,21 +401,25 @@ impl App {
                 if let Some(cmd) = self
                     .panels
                     .editors
-                    .settings_ui(ui, &self.session.doc.settings)
+                    .settings_ui(ui, &self.session.doc().settings)
                 {
-                    let motion = self.session.doc.settings.motion;
+                    let motion = self.session.doc().settings.motion;
                     let changed =
-                        self.execute(cmd).is_ok() && self.session.doc.settings.motion != motion;
+                        self.execute(cmd).is_ok() && self.session.doc().settings.motion != motion;
                     // on the fly holds what no scan field could (and back): fields placed for
                     // the other motion that leave geometries uncovered are placed again at once
-                    if changed && !self.session.uncovered.is_empty() && !self.is_busy() {
+                    if changed && !self.session.uncovered().is_empty() && !self.is_busy() {
                         self.replace_fields(ui.ctx());
                     }
                 }
             }
             Section::Tray => self.tray_ui(ui),
             Section::Profile => {
-                if let Some(cmd) = self.panels.editors.profile_ui(ui, &self.session.doc.profile) {
+                if let Some(cmd) = self
+                    .panels
+                    .editors
+                    .profile_ui(ui, &self.session.doc().profile)
+                {
                     let _ = self.execute(cmd);
                 }
                 if let Some(a) = self.panels.editors.take_file_request() {
@@ -429,7 +436,7 @@ impl App {
 
     fn right_panel(&mut self, ui: &mut egui::Ui) {
         ui.heading("Document");
-        match &self.session.doc.source {
+        match &self.session.doc().source {
             Some(s) => {
                 ui.label(RichText::new(s).small());
             }
@@ -438,24 +445,28 @@ impl App {
             }
         }
         if self.has_document() {
-            let closed = self.session.closed;
+            let closed = self.session.closed();
             ui.label(format!(
                 "{} ({closed} closed, {} open), {}",
-                super::count(self.session.doc.geometries.len(), "geometry", "geometries"),
-                self.session.doc.geometries.len() - closed,
-                super::fields_count(&self.session.doc.fields, &self.session.doc.profile)
+                super::count(
+                    self.session.doc().geometries.len(),
+                    "geometry",
+                    "geometries"
+                ),
+                self.session.doc().geometries.len() - closed,
+                super::fields_count(&self.session.doc().fields, &self.session.doc().profile)
             ));
-            let far = self.session.out_of_reach.len();
-            let near = self.session.uncovered.len() - far;
+            let far = self.session.out_of_reach().len();
+            let near = self.session.uncovered().len() - far;
             // larger than a field (cut them, or mark on the fly) or beyond the reach (move the
             // artwork): each told what helps it
-            let [fw, fh] = self.session.doc.profile.field_mm;
+            let [fw, fh] = self.session.doc().profile.field_mm;
             let large = self
                 .session
-                .out_of_reach
+                .out_of_reach()
                 .iter()
                 .filter(|&&g| {
-                    let b = self.session.doc.geometries[g].bbox();
+                    let b = self.session.doc().geometries[g].bbox();
                     b.width() > fw || b.height() > fh
                 })
                 .count();
@@ -501,7 +512,7 @@ impl App {
                 );
             }
         }
-        if let Some(p) = &self.session.problem {
+        if let Some(p) = self.session.problem() {
             ui.add(egui::Label::new(RichText::new(p).color(ERROR)).wrap());
         }
         self.selected_field_ui(ui);
@@ -513,13 +524,13 @@ impl App {
             // stale figures are said to be so before they are shown
             let stale = self
                 .session
-                .active
+                .active()
                 .map_or(&[][..], |k| self.plan_staleness(k));
             compare::stale_notes(ui, &[(plan, stale)]);
             compare::metrics_table(ui, "active-metrics", plan, None);
         }
         ui.separator();
-        let n = self.session.doc.warnings.len();
+        let n = self.session.doc().warnings.len();
         let title = if n > 0 {
             // import, cut and whole-or-cut warnings alike: what the drawing and the placement say
             RichText::new(format!("Warnings ({n})"))
@@ -530,13 +541,13 @@ impl App {
         };
         // a new id per import: the list opens on each import that has warnings
         egui::CollapsingHeader::new(title)
-            .id_salt(("warnings", self.session.imports))
+            .id_salt(("warnings", self.session.imports()))
             .default_open(n > 0)
             .show(ui, |ui| {
                 if n == 0 {
                     ui.label("none");
                 }
-                for w in &self.session.doc.warnings {
+                for w in &self.session.doc().warnings {
                     ui.add(
                         egui::Label::new(
                             RichText::new(w.to_string()).color(Color32::from_rgb(180, 83, 9)),
@@ -561,16 +572,16 @@ impl App {
         let Some(f) = self
             .view
             .selected
-            .and_then(|id| self.session.doc.fields.iter().find(|f| f.id == id))
+            .and_then(|id| self.session.doc().fields.iter().find(|f| f.id == id))
         else {
             return;
         };
         ui.separator();
         let visiting = self.active_plan().map(|p| p.fields.as_slice());
-        let word = super::field_word(f, &self.session.doc.profile);
+        let word = super::field_word(f, &self.session.doc().profile);
         let mut heading = format!(
             "{word} {}",
-            super::field_number(&self.session.doc.fields, visiting, f.id)
+            super::field_number(&self.session.doc().fields, visiting, f.id)
         );
         if let Some(first) = heading.get_mut(..1) {
             first.make_ascii_uppercase();
@@ -589,7 +600,7 @@ impl App {
             .wrap(),
         );
         if word == "region" {
-            let [w, h] = self.session.doc.profile.field_mm;
+            let [w, h] = self.session.doc().profile.field_mm;
             ui.add(
                 egui::Label::new(
                     RichText::new(format!(
@@ -605,21 +616,21 @@ impl App {
 
     fn plans_ui(&mut self, ui: &mut egui::Ui) {
         ui.heading("Plans");
-        if self.session.doc.plans.is_empty() {
+        if self.session.doc().plans.is_empty() {
             ui.label("none yet: run a solver");
         }
-        let mut remove = None;
-        for k in 0..self.session.doc.plans.len() {
-            let p = &self.session.doc.plans[k];
+        let (mut remove, mut show) = (None, None);
+        for k in 0..self.session.doc().plans.len() {
+            let p = &self.session.doc().plans[k];
             let stale = self.plan_staleness(k).to_vec();
             // the name (what the plan is: algorithm, cost, motion, seed) wraps on its own line
-            let selected = self.session.active == Some(k);
+            let selected = self.session.active() == Some(k);
             ui.set_max_width(ui.available_width());
             if ui
                 .add(egui::Button::selectable(selected, p.name.as_str()).wrap())
                 .clicked()
             {
-                self.session.active = Some(k);
+                show = Some(k);
             }
             ui.horizontal_wrapped(|ui| {
                 let text = match p.metrics.job_time_s {
@@ -639,6 +650,9 @@ impl App {
                     remove = Some(k);
                 }
             });
+        }
+        if let Some(k) = show {
+            self.session.show_plan(k);
         }
         if let Some(p) = remove.and_then(|k| self.session.remove_plan(k)) {
             self.panels.compare = super::CompareState {
@@ -660,42 +674,42 @@ impl App {
         }
         let plan = self
             .session
-            .active
-            .and_then(|k| self.session.doc.plans.get(k));
+            .active()
+            .and_then(|k| self.session.doc().plans.get(k));
         let lowered = self
             .session
-            .active
-            .and_then(|k| self.session.toolpaths.get(k));
+            .active()
+            .and_then(|k| self.session.toolpaths().get(k));
         playback::controls(ui, "workbench", &mut self.panels.playback, lowered, true);
         let stale = self
             .session
-            .active
+            .active()
             .map_or_else(Vec::new, |k| self.plan_staleness(k).to_vec());
         let playback_t_s = lowered
             .and_then(Result::ok)
             .and_then(|_| self.panels.playback.shown_t_s());
         let canvas = Canvas {
             label: "Work area",
-            geometries: &self.session.doc.geometries,
-            profile: &self.session.doc.profile,
-            fields: &self.session.doc.fields,
-            seams: &self.session.doc.seams.lines,
-            tiling: self.session.doc.tiling.as_ref(),
+            geometries: &self.session.doc().geometries,
+            profile: &self.session.doc().profile,
+            fields: &self.session.doc().fields,
+            seams: &self.session.doc().seams.lines,
+            tiling: self.session.doc().tiling.as_ref(),
             cell_max_mm: crate::fields::cell_max_mm(
-                &self.session.doc.layers,
-                self.session.doc.profile.field_mm,
+                &self.session.doc().layers,
+                self.session.doc().profile.field_mm,
             ),
             visiting: plan.map(|p| p.fields.as_slice()),
             // layer colours when the layers tell something apart (several, or a hatch)
-            colours: (self.session.doc.layers.len() > 1
+            colours: (self.session.doc().layers.len() > 1
                 || self
                     .session
-                    .doc
+                    .doc()
                     .layers
                     .iter()
                     .any(|l| l.pen.hatch.is_some()))
-            .then_some(self.session.colours.as_slice()),
-            out_of_reach: &self.session.out_of_reach,
+            .then_some(self.session.colours()),
+            out_of_reach: self.session.out_of_reach(),
             paths: plan
                 .zip(lowered)
                 .map(|(p, lowered)| PathLayer {
@@ -705,15 +719,15 @@ impl App {
                 })
                 .into_iter()
                 .collect(),
-            uncovered: &self.session.uncovered,
+            uncovered: self.session.uncovered(),
             selected: self.view.selected,
             editable: true,
             add_tool: self.view.add_tool,
             layers: self.prefs.layers,
             stale: &stale,
             playback_t_s,
-            parts: &self.session.part_boxes,
-            codes: &self.session.code_boxes,
+            parts: self.session.part_boxes(),
+            codes: self.session.code_boxes(),
             revision: self.canvas_revision(),
         };
         let motion = lowered.and_then(Result::ok).and_then(|l| l.motion.as_ref());
@@ -724,10 +738,7 @@ impl App {
             Some(_) => header_px,
             None => 0.0,
         };
-        let below = (
-            motion.is_some(),
-            motion.is_some() && self.panels.plots_open,
-        );
+        let below = (motion.is_some(), motion.is_some() && self.panels.plots_open);
         if below != self.panels.plots_below {
             // the canvas changes height when the plots come or go: fit the content again
             self.panels.plots_below = below;
@@ -741,7 +752,7 @@ impl App {
                 motion_plots::show(
                     ui,
                     samples,
-                    &self.session.doc.profile,
+                    &self.session.doc().profile,
                     playback_t_s,
                     plots_px,
                 );

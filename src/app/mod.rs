@@ -254,14 +254,11 @@ impl App {
     /// A new window state with stored preferences.
     pub fn with_prefs(prefs: Prefs) -> Self {
         Self {
-            session: Session {
-                doc: Document {
-                    profile: prefs.profile.clone(),
-                    settings: prefs.settings.clone(),
-                    ..Document::default()
-                },
-                ..Session::default()
-            },
+            session: Session::with_document(Document {
+                profile: prefs.profile.clone(),
+                settings: prefs.settings.clone(),
+                ..Document::default()
+            }),
             view: ViewState {
                 selected: None,
                 add_tool: false,
@@ -300,8 +297,8 @@ impl App {
     /// The preferences to store.
     pub fn prefs(&self) -> Prefs {
         Prefs {
-            profile: self.session.doc.profile.clone(),
-            settings: self.session.doc.settings.clone(),
+            profile: self.session.doc().profile.clone(),
+            settings: self.session.doc().settings.clone(),
             ..self.prefs.clone()
         }
     }
@@ -320,10 +317,6 @@ impl App {
     /// True when the document has changes that are not saved in a project file.
     pub fn has_unsaved_changes(&self) -> bool {
         self.session.has_unsaved_changes()
-    }
-
-    fn changed(&mut self) {
-        self.session.changed();
     }
 
     fn set_status(&mut self, text: impl Into<String>, error: bool) {
@@ -348,8 +341,8 @@ impl App {
     pub fn open(&mut self, path: &Path) -> bool {
         match files::open(
             path,
-            &self.session.doc.profile,
-            &self.session.doc.settings,
+            &self.session.doc().profile,
+            &self.session.doc().settings,
             &JobCtx::default(),
         ) {
             Ok(o) => {
@@ -367,8 +360,8 @@ impl App {
     pub fn open_in_background(&mut self, path: &Path, repaint: &egui::Context) {
         let (file, profile, settings) = (
             path.to_path_buf(),
-            self.session.doc.profile.clone(),
-            self.session.doc.settings.clone(),
+            self.session.doc().profile.clone(),
+            self.session.doc().settings.clone(),
         );
         let name = format!("opening {}", path.display());
         self.start_job(name, "open", repaint, move |ctx| {
@@ -382,21 +375,16 @@ impl App {
     /// Takes an opened document into the window.
     fn opened(&mut self, path: &Path, o: files::Opened) {
         self.runtime.job = None;
-        self.session.doc = o.doc;
-        self.session.project_path = o.is_project.then(|| path.to_path_buf());
-        self.session.history.clear();
+        self.session
+            .replace(o.doc, o.is_project.then(|| path.to_path_buf()), true);
         self.view.selected = None;
-        self.session.active = self.session.doc.plans.len().checked_sub(1);
         self.panels.compare = CompareState::default();
         self.panels.playback = Playback::default();
         self.panels.workbench.fit_requested = true;
         self.panels.compare.canvas.fit_requested = true;
         self.prefs.recent.push(path);
-        self.session.imports += 1;
-        self.refresh();
-        self.changed();
-        self.session.saved_revision = self.session.revision;
-        let hidden = self.session.doc.import.skipped().count();
+        self.refresh_view();
+        let hidden = self.session.doc().import.skipped().count();
         let hidden = if hidden > 0 {
             format!(
                 "; {} the drawing hides not marked (Layers panel)",
@@ -408,19 +396,23 @@ impl App {
         let msg = format!(
             "{}: {} on {}, {}, {}{hidden}",
             path.display(),
-            count(self.session.doc.geometries.len(), "geometry", "geometries"),
-            count(self.session.doc.layers.len(), "layer", "layers"),
-            count(self.session.doc.fields.len(), "scan field", "scan fields"),
+            count(
+                self.session.doc().geometries.len(),
+                "geometry",
+                "geometries"
+            ),
+            count(self.session.doc().layers.len(), "layer", "layers"),
+            count(self.session.doc().fields.len(), "scan field", "scan fields"),
             // the Warnings panel's word
-            count(self.session.doc.warnings.len(), "warning", "warnings")
+            count(self.session.doc().warnings.len(), "warning", "warnings")
         );
         match o.problem {
             Some(p) => {
                 self.set_status(format!("{msg}; scan fields not placed: {p}"), true);
-                self.session.problem = Some(p);
+                self.session.set_problem(Some(p));
             }
             None => {
-                self.session.problem = None;
+                self.session.set_problem(None);
                 self.set_status(msg, false);
             }
         }
@@ -450,7 +442,7 @@ impl App {
 
     /// Re-places the unlocked fields automatically in a background job (undoable).
     pub fn replace_fields(&mut self, repaint: &egui::Context) {
-        let mut work = self.session.doc.clone();
+        let mut work = self.session.doc().clone();
         self.start_job(
             "re-placing scan fields".into(),
             "place",
@@ -470,8 +462,8 @@ impl App {
     /// Imports the artwork again with other choices (placement, hidden layers) in a background
     /// job (undoable when it ends).
     pub fn reimport(&mut self, import: crate::document::ArtworkImport, repaint: &egui::Context) {
-        let what = import_change(&self.session.doc.import, &import);
-        let doc = self.session.doc.clone();
+        let what = import_change(&self.session.doc().import, &import);
+        let doc = self.session.doc().clone();
         self.start_job(
             format!("importing again: {what}"),
             "import",
@@ -498,14 +490,14 @@ impl App {
         }
         if Some(DerivedKey::of(
             &layers,
-            self.session.doc.profile.field_mm,
-            self.session.doc.tiling_set.as_ref(),
-        )) == self.session.doc.derived_with
+            self.session.doc().profile.field_mm,
+            self.session.doc().tiling_set.as_ref(),
+        )) == self.session.doc().derived_with
         {
             let _ = self.execute(Command::SetLayers(layers));
             return;
         }
-        let mut work = self.session.doc.clone();
+        let mut work = self.session.doc().clone();
         work.layers = layers;
         self.start_job("hatching".into(), "hatch", repaint, move |ctx| {
             let before = work.geometries.len();
@@ -528,9 +520,8 @@ impl App {
 
     /// Saves the document (with its plans) as a project file, atomically.
     pub fn save_project(&mut self, path: &Path) -> Result<(), String> {
-        crate::document::save_project(&self.session.doc, path).map_err(|e| e.to_string())?;
-        self.session.project_path = Some(path.to_path_buf());
-        self.session.saved_revision = self.session.revision;
+        crate::document::save_project(self.session.doc(), path).map_err(|e| e.to_string())?;
+        self.session.mark_saved(Some(path.to_path_buf()));
         self.prefs.recent.push(path);
         self.set_status(format!("saved {}", path.display()), false);
         Ok(())
@@ -549,23 +540,23 @@ impl App {
         self.check_export_path(kind, path)?;
         let k = self
             .session
-            .active
+            .active()
             .ok_or("no plan to export: run a solver first")?;
         let plan = self
             .session
-            .doc
+            .doc()
             .plans
             .get(k)
             .ok_or("no plan to export: run a solver first")?;
         let toolpath = self
             .session
-            .toolpaths
+            .toolpaths()
             .get(k)
             .and_then(Result::ok)
             .map(|l| &l.toolpath);
-        files::export(&self.session.doc, plan, toolpath, kind, path)?;
+        files::export(self.session.doc(), plan, toolpath, kind, path)?;
         self.prefs.export_dirs.remember(kind, path);
-        let note = match self.session.stale.get(k) {
+        let note = match self.session.stale().get(k) {
             Some(why) if !why.is_empty() => " as planned (stale: the document changed since)",
             _ => "",
         };
@@ -581,17 +572,22 @@ impl App {
         }
         let Some((k, plan)) = self
             .session
-            .active
-            .and_then(|k| Some((k, self.session.doc.plans.get(k)?.clone())))
+            .active()
+            .and_then(|k| Some((k, self.session.doc().plans.get(k)?.clone())))
         else {
             self.set_status("no plan to export: run a solver first", true);
             return;
         };
-        let lowered = self.session.toolpaths.get(k).and_then(Result::ok).cloned();
+        let lowered = self
+            .session
+            .toolpaths()
+            .get(k)
+            .and_then(Result::ok)
+            .cloned();
         let doc = Document {
             plans: Vec::new(),
             artwork: Vec::new(),
-            ..self.session.doc.clone()
+            ..self.session.doc().clone()
         };
         self.prefs.export_dirs.remember(kind, path);
         let file = path.to_path_buf();
@@ -640,8 +636,8 @@ impl App {
                     };
                     self.set_status(format!("{what}: {cover}"), false);
                 }
-                if o.uncovered.is_empty() && self.session.problem.is_some() {
-                    self.session.problem = None;
+                if o.uncovered.is_empty() && self.session.problem().is_some() {
+                    self.session.set_problem(None);
                 }
             }
             Err(e) => self.set_status(format!("cannot {what}: {e}"), true),
@@ -671,36 +667,12 @@ impl App {
     /// What the canvases' raster caches are keyed by besides what they compare by value: the
     /// document's revision and the view's refreshes.
     fn canvas_revision(&self) -> u64 {
-        self.session.revision ^ self.session.canvas_revision.rotate_left(32)
+        self.session.revision() ^ self.session.canvas_revision().rotate_left(32)
     }
 
-    /// Recomputes what derives from the document after a change.
-    fn refresh(&mut self) {
-        self.session.refresh();
-        self.refresh_view();
-    }
-
-    /// The view's part of a refresh (the session's is done): layer colours, the selection.
+    /// The view's part of a refresh (the session's is done): the selection.
     fn refresh_view(&mut self) {
-        self.session.canvas_revision += 1;
-        let doc = &self.session.doc;
-        let rgb: std::collections::HashMap<&str, egui::Color32> = doc
-            .layers
-            .iter()
-            .map(|l| {
-                let [r, g, b] = l.rgb();
-                (l.name.as_str(), egui::Color32::from_rgb(r, g, b))
-            })
-            .collect();
-        self.session.colours = doc
-            .geometries
-            .iter()
-            .map(|g| {
-                rgb.get(g.layer.as_str())
-                    .copied()
-                    .unwrap_or(paint::colour::CLOSED)
-            })
-            .collect();
+        let doc = self.session.doc();
         if self
             .view
             .selected
@@ -729,12 +701,12 @@ impl App {
 
     /// Uncovered geometries that no scan field can hold.
     pub fn out_of_reach(&self) -> &[usize] {
-        &self.session.out_of_reach
+        self.session.out_of_reach()
     }
 
     /// Geometries no field holds.
     pub fn uncovered(&self) -> &[usize] {
-        &self.session.uncovered
+        self.session.uncovered()
     }
 
     /// The selected field id.
@@ -790,7 +762,7 @@ impl App {
     pub fn part_screen_pos(&self, part: u32) -> Option<egui::Pos2> {
         let b = self
             .session
-            .part_boxes
+            .part_boxes()
             .iter()
             .find(|b| b.part == Some(part))?;
         self.cell_screen_pos(b.cell)
@@ -798,7 +770,7 @@ impl App {
 
     /// Screen position of a tray cell's centre (marked or skipped) on the workbench canvas.
     pub fn cell_screen_pos(&self, cell: u32) -> Option<egui::Pos2> {
-        let b = self.session.part_boxes.iter().find(|b| b.cell == cell)?;
+        let b = self.session.part_boxes().iter().find(|b| b.cell == cell)?;
         let rect = self.panels.workbench.rect?;
         let c = crate::geom::Pt::new(
             (b.bbox.min_x + b.bbox.max_x) / 2.0,
@@ -823,7 +795,7 @@ impl App {
     pub fn code_centre_mm(&self, code: usize, part: u32) -> Option<crate::geom::Pt> {
         let b = self
             .session
-            .code_boxes
+            .code_boxes()
             .iter()
             .find(|c| c.code == code && c.part == part)?;
         Some(crate::geom::Pt::new(
@@ -834,7 +806,7 @@ impl App {
 
     /// Screen position of a field's centre on the workbench canvas (after the first frame).
     pub fn field_screen_pos(&self, id: usize) -> Option<egui::Pos2> {
-        let f = self.session.doc.fields.iter().find(|f| f.id == id)?;
+        let f = self.session.doc().fields.iter().find(|f| f.id == id)?;
         let rect = self.panels.workbench.rect?;
         Some(self.panels.workbench.view.to_screen(rect, f.center))
     }
@@ -845,8 +817,8 @@ impl App {
             Some(format!("{} is running", j.name))
         } else if !self.has_document() {
             Some("no document open".into())
-        } else if !self.session.uncovered.is_empty() {
-            Some(match self.session.uncovered.len() {
+        } else if !self.session.uncovered().is_empty() {
+            Some(match self.session.uncovered().len() {
                 1 => "1 geometry is not covered by a scan field".to_string(),
                 n => format!("{n} geometries are not covered by a scan field"),
             })
@@ -862,7 +834,7 @@ impl App {
             return;
         }
         let name = self.next_plan_name(algo);
-        match Job::solve(&self.session.doc, algo, name.clone(), repaint) {
+        match Job::solve(self.session.doc(), algo, name.clone(), repaint) {
             Ok(job) => {
                 self.runtime.job = Some(job);
                 self.set_status(format!("{name}: solving…"), false);
@@ -881,7 +853,7 @@ impl App {
     /// The name of the next plan of `algo`: what it is ([`SolverSettings::plan_title`]), with
     /// " #2", " #3"… when a plan of that name exists.
     fn next_plan_name(&self, algo: Algo) -> String {
-        let mut settings = self.session.doc.settings.clone();
+        let mut settings = self.session.doc().settings.clone();
         settings.algo = algo;
         self.unique_plan_name(settings.plan_title())
     }
@@ -890,7 +862,7 @@ impl App {
     fn unique_plan_name(&self, title: String) -> String {
         let taken = |name: &str| {
             self.session
-                .doc
+                .doc()
                 .plans
                 .iter()
                 .any(|p| p.name == name || p.name.strip_suffix(" (stopped)") == Some(name))
@@ -925,7 +897,7 @@ impl App {
                     }
                     if let Some(p) = problem {
                         self.set_status(format!("scan fields not placed: {p}"), true);
-                        self.session.problem = Some(p);
+                        self.session.set_problem(Some(p));
                     }
                 }
             }
@@ -968,8 +940,8 @@ impl App {
                 // a new plan is shown from its start
                 self.panels.playback.t_s = 0.0;
                 self.panels.playback.playing = false;
-                self.panels.compare.push(k, &self.session.doc.plans);
-                match self.session.toolpaths.get(k) {
+                self.panels.compare.push(k, &self.session.doc().plans);
+                match self.session.toolpaths().get(k) {
                     Some(Err(why)) => {
                         let msg = format!("{msg}; {why}");
                         self.set_status(msg, true);
@@ -1014,10 +986,10 @@ impl App {
                 }
                 CanvasAction::EndDrag => {
                     self.panels.workbench.dragging = false;
-                    self.session.history.close_group();
+                    self.session.close_edit_group();
                     if let Some(f) = self
                         .session
-                        .doc
+                        .doc()
                         .fields
                         .iter()
                         .find(|f| Some(f.id) == self.view.selected)
@@ -1028,7 +1000,7 @@ impl App {
                             f.center.x,
                             f.center.y,
                             count(f.geometries.len(), "geometry", "geometries"),
-                            self.session.uncovered.len()
+                            self.session.uncovered().len()
                         );
                         self.set_status(msg, false);
                     }
@@ -1056,7 +1028,7 @@ impl App {
             self.set_status("wait for the running job to end before moving a seam", true);
             return;
         }
-        let mut work = self.session.doc.clone();
+        let mut work = self.session.doc().clone();
         let Some(at) = move_seam(&mut work, axis, from_mm, to_mm) else {
             self.set_status("no seam to move there", true);
             return;
@@ -1098,14 +1070,14 @@ impl App {
         self.poll_job(ui.ctx());
         self.handle_input(ui.ctx());
         // plans added, loaded or removed, the profile or the geometries changed
-        self.session.toolpaths.sync(&self.session.doc);
+        self.session.sync_toolpaths();
         self.layout(ui);
         self.prompt_ui(ui);
         if self.runtime.job.is_some() {
             // keep the elapsed time ticking between progress reports
             ui.ctx().request_repaint_after(Duration::from_millis(100));
         }
-        let title = match (&self.session.project_path, &self.session.doc.source) {
+        let title = match (self.session.project_path(), &self.session.doc().source) {
             (Some(p), _) => format!("galvoplan — {}", p.display()),
             (None, Some(s)) => format!("galvoplan — {s}"),
             (None, None) => "galvoplan".into(),

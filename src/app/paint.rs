@@ -882,7 +882,7 @@ mod tests {
     /// covers the canvas where the artwork is.
     #[test]
     fn heavy_layers_rasterise_whole() {
-        let doc = super::super::session::tests::demo().doc;
+        let doc = super::super::session::tests::demo().doc().clone();
         let (plan, toolpath) = order_document_lowered(&doc, &JobCtx::default()).unwrap();
         let lowered = Lowered::new(toolpath);
         let canvas = demo_canvas(&doc, &plan, &lowered);
@@ -917,7 +917,7 @@ mod tests {
     /// (The words only: tests/motion.rs lowers a real mixed job.)
     #[test]
     fn a_mixed_job_names_its_step_and_scan_fields() {
-        let doc = super::super::session::tests::demo().doc;
+        let doc = super::super::session::tests::demo().doc().clone();
         let (plan, toolpath) = order_document_lowered(&doc, &JobCtx::default()).unwrap();
         let first_field = toolpath.strokes[0].field;
         let other = toolpath.strokes.iter().position(|s| s.field != first_field);

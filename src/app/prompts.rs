@@ -7,7 +7,7 @@ use super::files::{self, ExportKind, PROJECT_EXT};
 use super::App;
 use crate::document::{Document, PenLibrary};
 use egui::RichText;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 /// A dialog that returns "nothing chosen" faster than this was never shown (no desktop
@@ -122,18 +122,13 @@ impl App {
             return;
         }
         self.runtime.job = None;
-        self.session.doc = Document {
-            profile: self.session.doc.profile.clone(),
-            settings: self.session.doc.settings.clone(),
+        let empty = Document {
+            profile: self.session.doc().profile.clone(),
+            settings: self.session.doc().settings.clone(),
             ..Document::default()
         };
-        self.session.project_path = None;
-        self.session.history.clear();
-        self.session.problem = None;
-        self.session.active = None;
-        self.refresh();
-        self.changed();
-        self.session.saved_revision = self.session.revision;
+        self.session.replace(empty, None, false);
+        self.refresh_view();
         self.set_status("new empty document: open an SVG or a project", false);
     }
 
@@ -154,9 +149,8 @@ impl App {
             self.set_status("nothing to save: open an SVG or a project first", true);
             return;
         }
-        match (&self.session.project_path, save_as) {
+        match (self.session.project_path().map(Path::to_path_buf), save_as) {
             (Some(p), false) => {
-                let p = p.clone();
                 if let Err(e) = self.save_project(&p) {
                     self.set_status(e, true);
                 }
@@ -167,7 +161,7 @@ impl App {
 
     /// Export the plan shown (asking first when it is stale).
     pub fn request_export(&mut self, kind: ExportKind, ctx: &egui::Context) {
-        match self.session.active {
+        match self.session.active() {
             None => self.set_status("no plan to export: run a solver first (Run HHA)", true),
             Some(k) if !self.plan_staleness(k).is_empty() => {
                 self.panels.prompt = Some(Prompt::StaleExport(kind))
@@ -180,7 +174,8 @@ impl App {
     pub fn choose_path(&mut self, action: PathAction, ctx: &egui::Context) {
         let (title, _, ext, filter) = action.words();
         // LinuxCNC reads programs named .ngc
-        let linuxcnc = self.session.doc.profile.gcode.mode == crate::document::GcodeMode::Linuxcnc;
+        let linuxcnc =
+            self.session.doc().profile.gcode.mode == crate::document::GcodeMode::Linuxcnc;
         let gcode = matches!(
             action,
             PathAction::Export(ExportKind::Gcode)
@@ -192,12 +187,12 @@ impl App {
             PathAction::SavePens => "pens.toml".to_string(),
             PathAction::SaveProfile => "profile.toml".to_string(),
             PathAction::Export(_) | PathAction::ResolveExport(_) if gcode && linuxcnc => {
-                files::default_name(&self.session.doc, "ngc")
+                files::default_name(self.session.doc(), "ngc")
             }
             PathAction::Export(kind) | PathAction::ResolveExport(kind) => {
-                files::default_name(&self.session.doc, kind.suffix())
+                files::default_name(self.session.doc(), kind.suffix())
             }
-            _ => files::default_name(&self.session.doc, ext),
+            _ => files::default_name(self.session.doc(), ext),
         };
         let folder = match action {
             PathAction::Export(kind) | PathAction::ResolveExport(kind) => self
@@ -210,7 +205,7 @@ impl App {
         .or_else(|| {
             let source = self
                 .session
-                .doc
+                .doc()
                 .source
                 .as_deref()
                 .map(std::path::Path::new)?;
@@ -270,7 +265,7 @@ impl App {
             PathAction::LoadPens => PenLibrary::load(&path)
                 .map_err(|e| e.to_string())
                 .map(|lib| {
-                    let mut layers = self.session.doc.layers.clone();
+                    let mut layers = self.session.doc().layers.clone();
                     let missing = lib.apply(&mut layers);
                     self.set_layers(layers, ctx);
                     if !missing.is_empty() {
@@ -282,7 +277,7 @@ impl App {
                         self.set_status(msg, false);
                     }
                 }),
-            PathAction::SavePens => PenLibrary::of(&self.session.doc.layers)
+            PathAction::SavePens => PenLibrary::of(&self.session.doc().layers)
                 .save(&path)
                 .map_err(|e| e.to_string())
                 .map(|()| self.set_status(format!("saved pens to {}", path.display()), false)),
@@ -296,7 +291,7 @@ impl App {
             }
             PathAction::SaveProfile => self
                 .session
-                .doc
+                .doc()
                 .profile
                 .to_toml()
                 .map_err(|e| format!("the profile cannot be written as TOML: {e}"))
@@ -320,11 +315,11 @@ impl App {
             Then::Open(None) => self.choose_path(PathAction::Open, ctx),
             // the operator has answered for the current changes
             Then::Quit => {
-                self.session.saved_revision = self.session.revision;
+                self.session.mark_saved(None);
                 self.request_quit(ctx);
             }
             Then::New => {
-                self.session.saved_revision = self.session.revision;
+                self.session.mark_saved(None);
                 self.request_new();
             }
         }
@@ -405,7 +400,7 @@ impl App {
                     ui.heading("The plan shown is stale");
                     let why = self
                         .session
-                        .active
+                        .active()
                         .map_or(&[][..], |k| self.plan_staleness(k));
                     let name = self
                         .active_plan()

@@ -13,49 +13,179 @@ use std::path::PathBuf;
 #[derive(Default)]
 pub struct Session {
     /// The open document (empty until a file is opened).
-    pub doc: Document,
+    doc: Document,
     /// Where the project was loaded from or saved to.
-    pub project_path: Option<PathBuf>,
+    project_path: Option<PathBuf>,
     /// Undo and redo.
-    pub history: History,
+    history: History,
     /// Index of the plan shown (workbench, exports, field numbers).
-    pub active: Option<usize>,
+    active: Option<usize>,
     /// Each plan's lowered toolpath (run time only).
-    pub toolpaths: ToolpathCache,
+    toolpaths: ToolpathCache,
     /// Counts changes of the document (edits, plans, layers).
-    pub revision: u64,
+    revision: u64,
     /// `revision` when the document was last opened or saved.
-    pub saved_revision: u64,
+    saved_revision: u64,
     /// Geometries no field holds.
-    pub uncovered: Vec<usize>,
+    uncovered: Vec<usize>,
     /// Uncovered geometries no scan field can ever hold (larger than a field, or beyond the
     /// stage's stroke plus half a field).
-    pub out_of_reach: Vec<usize>,
+    out_of_reach: Vec<usize>,
     /// (imported, marked) geometries per layer.
-    pub layer_counts: Vec<(usize, usize)>,
+    layer_counts: Vec<(usize, usize)>,
     /// Closed geometries (counted once per change, not every frame).
-    pub closed: usize,
+    closed: usize,
     /// Per plan, what changed since it was planned, in words (empty: current).
-    pub stale: Vec<Vec<String>>,
+    stale: Vec<Vec<String>>,
     /// A problem with the open document (e.g. fields could not be placed).
-    pub problem: Option<String>,
+    problem: Option<String>,
     /// The artwork's file is there to be imported again (placement, hidden layers); checked
     /// when the document changes, not every frame.
-    pub can_reimport: bool,
+    can_reimport: bool,
     /// The tray's cells as the canvas shows them (made when the document changes).
-    pub part_boxes: Vec<super::tray_panel::PartBox>,
+    part_boxes: Vec<super::tray_panel::PartBox>,
     /// Every part's codes, boxed (the canvas drags them).
-    pub code_boxes: Vec<super::tray_panel::CodeBox>,
+    code_boxes: Vec<super::tray_panel::CodeBox>,
     /// Each geometry's layer colour.
-    pub colours: Vec<egui::Color32>,
+    colours: Vec<egui::Color32>,
     /// Counts imports: the warnings list opens again on each one.
-    pub imports: u64,
+    imports: u64,
     /// Counts refreshes of what the canvases draw (with `revision`: the canvases' raster
     /// caches are redrawn when it changes).
-    pub canvas_revision: u64,
+    canvas_revision: u64,
 }
 
 impl Session {
+    /// The open document (empty until a file is opened).
+    pub fn doc(&self) -> &Document {
+        &self.doc
+    }
+    /// Where the project was loaded from or saved to.
+    pub fn project_path(&self) -> Option<&std::path::Path> {
+        self.project_path.as_deref()
+    }
+    /// Undo and redo.
+    pub fn history(&self) -> &History {
+        &self.history
+    }
+    /// Index of the plan shown (workbench, exports, field numbers).
+    pub fn active(&self) -> Option<usize> {
+        self.active
+    }
+    /// Counts changes of the document (edits, plans, layers).
+    pub fn revision(&self) -> u64 {
+        self.revision
+    }
+    /// Geometries no field holds.
+    pub fn uncovered(&self) -> &[usize] {
+        &self.uncovered
+    }
+    /// Uncovered geometries no scan field can ever hold.
+    pub fn out_of_reach(&self) -> &[usize] {
+        &self.out_of_reach
+    }
+    /// (imported, marked) geometries per layer.
+    pub fn layer_counts(&self) -> &[(usize, usize)] {
+        &self.layer_counts
+    }
+    /// Closed geometries.
+    pub fn closed(&self) -> usize {
+        self.closed
+    }
+    /// A problem with the open document (e.g. fields could not be placed).
+    pub fn problem(&self) -> Option<&str> {
+        self.problem.as_deref()
+    }
+    /// The artwork's file is there to be imported again.
+    pub fn can_reimport(&self) -> bool {
+        self.can_reimport
+    }
+    /// The tray's cells as the canvas shows them.
+    pub fn part_boxes(&self) -> &[super::tray_panel::PartBox] {
+        &self.part_boxes
+    }
+    /// Every part's codes, boxed.
+    pub fn code_boxes(&self) -> &[super::tray_panel::CodeBox] {
+        &self.code_boxes
+    }
+    /// Each geometry's layer colour.
+    pub fn colours(&self) -> &[egui::Color32] {
+        &self.colours
+    }
+    /// Counts imports (the warnings list opens again on each one).
+    pub fn imports(&self) -> u64 {
+        self.imports
+    }
+    /// Counts refreshes of what the canvases draw.
+    pub fn canvas_revision(&self) -> u64 {
+        self.canvas_revision
+    }
+
+    /// A session on `doc` (not yet refreshed: nothing derived from it).
+    pub fn with_document(doc: Document) -> Self {
+        Self {
+            doc,
+            ..Self::default()
+        }
+    }
+
+    /// Each plan's lowered toolpath.
+    pub fn toolpaths(&self) -> &ToolpathCache {
+        &self.toolpaths
+    }
+    /// Per plan, what changed since it was planned, in words (empty: current).
+    pub fn stale(&self) -> &[Vec<String>] {
+        &self.stale
+    }
+
+    /// Takes `doc` as the open document (read from `project_path` when that is a project; an
+    /// import counts as one when `imported`): the history starts afresh, the last plan is
+    /// shown, and the document counts as saved.
+    pub fn replace(&mut self, doc: Document, project_path: Option<PathBuf>, imported: bool) {
+        self.doc = doc;
+        self.project_path = project_path;
+        self.history.clear();
+        self.problem = None;
+        self.active = self.doc.plans.len().checked_sub(1);
+        if imported {
+            self.imports += 1;
+        }
+        self.refresh();
+        self.changed();
+        self.saved_revision = self.revision;
+    }
+
+    /// The document was saved (to `project_path` when given): it has no unsaved changes.
+    pub fn mark_saved(&mut self, project_path: Option<PathBuf>) {
+        if project_path.is_some() {
+            self.project_path = project_path;
+        }
+        self.saved_revision = self.revision;
+    }
+
+    /// Says what is wrong with the open document (none: nothing).
+    pub fn set_problem(&mut self, problem: Option<String>) {
+        self.problem = problem;
+    }
+
+    /// Shows plan `k` (ignored when there is no such plan).
+    pub fn show_plan(&mut self, k: usize) {
+        if k < self.doc.plans.len() {
+            self.active = Some(k);
+        }
+    }
+
+    /// Lowers the plans added, loaded or changed since the last frame (and drops the removed
+    /// ones' toolpaths).
+    pub fn sync_toolpaths(&mut self) {
+        self.toolpaths.sync(&self.doc);
+    }
+
+    /// Ends the undo group of a drag: the next edit is a step of its own.
+    pub fn close_edit_group(&mut self) {
+        self.history.close_group();
+    }
+
     /// True when a document is open.
     pub fn has_document(&self) -> bool {
         !self.doc.geometries.is_empty()
@@ -207,6 +337,26 @@ impl Session {
             self.active = self.doc.plans.len().checked_sub(1);
         }
         self.toolpaths.sync(&self.doc);
+        self.canvas_revision += 1;
+        let rgb: std::collections::HashMap<&str, egui::Color32> = self
+            .doc
+            .layers
+            .iter()
+            .map(|l| {
+                let [r, g, b] = l.rgb();
+                (l.name.as_str(), egui::Color32::from_rgb(r, g, b))
+            })
+            .collect();
+        self.colours = self
+            .doc
+            .geometries
+            .iter()
+            .map(|g| {
+                rgb.get(g.layer.as_str())
+                    .copied()
+                    .unwrap_or(super::paint::colour::CLOSED)
+            })
+            .collect();
         self.stale = self
             .doc
             .plans
@@ -309,6 +459,62 @@ pub(super) mod tests {
         assert!(r.is_ok());
         assert_eq!(what, format!("delete field {}", visiting.len()));
         assert_eq!(s.history.undo_label(), Some(what.as_str()));
+    }
+
+    /// The invariant the session's private fields keep: a plan is shown with the toolpath of
+    /// its own geometry revision, whatever the document's geometries become (re-hatched here)
+    /// and through undo and redo; the plans made afterwards get the new revision's.
+    #[test]
+    fn a_plan_is_never_shown_against_another_revisions_geometries() {
+        let mut s = demo();
+        let k = solve(&mut s);
+        let strokes = |s: &Session, k: usize| -> Vec<Vec<crate::geom::Pt>> {
+            let l = s.toolpath(k).unwrap().unwrap();
+            (0..l.toolpath.strokes.len())
+                .map(|j| l.toolpath.stroke_points(j).to_vec())
+                .collect()
+        };
+        let before = strokes(&s, k);
+        let rev = s.doc().plans[k].geometry_rev;
+        // hatch every layer: new geometries, a new revision
+        let mut work = s.doc().clone();
+        for l in &mut work.layers {
+            l.pen.hatch = Some(crate::document::HatchSettings::default());
+        }
+        crate::pipeline::derive_geometries(&mut work, &JobCtx::default()).unwrap();
+        place_document_fields(&mut work, &JobCtx::default()).unwrap();
+        let (_, r) = s.execute(
+            Command::SetContent {
+                doc: Box::new(work),
+                what: "hatch".into(),
+            },
+            None,
+        );
+        assert!(r.is_ok());
+        assert_ne!(s.doc().geometry_rev, rev);
+        assert!(
+            s.doc().geometries.len() > s.doc().plan_geometries(&s.doc().plans[k]).unwrap().len()
+        );
+        // the plan keeps its strokes, each on a geometry of its own revision
+        assert_eq!(strokes(&s, k), before);
+        let own = s.doc().plan_geometries(&s.doc().plans[k]).unwrap().to_vec();
+        let l = s.toolpath(k).unwrap().unwrap();
+        for (j, st) in l.toolpath.strokes.iter().enumerate() {
+            let g = &own[st.geometry];
+            let first = l.toolpath.stroke_points(j)[0];
+            assert!(g.points.iter().any(|p| p.dist(first) < 1e-9));
+        }
+        assert!(!s.plan_staleness(k).is_empty());
+        // through undo and redo too
+        s.undo().unwrap();
+        assert_eq!(strokes(&s, k), before);
+        assert!(s.plan_staleness(k).is_empty());
+        s.redo();
+        assert_eq!(strokes(&s, k), before);
+        // a plan made now is made on the hatched geometries
+        let k2 = solve(&mut s);
+        assert_eq!(s.doc().plans[k2].geometry_rev, s.doc().geometry_rev);
+        assert!(strokes(&s, k2).len() > before.len());
     }
 
     #[test]

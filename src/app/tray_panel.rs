@@ -374,9 +374,9 @@ impl super::App {
     pub(super) fn tray_ui(&mut self, ui: &mut egui::Ui) {
         let can_export = self
             .session
-            .active
+            .active()
             .is_some_and(|k| self.plan_staleness(k).is_empty());
-        match self.panels.tray.ui(ui, &self.session.doc, can_export) {
+        match self.panels.tray.ui(ui, self.session.doc(), can_export) {
             Some(TrayAction::Set(setup)) => self.set_tray(setup, ui.ctx()),
             Some(TrayAction::SetCodes(codes)) => {
                 let what = match codes.len() {
@@ -399,7 +399,7 @@ impl super::App {
     pub fn set_tray(&mut self, setup: TraySetup, repaint: &egui::Context) {
         let logged = self
             .session
-            .doc
+            .doc()
             .production
             .as_ref()
             .and_then(|p| p.logged_through);
@@ -433,7 +433,7 @@ impl super::App {
         repaint: &egui::Context,
         change: impl FnOnce(&mut Production),
     ) {
-        let mut work = self.session.doc.clone();
+        let mut work = self.session.doc().clone();
         let mut p = production_or_part(&work);
         change(&mut p);
         work.production = Some(p);
@@ -463,7 +463,7 @@ impl super::App {
     pub fn move_code(&mut self, code: usize, by: crate::geom::Pt, repaint: &egui::Context) {
         let Some(spec) = self
             .session
-            .doc
+            .doc()
             .production
             .as_ref()
             .and_then(|p| p.codes.get(code))
@@ -487,7 +487,7 @@ impl super::App {
 
     /// Leaves a tray cell out, or marks it again (`skip`), through [`super::App::set_tray`].
     pub fn skip_cell(&mut self, cell: u32, skip: bool, repaint: &egui::Context) {
-        let Some(p) = &self.session.doc.production else {
+        let Some(p) = &self.session.doc().production else {
             return;
         };
         let mut setup = p.setup();
@@ -508,7 +508,7 @@ impl super::App {
         }
         let base = self
             .session
-            .doc
+            .doc()
             .source
             .as_deref()
             .map(std::path::Path::new)
@@ -527,12 +527,12 @@ impl super::App {
     ) -> Result<(), String> {
         let k = self
             .session
-            .active
+            .active()
             .ok_or("no plan to export: run a solver first")?;
         if !self.plan_staleness(k).is_empty() {
             return Err("the plan is stale: solve the tray again before marking it".into());
         }
-        let plan = &self.session.doc.plans[k];
+        let plan = &self.session.doc().plans[k];
         let (first, last) = match (plan.parts.first(), plan.parts.last()) {
             (Some(f), Some(l)) => (f.serial, l.serial),
             _ => return Err("the plan marks no tray: set a tray and solve it".into()),
@@ -540,7 +540,7 @@ impl super::App {
         let parts = plan.parts.clone();
         let production = self
             .session
-            .doc
+            .doc()
             .production
             .as_ref()
             .ok_or("the document is not a tray")?;
@@ -563,7 +563,7 @@ impl super::App {
             next,
             logged_through: last,
         })?;
-        let saved = match self.session.project_path.clone() {
+        let saved = match self.session.project_path().map(|p| p.to_path_buf()) {
             Some(project) => self.save_project(&project).map(|()| " (project saved)"),
             None => Ok("; save the project to keep it"),
         }?;
@@ -572,7 +572,13 @@ impl super::App {
             path.display(),
             log.display()
         );
-        if let Some(setup) = self.session.doc.production.as_ref().map(Production::setup) {
+        if let Some(setup) = self
+            .session
+            .doc()
+            .production
+            .as_ref()
+            .map(Production::setup)
+        {
             self.set_tray(setup, repaint);
         }
         self.set_status(done, false);
