@@ -6,11 +6,11 @@
 //! [`Command::SetProfile`] / [`Command::SetSettings`] (so it can be undone).
 
 use super::commands::Command;
-use crate::document::spec::{self, FieldSpec, Rule};
-use crate::document::{
-    ControllerKind, CostModel, FieldsMode, GcodeMode, MachineProfile, MotionMode, SolverSettings,
-    StageRouteKind, VertexMode, BUILTIN,
+use crate::document::spec::{
+    self, Choice, FieldSpec, Rule, CONTROLLERS, COST_MODELS, FIELD_PLACEMENTS, GCODE_DIALECTS,
+    MOTION_MODES, STAGE_ROUTES, START_POINTS,
 };
+use crate::document::{ControllerKind, GcodeMode, MachineProfile, SolverSettings, BUILTIN};
 use egui::{Color32, RichText};
 
 /// The profile editor's rows: every value of the profile's table that is typed.
@@ -205,63 +205,9 @@ fn add_edit(
     }
 }
 
-/// Whether a profile row is used with the profile's G-code dialect and controller.
-fn profile_row_applies(spec: &FieldSpec<MachineProfile>, p: &MachineProfile) -> bool {
-    let linuxcnc = p.gcode.mode == GcodeMode::Linuxcnc;
-    match spec.key {
-        "gcode.laser_on" | "gcode.laser_off" | "gcode.feed_mm_min" => !linuxcnc,
-        "gcode.scanner_axes[0]" | "gcode.scanner_axes[1]" => p.gcode.mode != GcodeMode::Tcp,
-        "gcode.laser_output" | "gcode.power_output" | "gcode.path_tol_mm" => linuxcnc,
-        "gcode.power_word" => !(linuxcnc && p.gcode.power_output.is_some()),
-        "controller.servo_period_s" => p.controller.kind == ControllerKind::Linuxcnc,
-        // also the scanner's acceleration in linuxcnc-config's machine
-        "controller.scanner_accel_mm_s2" => {
-            linuxcnc || p.controller.kind == ControllerKind::Linuxcnc
-        }
-        _ => true,
-    }
-}
-
-/// The G-code dialects offered, in words.
-pub const GCODE_DIALECTS: &[Choice<GcodeMode>] = &[
-    (
-        GcodeMode::Tcp,
-        "Tool-centre point (X/Y)",
-        "The laser point's path on X/Y; the controller splits it between stage and scanner.",
-    ),
-    (
-        GcodeMode::StageScanner,
-        "Stage and scanner axes",
-        "G0 X/Y to each scan field, the scanner on its own two axis words (step-and-scan).",
-    ),
-    (
-        GcodeMode::Linuxcnc,
-        "LinuxCNC (X/Y stage, U/V scanner)",
-        "One LinuxCNC machine: the laser on a digital output (M62/M63), exact stops in \
-         step-and-scan, timed G93 lines on the fly; `galvoplan linuxcnc-config` writes the \
-         machine's configuration.",
-    ),
-];
-
-/// The controllers offered, in words.
-pub const CONTROLLERS: &[Choice<ControllerKind>] = &[
-    (
-        ControllerKind::Ideal,
-        "Scan-head controller",
-        "Job time as a scan head runs it: marks at constant speed through corners, jumps at \
-         jump speed, delays as given.",
-    ),
-    (
-        ControllerKind::Linuxcnc,
-        "LinuxCNC",
-        "Job time as LinuxCNC's planner runs the program: every move to rest in whole servo \
-         periods; on the fly its blends, slower than planned.",
-    ),
-];
-
 /// True for a free-text row (a name): it gets the panel's width, wrapped.
 fn is_wide<T>(spec: &FieldSpec<T>) -> bool {
-    spec.rule == Rule::AnyText && spec.key == "name"
+    spec.rule == Rule::AnyText && spec.key == spec::rows::PROFILE_NAME.key
 }
 
 /// The profile and settings editors.
@@ -278,7 +224,7 @@ impl Default for Editors {
     fn default() -> Self {
         Self {
             profile: Form {
-                applies: profile_row_applies,
+                applies: spec::profile_row_applies,
                 ..Form::new(profile_specs())
             },
             settings: Form::new(settings_specs()),
@@ -399,68 +345,13 @@ impl Editors {
     }
 }
 
-/// One option of a choice: its value, its words, and what it does (with the command line's
-/// name for it).
-pub type Choice<T> = (T, &'static str, &'static str);
-
-/// The field placements offered, in words.
-pub const FIELD_PLACEMENTS: &[Choice<FieldsMode>] = &[
-    (
-        FieldsMode::Auto,
-        "Fewest fields (automatic)",
-        "As few scan fields as the search finds (a set cover); command line: --fields auto.",
-    ),
-    (
-        FieldsMode::Paper,
-        "Reference paper's method",
-        "The scan-field paper's placement (random fields, removal test, unit moves), for comparison; command line: \
-         --fields paper.",
-    ),
-    (
-        FieldsMode::Greedy,
-        "Quick greedy cover",
-        "Fields added one at a time where they cover the most (the baseline); command line: \
-         --fields greedy.",
-    ),
-];
-
 /// What the field placements mean for the operator.
 const FIELDS_HELP: &str = "How scan fields are placed when a file is opened or \
     \"Re-place automatically\" is pressed (locked fields stay).";
 
-/// The start-point choices offered, in words.
-pub const START_POINTS: &[Choice<VertexMode>] = &[
-    (
-        VertexMode::Exact,
-        "Best start points (exact)",
-        "Where each closed shape starts and which way each open one runs, chosen exactly for \
-         the order found (VEA, then an exact search); command line: --vertex exact.",
-    ),
-    (
-        VertexMode::Vea,
-        "Quick start points (estimate)",
-        "The estimate alone (each start vertex nearest the next geometry), for comparison; command line: --vertex vea.",
-    ),
-];
-
 /// What the start points mean for the operator.
 const VERTEX_HELP: &str = "Where the laser starts each closed shape and which end of an open \
     one it starts from. Used by the next solve.";
-
-/// The cost models offered, in words.
-pub const COST_MODELS: &[Choice<CostModel>] = &[
-    (
-        CostModel::Time,
-        "Job time (machine dynamics)",
-        "The machine's time for the job; command line: --cost time.",
-    ),
-    (
-        CostModel::Distance,
-        "Idle travel distance",
-        "The laser-off travel in mm, ignoring the machine's dynamics; \
-         command line: --cost distance.",
-    ),
-];
 
 /// What the cost model means for the operator.
 const COST_MODEL_HELP: &str = "What the ordering minimises.\n\
@@ -469,25 +360,6 @@ const COST_MODEL_HELP: &str = "What the ordering minimises.\n\
     idle-distance plan.\n\
     Idle travel distance: the laser-off travel in mm, ignoring the machine's dynamics.\n\
     Used by the next solve (HHA, HGA and baseline; as-is keeps the document order).";
-
-/// The motion modes offered, in words.
-pub const MOTION_MODES: &[Choice<MotionMode>] = &[
-    (
-        MotionMode::Auto,
-        "Automatic (the faster)",
-        "Plans step-and-scan and on the fly and keeps the faster job; command line: --motion auto.",
-    ),
-    (
-        MotionMode::Step,
-        "Step-and-scan",
-        "The stage stops at each scan field; command line: --motion step.",
-    ),
-    (
-        MotionMode::OnTheFly,
-        "On the fly (stage moves while marking)",
-        "The stage never stops; command line: --motion on-the-fly.",
-    ),
-];
 
 /// What the motion modes mean for the operator.
 const MOTION_HELP: &str = "How the machine moves while it marks.\n\
@@ -500,28 +372,6 @@ const MOTION_HELP: &str = "How the machine moves while it marks.\n\
     it chose); planning takes about twice as long.\n\
     Used by the next solve; a plan made already keeps the motion it was planned for (its \
     path, playback and motion plots), marked stale.";
-
-/// The stage routes offered, in words.
-pub const STAGE_ROUTES: &[Choice<StageRouteKind>] = &[
-    (
-        StageRouteKind::Taut,
-        "Tracked route (default)",
-        "The stage follows the laser point as closely as its speed and acceleration allow, \
-         and the marking waits only where it cannot keep up; command line: --stage-route taut.",
-    ),
-    (
-        StageRouteKind::Lsa,
-        "Follow a simplified path of the marks",
-        "The stage follows the marks' points, thinned out by line simplification (a \
-         published benchmark route); command line: --stage-route lsa.",
-    ),
-    (
-        StageRouteKind::CetspGa,
-        "Genetic algorithm route (slow)",
-        "A route through circles around the marks, searched by a genetic algorithm (a \
-         published benchmark route); command line: --stage-route cetsp-ga.",
-    ),
-];
 
 /// What the stage routes mean for the operator.
 const STAGE_ROUTE_HELP: &str = "How the stage's route is planned on the fly.\n\
@@ -584,6 +434,7 @@ pub fn builtin_words(profile: &MachineProfile) -> String {
 mod tests {
     #![allow(clippy::unwrap_used)]
     use super::*;
+    use crate::document::spec::profile_row_applies;
 
     #[test]
     fn rows_the_dialect_or_controller_does_not_use_are_greyed() {

@@ -2,11 +2,9 @@
 //! and *Export and advance*. A panel with its own state (the form's buffers, the part
 //! previewed, the parts log's path); it reads the document and returns what the operator asked.
 
-use super::panels::{combo, Choice, Form};
-use crate::document::spec::{check_all, tray_specs};
-use crate::document::{
-    CodeKind, CodeSpec, Document, Ecc, Numbering, Production, TraySetup, CODE_LAYER,
-};
+use super::panels::{combo, Form};
+use crate::document::spec::{check_all, tray_specs, CODE_KINDS, NUMBERINGS};
+use crate::document::{CodeKind, CodeSpec, Document, Ecc, Production, TraySetup, CODE_LAYER};
 use egui::RichText;
 
 /// What the operator asked of the Tray section.
@@ -75,24 +73,6 @@ impl CodeRow {
     }
 }
 
-const CODE_KINDS: [Choice<CodeKind>; 3] = [
-    (
-        CodeKind::DataMatrix,
-        "DataMatrix",
-        "DataMatrix ECC200; options rect, gs1, dots, inverted",
-    ),
-    (
-        CodeKind::Qr,
-        "QR code",
-        "QR code; options ecc=L|M|Q|H, dots, inverted",
-    ),
-    (
-        CodeKind::Code128,
-        "Code 128",
-        "a 1-D Code 128 (printable ASCII); option inverted",
-    ),
-];
-
 /// The Tray section's state.
 pub struct TrayPanel {
     form: Form<TraySetup>,
@@ -119,19 +99,6 @@ impl Default for TrayPanel {
         }
     }
 }
-
-const NUMBERINGS: [Choice<Numbering>; 2] = [
-    (
-        Numbering::Rows,
-        "Row by row",
-        "parts numbered along each row from the top-left, every row left to right",
-    ),
-    (
-        Numbering::Serpentine,
-        "Serpentine",
-        "parts numbered along each row from the top-left, every other row right to left",
-    ),
-];
 
 fn validate(p: &TraySetup) -> Result<(), String> {
     check_all(&tray_specs(), p).map_err(|e| e.to_string())?;
@@ -171,7 +138,7 @@ impl TrayPanel {
             out = Some(TrayAction::Set(p));
         }
         let mut numbering = current.tray.numbering;
-        if combo(ui, "Numbering", &mut numbering, &NUMBERINGS).changed() {
+        if combo(ui, "Numbering", &mut numbering, NUMBERINGS).changed() {
             let mut p = current.clone();
             p.tray.numbering = numbering;
             out = Some(TrayAction::Set(p));
@@ -238,7 +205,7 @@ impl TrayPanel {
         let mut remove = None;
         for (k, row) in self.codes.iter_mut().enumerate() {
             ui.push_id(("code", k), |ui| {
-                combo(ui, "Code kind", &mut row.kind, &CODE_KINDS);
+                combo(ui, "Code kind", &mut row.kind, CODE_KINDS);
                 let text = |ui: &mut egui::Ui, label: &str, value: &mut String, hint: &str| {
                     ui.horizontal(|ui| {
                         let l = ui.label(label);

@@ -1,6 +1,7 @@
 //! The document model: geometries, machine profile, solver settings, scan fields and plans.
 
 mod artwork_import;
+mod choices;
 mod code;
 mod geometry;
 mod hatch;

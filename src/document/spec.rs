@@ -10,6 +10,11 @@ use super::{
 use crate::geom::MAX_COORD_MM;
 use thiserror::Error;
 
+pub use super::choices::{
+    label_of, Choice, CODE_KINDS, CONTROLLERS, COST_MODELS, FIELD_PLACEMENTS, GCODE_DIALECTS,
+    MOTION_MODES, NUMBERINGS, STAGE_ROUTES, START_POINTS,
+};
+
 /// What a value must be.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Rule {
@@ -640,6 +645,8 @@ fn controller_specs() -> Vec<FieldSpec<MachineProfile>> {
             Positive,
             |p| p.controller.scanner_accel_mm_s2
         ),
+        // a choice's short words (plan names, stale reasons); the editors' labels and help are
+        // the tables of `super::choices`
         choice!("G-code dialect", "gcode.mode", |p| match p.gcode.mode {
             GcodeMode::Tcp => "tool-centre point".into(),
             GcodeMode::StageScanner => "stage and scanner axes".into(),
@@ -1051,6 +1058,162 @@ pub fn tray_specs() -> Vec<FieldSpec<super::TraySetup>> {
     ]
 }
 
+/// A typed handle on one row of a spec table over `T`: the row's key and its table. Editors
+/// name the rows they show by handle, never by a key typed where it is used; every handle
+/// resolves ([`unresolved`] is empty for [`editor_rows`], which a test checks).
+pub struct Row<T: 'static> {
+    /// The row's file key.
+    pub key: &'static str,
+    table: fn() -> Vec<FieldSpec<T>>,
+}
+
+impl<T> Clone for Row<T> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+impl<T> Copy for Row<T> {}
+
+impl<T> std::fmt::Debug for Row<T> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Row({})", self.key)
+    }
+}
+
+impl<T> Row<T> {
+    /// The handle on the row `key` of `table`.
+    pub const fn new(key: &'static str, table: fn() -> Vec<FieldSpec<T>>) -> Self {
+        Self { key, table }
+    }
+    /// The row (none only for a handle whose key its table lacks: see [`unresolved`]).
+    pub fn spec(&self) -> Option<FieldSpec<T>> {
+        (self.table)().into_iter().find(|s| s.key == self.key)
+    }
+    /// True when `spec` is this row.
+    pub fn is(&self, spec: &FieldSpec<T>) -> bool {
+        spec.key == self.key
+    }
+}
+
+/// The rows the editors name.
+pub mod rows {
+    use super::{hatch_specs, pen_specs, profile_specs, Row};
+    use crate::document::{HatchSettings, MachineProfile, Pen};
+
+    /// The profile's name (a free-text row: the panel's width).
+    pub const PROFILE_NAME: Row<MachineProfile> = Row::new("name", profile_specs);
+    /// The laser-on word (dialects that are not LinuxCNC).
+    pub const LASER_ON: Row<MachineProfile> = Row::new("gcode.laser_on", profile_specs);
+    /// The laser-off word.
+    pub const LASER_OFF: Row<MachineProfile> = Row::new("gcode.laser_off", profile_specs);
+    /// The feed word's value.
+    pub const FEED: Row<MachineProfile> = Row::new("gcode.feed_mm_min", profile_specs);
+    /// The scanner's first axis word.
+    pub const SCANNER_AXIS_0: Row<MachineProfile> =
+        Row::new("gcode.scanner_axes[0]", profile_specs);
+    /// The scanner's second axis word.
+    pub const SCANNER_AXIS_1: Row<MachineProfile> =
+        Row::new("gcode.scanner_axes[1]", profile_specs);
+    /// LinuxCNC's laser output.
+    pub const LASER_OUTPUT: Row<MachineProfile> = Row::new("gcode.laser_output", profile_specs);
+    /// LinuxCNC's power output.
+    pub const POWER_OUTPUT: Row<MachineProfile> = Row::new("gcode.power_output", profile_specs);
+    /// LinuxCNC's path tolerance.
+    pub const PATH_TOL: Row<MachineProfile> = Row::new("gcode.path_tol_mm", profile_specs);
+    /// The power word.
+    pub const POWER_WORD: Row<MachineProfile> = Row::new("gcode.power_word", profile_specs);
+    /// LinuxCNC's servo period.
+    pub const SERVO_PERIOD: Row<MachineProfile> =
+        Row::new("controller.servo_period_s", profile_specs);
+    /// LinuxCNC's scanner acceleration.
+    pub const SCANNER_ACCEL: Row<MachineProfile> =
+        Row::new("controller.scanner_accel_mm_s2", profile_specs);
+
+    /// A pen's mark speed.
+    pub const PEN_SPEED: Row<Pen> = Row::new("mark_speed_mm_s", pen_specs);
+    /// A pen's power.
+    pub const PEN_POWER: Row<Pen> = Row::new("power", pen_specs);
+    /// A pen's pulse frequency.
+    pub const PEN_FREQUENCY: Row<Pen> = Row::new("frequency_khz", pen_specs);
+    /// A pen's passes.
+    pub const PEN_PASSES: Row<Pen> = Row::new("passes", pen_specs);
+    /// A pen's seam width.
+    pub const PEN_SEAM_WIDTH: Row<Pen> = Row::new("seam_mm", pen_specs);
+    /// A hatch's line spacing.
+    pub const HATCH_SPACING: Row<HatchSettings> = Row::new("spacing_mm", hatch_specs);
+    /// A hatch's angle.
+    pub const HATCH_ANGLE: Row<HatchSettings> = Row::new("angle_deg", hatch_specs);
+    /// A hatch's edge offset.
+    pub const HATCH_EDGE: Row<HatchSettings> = Row::new("edge_offset_mm", hatch_specs);
+}
+
+/// Profile rows and the test of the profiles they are used with.
+pub type AppliesWhen = (&'static [Row<MachineProfile>], fn(&MachineProfile) -> bool);
+
+/// Every row handle an editor uses, by table: profile, pen and hatch rows.
+pub type EditorRows = (
+    Vec<Row<MachineProfile>>,
+    Vec<Row<Pen>>,
+    Vec<Row<HatchSettings>>,
+);
+
+/// When profile rows apply: the rows, and the profiles they are used with (the G-code dialect
+/// and the controller decide). A row named by no rule always applies.
+pub const PROFILE_APPLIES: &[AppliesWhen] = &[
+    (&[rows::LASER_ON, rows::LASER_OFF, rows::FEED], |p| {
+        p.gcode.mode != GcodeMode::Linuxcnc
+    }),
+    (&[rows::SCANNER_AXIS_0, rows::SCANNER_AXIS_1], |p| {
+        p.gcode.mode != GcodeMode::Tcp
+    }),
+    (
+        &[rows::LASER_OUTPUT, rows::POWER_OUTPUT, rows::PATH_TOL],
+        |p| p.gcode.mode == GcodeMode::Linuxcnc,
+    ),
+    (&[rows::POWER_WORD], |p| {
+        !(p.gcode.mode == GcodeMode::Linuxcnc && p.gcode.power_output.is_some())
+    }),
+    (&[rows::SERVO_PERIOD], |p| {
+        p.controller.kind == ControllerKind::Linuxcnc
+    }),
+    // also the scanner's acceleration in linuxcnc-config's machine
+    (&[rows::SCANNER_ACCEL], |p| {
+        p.gcode.mode == GcodeMode::Linuxcnc || p.controller.kind == ControllerKind::Linuxcnc
+    }),
+];
+
+/// Whether profile row `spec` is used with `p`'s G-code dialect and controller.
+pub fn profile_row_applies(spec: &FieldSpec<MachineProfile>, p: &MachineProfile) -> bool {
+    PROFILE_APPLIES
+        .iter()
+        .filter(|(rows, _)| rows.iter().any(|r| r.is(spec)))
+        .all(|(_, when)| when(p))
+}
+
+/// Every row handle an editor uses, by table: (profile rows, pen rows, hatch rows).
+pub fn editor_rows() -> EditorRows {
+    use rows::*;
+    let mut profile = vec![PROFILE_NAME];
+    profile.extend(PROFILE_APPLIES.iter().flat_map(|(r, _)| r.iter().copied()));
+    let pen = vec![
+        PEN_SPEED,
+        PEN_POWER,
+        PEN_FREQUENCY,
+        PEN_PASSES,
+        PEN_SEAM_WIDTH,
+    ];
+    let hatch = vec![HATCH_SPACING, HATCH_ANGLE, HATCH_EDGE];
+    (profile, pen, hatch)
+}
+
+/// The keys of `rows` whose table has no such row.
+pub fn unresolved<T>(rows: &[Row<T>]) -> Vec<&'static str> {
+    rows.iter()
+        .filter(|r| r.spec().is_none())
+        .map(|r| r.key)
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1141,5 +1304,33 @@ mod tests {
         );
         bad.passes = 0;
         assert!(passes.check(&bad).is_err());
+    }
+
+    /// Every row an editor names resolves in its table, and the check finds a planted handle
+    /// whose key the table lacks.
+    #[test]
+    fn every_editor_row_resolves_and_a_planted_key_is_found() {
+        let (profile, pen, hatch) = editor_rows();
+        assert!(profile.len() > 10 && pen.len() == 5 && hatch.len() == 3);
+        assert!(
+            unresolved(&profile).is_empty(),
+            "{:?}",
+            unresolved(&profile)
+        );
+        assert!(unresolved(&pen).is_empty(), "{:?}", unresolved(&pen));
+        assert!(unresolved(&hatch).is_empty(), "{:?}", unresolved(&hatch));
+        let mut planted = pen.clone();
+        planted.push(Row::new("mark_sped_mm_s", pen_specs));
+        assert_eq!(unresolved(&planted), ["mark_sped_mm_s"]);
+        // every choice's value has its words
+        for m in [GcodeMode::Tcp, GcodeMode::StageScanner, GcodeMode::Linuxcnc] {
+            assert_ne!(label_of(GCODE_DIALECTS, &m), "?");
+        }
+        for c in [ControllerKind::Ideal, ControllerKind::Linuxcnc] {
+            assert_ne!(label_of(CONTROLLERS, &c), "?");
+        }
+        for m in [MotionMode::Auto, MotionMode::Step, MotionMode::OnTheFly] {
+            assert_ne!(label_of(MOTION_MODES, &m), "?");
+        }
     }
 }
