@@ -2,82 +2,13 @@
 //! Drawing is in `super::paint`; the canvas never changes the document, it returns
 //! [`CanvasAction`]s that the app turns into commands.
 
+use super::draw::{colour, View};
 use super::hit::HitIndex;
 use super::paint;
-use super::toolpaths::Lowered;
-use crate::document::{Geometry, MachineProfile, Plan, ScanField};
+use super::scene::Canvas;
+use crate::document::{Geometry, MachineProfile, ScanField};
 use crate::geom::{BBox, Pt};
-use egui::{Color32, PointerButton, Pos2, Rect, Sense, Vec2};
-use serde::{Deserialize, Serialize};
-
-/// Pan and zoom of a canvas: screen = rect corner + offset + mm × scale.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct View {
-    /// Pixels per mm (0 until the first fit).
-    pub scale: f32,
-    /// Screen offset of the machine origin, relative to the canvas rectangle's corner.
-    pub offset: Vec2,
-}
-
-impl Default for View {
-    fn default() -> Self {
-        Self {
-            scale: 0.0,
-            offset: Vec2::ZERO,
-        }
-    }
-}
-
-impl View {
-    /// Fits the box `(min, max)` in mm into `rect` with a margin.
-    pub fn fit(&mut self, rect: Rect, min: Pt, max: Pt) {
-        let w = (max.x - min.x).max(1.0) as f32;
-        let h = (max.y - min.y).max(1.0) as f32;
-        self.scale = ((rect.width() - 20.0) / w)
-            .min((rect.height() - 20.0) / h)
-            .max(0.01);
-        let used = Vec2::new(w, h) * self.scale;
-        self.offset =
-            (rect.size() - used) / 2.0 - Vec2::new(min.x as f32, min.y as f32) * self.scale;
-    }
-    /// mm → screen.
-    pub fn to_screen(&self, rect: Rect, p: Pt) -> Pos2 {
-        rect.min + self.offset + Vec2::new(p.x as f32, p.y as f32) * self.scale
-    }
-    /// screen → mm.
-    pub fn to_mm(&self, rect: Rect, p: Pos2) -> Pt {
-        let v = (p - rect.min - self.offset) / self.scale.max(1e-6);
-        Pt::new(f64::from(v.x), f64::from(v.y))
-    }
-}
-
-/// Which layers a canvas draws (kept between runs).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
-pub struct Layers {
-    /// Scan fields.
-    pub fields: bool,
-    /// The planned path: idle moves and start/end markers.
-    pub path: bool,
-    /// Direction arrows on idle moves long enough to carry one.
-    pub arrows: bool,
-    /// The base path through the field centres in visiting order.
-    pub base_path: bool,
-    /// Marks coloured by their position in the order (else: by open/closed).
-    pub order_colours: bool,
-}
-
-impl Default for Layers {
-    fn default() -> Self {
-        Self {
-            fields: true,
-            path: true,
-            arrows: true,
-            base_path: true,
-            order_colours: true,
-        }
-    }
-}
+use egui::{Color32, PointerButton, Rect, Sense, Vec2};
 
 /// What a drag is doing.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -166,65 +97,6 @@ pub enum CanvasAction {
     },
 }
 
-/// One planned path to draw.
-#[derive(Debug, Clone, Copy)]
-pub struct PathLayer<'a> {
-    /// The plan.
-    pub plan: &'a Plan,
-    /// Its lowered toolpath (what is drawn), or why it could not be lowered.
-    pub lowered: Result<&'a Lowered, &'a str>,
-    /// Colour of its idle moves and markers.
-    pub colour: Color32,
-}
-
-/// A canvas over the machine's work area.
-pub struct Canvas<'a> {
-    /// Accessible name and caption.
-    pub label: &'a str,
-    /// The artwork.
-    pub geometries: &'a [Geometry],
-    /// The machine (stroke and field size).
-    pub profile: &'a MachineProfile,
-    /// Fields to draw.
-    pub fields: &'a [ScanField],
-    /// Seams: where artwork larger than a field is cut (drawn with the fields).
-    pub seams: &'a [crate::geom::seam::SeamLine],
-    /// The tiling the seams belong to (its extent: how far a seam line runs).
-    pub tiling: Option<&'a crate::geom::tiling::Tiling>,
-    /// The widest cell the tiling may have (how far a seam can be dragged), mm.
-    pub cell_max_mm: [f64; 2],
-    /// The shown plan's fields in visiting order: fields are numbered 1…n in that order (the
-    /// others after them), else in the order of `fields` (placement order).
-    pub visiting: Option<&'a [ScanField]>,
-    /// Each geometry's layer colour (none: closed dark, open green).
-    pub colours: Option<&'a [Color32]>,
-    /// Uncovered geometries no scan field can hold (drawn apart from merely uncovered ones).
-    pub out_of_reach: &'a [usize],
-    /// Planned paths to draw (one, or two overlaid).
-    pub paths: Vec<PathLayer<'a>>,
-    /// Geometries no field holds (drawn in red).
-    pub uncovered: &'a [usize],
-    /// The selected field id.
-    pub selected: Option<usize>,
-    /// Fields can be selected, dragged and added.
-    pub editable: bool,
-    /// The add tool is active: a click adds a field.
-    pub add_tool: bool,
-    /// Layers.
-    pub layers: Layers,
-    /// What changed since the path was planned (empty: it is current).
-    pub stale: &'a [String],
-    /// Playback time: the machine is drawn at this job time (`None`: the planned path only).
-    pub playback_t_s: Option<f64>,
-    /// The tray's cells: numbered, skipped ones greyed, each part's serial on hover.
-    pub parts: &'a [super::tray_panel::PartBox],
-    /// The parts' codes (dragged on an editable canvas).
-    pub codes: &'a [super::tray_panel::CodeBox],
-    /// Changes whenever the artwork, its colours or coverage change: the canvas keeps a raster
-    /// of what it draws while this (and what it compares by value) stays the same.
-    pub revision: u64,
-}
-
 /// Screen distance within which the pointer "hovers" a geometry, px.
 const HOVER_PX: f32 = 6.0;
 
@@ -307,7 +179,7 @@ impl Canvas<'_> {
                 (Pt::new(lo.x, at_mm), Pt::new(hi.x, at_mm))
             };
             let s = |q: Pt| state.view.to_screen(rect, q);
-            painter.line_segment([s(a), s(b)], egui::Stroke::new(2.0, paint::colour::SEAM));
+            painter.line_segment([s(a), s(b)], egui::Stroke::new(2.0, colour::SEAM));
             if let Some(p) = ui.input(|i| i.pointer.hover_pos()) {
                 // white on the seam's colour: readable over dark hatch
                 let galley = painter.layout_no_wrap(
@@ -317,7 +189,7 @@ impl Canvas<'_> {
                 );
                 let at = p + Vec2::new(12.0, -12.0 - galley.size().y);
                 let bg = Rect::from_min_size(at, galley.size() + Vec2::new(6.0, 2.0));
-                painter.rect_filled(bg, 3.0, paint::colour::SEAM);
+                painter.rect_filled(bg, 3.0, colour::SEAM);
                 painter.galley(at + Vec2::new(3.0, 1.0), galley, egui::Color32::WHITE);
             }
         }
@@ -676,8 +548,8 @@ impl Canvas<'_> {
             match self.fields.iter().find(|f| f.geometries.contains(&k)) {
                 Some(f) => lines.push(format!(
                     "  allocated to {} {}",
-                    super::field_word(f, self.profile),
-                    super::field_number(self.fields, self.visiting, f.id)
+                    super::words::field_word(f, self.profile),
+                    super::words::field_number(self.fields, self.visiting, f.id)
                 )),
                 None if self.out_of_reach.contains(&k) => lines.push(
                     "  no scan field can hold it: larger than a field or beyond the stage's reach"
@@ -696,7 +568,7 @@ impl Canvas<'_> {
             }
         }
         if let Some(f) = field {
-            let word = super::field_word(f, self.profile);
+            let word = super::words::field_word(f, self.profile);
             let size = if word == "field" {
                 String::new()
             } else {
@@ -705,10 +577,10 @@ impl Canvas<'_> {
             };
             lines.push(format!(
                 "{word} {}: centre ({:.2}, {:.2}) mm{size}, {}{}",
-                super::field_number(self.fields, self.visiting, f.id),
+                super::words::field_number(self.fields, self.visiting, f.id),
                 f.center.x,
                 f.center.y,
-                super::count(f.geometries.len(), "geometry", "geometries"),
+                super::words::count(f.geometries.len(), "geometry", "geometries"),
                 if f.locked { ", locked" } else { "" }
             ));
             if word == "region" {

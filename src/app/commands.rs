@@ -132,7 +132,7 @@ pub fn apply(doc: &mut Document, cmd: &Command) -> Result<Outcome, String> {
         Command::ReplaceAutomatically => {
             let mut work = doc.clone();
             place_document_fields(&mut work, &JobCtx::default())
-                .map_err(|e| super::gui_error(&e))?;
+                .map_err(|e| super::words::gui_error(&e))?;
             *doc = work;
             Ok(uncovered(reallocate(doc)))
         }

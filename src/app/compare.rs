@@ -2,9 +2,10 @@
 //! one clock, a metrics table led by the job time (the better value highlighted), and the GA
 //! convergence plot.
 
-use super::canvas::{Canvas, CanvasState, Layers, PathLayer};
-use super::paint::colour;
+use super::canvas::CanvasState;
+use super::draw::colour;
 use super::playback::{self, Playback};
+use super::scene::{Canvas, Layers, PathLayer};
 use super::toolpaths::{Lowered, ToolpathCache};
 use crate::document::{Algo, Document, Metrics, ObjectiveKind, Plan, TimeBreakdown};
 use egui::{Color32, RichText, Vec2};
@@ -406,11 +407,11 @@ pub fn stale_notes(ui: &mut egui::Ui, plans: &[(&Plan, &[String])]) {
                      the plan as made",
                     plan.name
                 ))
-                .color(super::layout::STALE),
+                .color(colour::STALE),
             )
             .wrap(),
         )
-        .on_hover_text(super::layout::stale_text(why));
+        .on_hover_text(super::words::stale_text(why));
     }
 }
 

@@ -76,7 +76,7 @@ pub fn open(
             Err(e) if ctx.is_cancelled() => {
                 return Err(format!("{}: cancelled ({e})", path.display()))
             }
-            Err(e) => Some(super::gui_error(&e)),
+            Err(e) => Some(super::words::gui_error(&e)),
         };
         Ok(Opened {
             doc,
@@ -118,7 +118,7 @@ pub fn reimport(
         doc.settings.clone(),
         &opts,
     )
-    .map_err(|e| super::gui_error(&e))?;
+    .map_err(|e| super::words::gui_error(&e))?;
     let mut work = doc.clone();
     work.artwork = loaded.doc.artwork;
     work.page_mm = loaded.doc.page_mm;
@@ -144,7 +144,7 @@ pub fn reimport(
     });
     work.derived_with = None;
     let before = work.geometry_rev;
-    derive_geometries(&mut work, ctx).map_err(|e| super::gui_error(&e))?;
+    derive_geometries(&mut work, ctx).map_err(|e| super::words::gui_error(&e))?;
     if work.geometry_rev == before {
         return Ok((work, None));
     }
@@ -153,7 +153,7 @@ pub fn reimport(
         Err(e) if ctx.is_cancelled() => Err(format!("cancelled ({e})")),
         Err(e) => {
             work.fields.retain(|f| f.locked);
-            Ok((work, Some(super::gui_error(&e))))
+            Ok((work, Some(super::words::gui_error(&e))))
         }
     }
 }

@@ -3,7 +3,7 @@
 //! is committed, like the profile editor. A change that alters the geometries (enabled, hatch)
 //! is made in a background job by the caller.
 
-use super::prompts::PathAction;
+use super::prompt::PathAction;
 use crate::document::spec::{self, Row};
 use crate::document::FillShapes;
 use crate::document::{ArtworkImport, Layer, MachineProfile, Pen, Place};
@@ -385,7 +385,7 @@ impl LayerEditor {
             let words = if layer.pen.hatch.is_some() {
                 format!("{imported} shapes, {marked} strokes with the hatch")
             } else {
-                super::count(imported, "geometry", "geometries")
+                super::words::count(imported, "geometry", "geometries")
             };
             ui.label(RichText::new(words).weak());
         });

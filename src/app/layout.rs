@@ -1,10 +1,12 @@
 //! The window layout: menu bar, toolbar, side panels, status bar and the central view.
 
-use super::canvas::{Canvas, PathLayer};
 use super::commands::Command;
+use super::draw::colour;
+use super::draw::colour::STALE;
 use super::files::ExportKind;
 use super::layers::LayerAction;
-use super::paint::colour;
+use super::scene::{Canvas, PathLayer};
+use super::words::stale_text;
 use super::{compare, motion_plots, playback, App, Section, Tab, SOLVERS};
 use egui::{Color32, RichText};
 
@@ -307,7 +309,7 @@ impl App {
                     let u = self.session.uncovered().len();
                     let t = RichText::new(format!(
                         "{} · {} uncovered",
-                        super::fields_count(
+                        super::words::fields_count(
                             &self.session.doc().fields,
                             &self.session.doc().profile
                         ),
@@ -448,13 +450,13 @@ impl App {
             let closed = self.session.closed();
             ui.label(format!(
                 "{} ({closed} closed, {} open), {}",
-                super::count(
+                super::words::count(
                     self.session.doc().geometries.len(),
                     "geometry",
                     "geometries"
                 ),
                 self.session.doc().geometries.len() - closed,
-                super::fields_count(&self.session.doc().fields, &self.session.doc().profile)
+                super::words::fields_count(&self.session.doc().fields, &self.session.doc().profile)
             ));
             let far = self.session.out_of_reach().len();
             let near = self.session.uncovered().len() - far;
@@ -489,7 +491,7 @@ impl App {
                     egui::Label::new(
                         RichText::new(format!(
                             "{} (dashed purple) cannot be held by any scan field, {} {what}",
-                            super::count(n, "geometry", "geometries"),
+                            super::words::count(n, "geometry", "geometries"),
                             if n == 1 { "it is" } else { "they are" },
                         ))
                         .color(colour::OUT_OF_REACH),
@@ -503,7 +505,7 @@ impl App {
                         RichText::new(format!(
                             "{} (magenta halo on the canvas) {} not covered by a scan field \
                      yet: add a field (Add field) or press \"Re-place automatically\".",
-                            super::count(near, "geometry", "geometries"),
+                            super::words::count(near, "geometry", "geometries"),
                             if near == 1 { "is" } else { "are" }
                         ))
                         .color(colour::UNCOVERED),
@@ -578,10 +580,10 @@ impl App {
         };
         ui.separator();
         let visiting = self.active_plan().map(|p| p.fields.as_slice());
-        let word = super::field_word(f, &self.session.doc().profile);
+        let word = super::words::field_word(f, &self.session.doc().profile);
         let mut heading = format!(
             "{word} {}",
-            super::field_number(&self.session.doc().fields, visiting, f.id)
+            super::words::field_number(&self.session.doc().fields, visiting, f.id)
         );
         if let Some(first) = heading.get_mut(..1) {
             first.make_ascii_uppercase();
@@ -594,7 +596,7 @@ impl App {
                 f.center.y,
                 f.size[0],
                 f.size[1],
-                super::count(f.geometries.len(), "geometry", "geometries"),
+                super::words::count(f.geometries.len(), "geometry", "geometries"),
                 if f.locked { ", locked" } else { "" }
             ))
             .wrap(),
@@ -761,14 +763,6 @@ impl App {
         let repaint = ui.ctx().clone();
         self.on_canvas(actions, &repaint);
     }
-}
-
-/// The colour of "stale" marks and notes.
-pub const STALE: Color32 = Color32::from_rgb(180, 83, 9);
-
-/// What changed since a plan was made, one reason a line.
-pub fn stale_text(why: &[String]) -> String {
-    format!("Changed since this plan was made:\n{}", why.join("\n"))
 }
 
 /// The header of the motion plots: shows or hides them.

@@ -16,6 +16,7 @@
 pub mod canvas;
 pub mod commands;
 pub mod compare;
+pub mod draw;
 pub mod files;
 mod hit;
 pub mod jobs;
@@ -25,17 +26,23 @@ pub mod motion_plots;
 mod paint;
 pub mod panels;
 pub mod playback;
+mod prompt;
 mod prompts;
 mod raster;
+pub mod scene;
 pub mod session;
 pub mod toolpaths;
+mod tray_actions;
 pub mod tray_panel;
+pub mod words;
 
-pub use canvas::{Canvas, CanvasAction, CanvasState, Layers, View};
+pub use canvas::{CanvasAction, CanvasState};
+pub use draw::View;
+pub use scene::{Canvas, Layers};
+pub use words::{count, field_number, field_numbers, field_word, fields_count, gui_error};
 
 use crate::document::{
-    Algo, DerivedKey, Document, Layer, MachineProfile, Motion, MotionMode, Plan, ScanField,
-    SolverSettings,
+    Algo, DerivedKey, Document, Layer, MachineProfile, Motion, MotionMode, Plan, SolverSettings,
 };
 use crate::job::JobCtx;
 use crate::pipeline::{derive_geometries, move_seam, place_document_fields};
@@ -44,7 +51,7 @@ use compare::CompareState;
 use files::{ExportKind, Recent};
 use jobs::{Job, JobOutcome, JobResult};
 use playback::Playback;
-pub use prompts::{PathAction, Prompt};
+pub use prompt::{PathAction, Prompt};
 use serde::{Deserialize, Serialize};
 use session::Session;
 use std::path::{Path, PathBuf};
@@ -1106,7 +1113,7 @@ impl App {
         let closing = ctx.input(|i| i.viewport().close_requested());
         if closing && !self.view.quit_confirmed && self.has_unsaved_changes() {
             ctx.send_viewport_cmd(egui::ViewportCommand::CancelClose);
-            self.panels.prompt = Some(Prompt::Unsaved(prompts::Then::Quit));
+            self.panels.prompt = Some(Prompt::Unsaved(prompt::Then::Quit));
         }
         if ctx.egui_wants_keyboard_input() || self.panels.prompt.is_some() {
             return;
@@ -1184,7 +1191,7 @@ fn install_fallback_font(ctx: &egui::Context) {
 /// The colour of the canvas's highlight of geometries no field holds (a halo around them,
 /// in a colour no layer is drawn in), and of the words about them.
 pub fn uncovered_rgb() -> [u8; 3] {
-    let c = paint::colour::UNCOVERED;
+    let c = draw::colour::UNCOVERED;
     [c.r(), c.g(), c.b()]
 }
 
@@ -1208,89 +1215,6 @@ fn import_change(
         (None, Some(n)) => format!("leave out hidden layer {}", layers::layer_label(n)),
         (None, None) => "import the artwork again".into(),
     }
-}
-
-/// `n` and the noun for it: "1 geometry", "3 geometries".
-pub fn count(n: usize, one: &str, many: &str) -> String {
-    format!("{n} {}", if n == 1 { one } else { many })
-}
-
-/// A pipeline error in the GUI's words: the message, then what the operator can do, naming
-/// the controls that do it.
-pub fn gui_error(e: &crate::pipeline::PipelineError) -> String {
-    use crate::pipeline::Remedy;
-    match e.remedy() {
-        Some(Remedy::SplitOversize) => format!(
-            "{e}; tick \"Split oversize geometries\" in Solver settings and press \"Re-place \
-             automatically\" to cut them at field borders, or choose \"Automatic\" or \"On the fly\" as the motion"
-        ),
-        Some(Remedy::Place) => format!(
-            "{e}; choose \"Placement: centred\" in the Layers panel to move it within reach"
-        ),
-        None => e.to_string(),
-    }
-}
-
-/// What the window calls a placed field: a "region" when it is larger than the profile's scan
-/// field (on the fly one region may hold what no scan field could: the stage carries the
-/// field across it), else a "field".
-pub fn field_word(field: &ScanField, profile: &MachineProfile) -> &'static str {
-    const TOLERANCE_MM: f64 = 1e-6;
-    let [w, h] = profile.field_mm;
-    if field.size[0] > w + TOLERANCE_MM || field.size[1] > h + TOLERANCE_MM {
-        "region"
-    } else {
-        "field"
-    }
-}
-
-/// How many fields and regions there are, in words: "6 fields", "1 region", "2 fields and
-/// 1 region".
-pub fn fields_count(fields: &[ScanField], profile: &MachineProfile) -> String {
-    let regions = fields
-        .iter()
-        .filter(|f| field_word(f, profile) == "region")
-        .count();
-    match (fields.len() - regions, regions) {
-        (n, 0) => count(n, "field", "fields"),
-        (0, r) => count(r, "region", "regions"),
-        (n, r) => format!(
-            "{} and {}",
-            count(n, "field", "fields"),
-            count(r, "region", "regions")
-        ),
-    }
-}
-
-/// The number shown for field `id`: 1…n in the visiting order of `visiting` (a plan's fields)
-/// for the fields it has, else by placement order (`fields`), after the plan's.
-pub fn field_number(fields: &[ScanField], visiting: Option<&[ScanField]>, id: usize) -> usize {
-    field_numbers(fields, visiting)
-        .get(&id)
-        .copied()
-        .unwrap_or(visiting.map_or(0, <[ScanField]>::len) + fields.len() + 1)
-}
-
-/// [`field_number`] of every field (and every visited one) at once, by id: what a frame that
-/// labels thousands of fields needs (one pass, not one per field).
-pub fn field_numbers(
-    fields: &[ScanField],
-    visiting: Option<&[ScanField]>,
-) -> std::collections::HashMap<usize, usize> {
-    let visited = visiting.unwrap_or(&[]);
-    let mut out: std::collections::HashMap<usize, usize> = visited
-        .iter()
-        .enumerate()
-        .map(|(k, f)| (f.id, k + 1))
-        .collect();
-    let mut next = visited.len() + 1;
-    for f in fields {
-        if let std::collections::hash_map::Entry::Vacant(e) = out.entry(f.id) {
-            e.insert(next);
-            next += 1;
-        }
-    }
-    out
 }
 
 impl eframe::App for App {

@@ -1,60 +1,13 @@
 //! Drawing of a [`Canvas`]: base stroke, fields, artwork, uncovered geometries, planned paths
 //! (from each plan's lowered toolpath) and the playback of a job.
 
-use super::canvas::{Canvas, PathLayer, View};
+use super::draw::{colour, screen_line, View, CULL_MARGIN_PX};
 use super::motion_plots;
 use super::playback;
+use super::scene::{Canvas, PathLayer};
 use super::toolpaths::Lowered;
 use crate::geom::Pt;
 use egui::{Align2, Color32, FontId, Painter, Pos2, Rect, Shape, Stroke, StrokeKind, Vec2};
-
-/// Colours of the canvas.
-pub mod colour {
-    use egui::Color32;
-    /// Closed geometries.
-    pub const CLOSED: Color32 = Color32::from_rgb(30, 41, 59);
-    /// Open geometries (also marked with dots at their ends).
-    pub const OPEN: Color32 = Color32::from_rgb(21, 128, 61);
-    /// Geometries no field holds: a magenta halo around the geometry (drawn in its own
-    /// colour), a style no layer colour has, and the words that tell of them.
-    pub const UNCOVERED: Color32 = Color32::from_rgb(192, 38, 211);
-    /// Width of the uncovered halo, px.
-    pub const UNCOVERED_HALO_PX: f32 = 9.0;
-    /// A lowering or other error in a canvas caption.
-    pub const ERROR: Color32 = Color32::from_rgb(200, 30, 30);
-    /// Geometries no field can hold (larger than a field, or beyond the stage's reach).
-    pub const OUT_OF_REACH: Color32 = Color32::from_rgb(147, 51, 234);
-    /// Scan fields.
-    pub const FIELD: Color32 = Color32::from_rgb(79, 70, 229);
-    /// Seams (where artwork larger than a field is cut).
-    pub const SEAM: Color32 = Color32::from_rgb(153, 27, 27);
-    /// The selected field.
-    pub const SELECTED: Color32 = Color32::from_rgb(245, 158, 11);
-    /// A mixed job's step-and-scan fields (the stage at rest while they are marked): their
-    /// fill, and the caption's words about them.
-    pub const STILL_FIELD: Color32 = Color32::from_rgb(13, 148, 136);
-    /// Idle moves of a single plan, and plan A when two are overlaid.
-    pub const PATH_A: Color32 = Color32::from_rgb(234, 88, 12);
-    /// Idle moves of plan B when two are overlaid.
-    pub const PATH_B: Color32 = Color32::from_rgb(37, 99, 235);
-    /// Start marker.
-    pub const START: Color32 = Color32::from_rgb(22, 163, 74);
-    /// End marker.
-    pub const END: Color32 = Color32::from_rgb(190, 18, 60);
-    /// First and last colours of marks coloured by order.
-    pub const ORDER: [Color32; 2] = [
-        Color32::from_rgb(8, 145, 178),
-        Color32::from_rgb(162, 28, 175),
-    ];
-}
-
-/// Screen points closer than this to the last one kept are left out of a drawn line, px: the
-/// line looks the same, and a zoomed-out job of 10⁵ strokes tessellates thousands of points,
-/// not millions.
-const DETAIL_PX: f32 = 0.75;
-
-/// Shapes wholly this far outside the canvas are not drawn, px (line widths and end dots).
-const CULL_MARGIN_PX: f32 = 8.0;
 
 /// A field's number is drawn only when the field is at least this much wider than its label
 /// and this tall on screen, px: smaller, the labels of neighbours overlap into a blob.
@@ -66,42 +19,6 @@ const LABEL_CHAR_PX: f32 = 7.5;
 
 /// Open geometries get dots at their ends only when at least this long on screen, px.
 const END_DOTS_MIN_PX: f32 = 6.0;
-
-/// `pts` (mm) on screen with the points closer than [`DETAIL_PX`] to the last kept one left out
-/// (the last point always kept; closed: back to the first), or none when the whole line lies
-/// outside `clip`.
-pub(super) fn screen_line<F: Fn(Pt) -> Pos2 + ?Sized>(
-    pts: &[Pt],
-    closed: bool,
-    s: &F,
-    clip: Rect,
-) -> Option<Vec<Pos2>> {
-    let first = *pts.first()?;
-    let mut out = Vec::with_capacity(pts.len().min(64));
-    let mut bounds = Rect::NOTHING;
-    let mut keep = |q: Pos2, out: &mut Vec<Pos2>| {
-        bounds.extend_with(q);
-        out.push(q);
-    };
-    keep(s(first), &mut out);
-    let n = pts.len();
-    for (k, &p) in pts.iter().enumerate().skip(1) {
-        let q = s(p);
-        let far = out
-            .last()
-            .is_none_or(|l| (q - *l).length_sq() >= DETAIL_PX * DETAIL_PX);
-        if far || k + 1 == n {
-            keep(q, &mut out);
-        }
-    }
-    if closed && n > 1 {
-        keep(s(first), &mut out);
-    }
-    bounds
-        .expand(CULL_MARGIN_PX)
-        .intersects(clip)
-        .then_some(out)
-}
 
 fn lerp(a: Color32, b: Color32, t: f32) -> Color32 {
     let m = |x: u8, y: u8| (f32::from(x) + (f32::from(y) - f32::from(x)) * t).round() as u8;
@@ -348,10 +265,11 @@ fn paint_field_labels(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect
         if !selected && (r.height() < LABEL_MIN_H_PX || r.width() < est_w(1) * 1.5) {
             continue;
         }
-        let numbers = numbers.get_or_insert_with(|| super::field_numbers(c.fields, c.visiting));
+        let numbers =
+            numbers.get_or_insert_with(|| super::words::field_numbers(c.fields, c.visiting));
         let number = numbers.get(&f.id).copied().unwrap_or_default();
         // a scan field shows its number; a region larger than the scan field says so
-        let name = match super::field_word(f, c.profile) {
+        let name = match super::words::field_word(f, c.profile) {
             "field" => format!("{number}"),
             word => format!("{word} {number}"),
         };
@@ -670,7 +588,7 @@ fn caption(c: &Canvas<'_>, playback_room: bool) -> Vec<(String, Color32)> {
         lines.push((
             format!(
                 "tinted green: {} marked step-and-scan (the stage at rest), the rest on the fly",
-                super::count(t.still_fields.len(), "field", "fields")
+                super::words::count(t.still_fields.len(), "field", "fields")
             ),
             colour::STILL_FIELD,
         ));
@@ -682,7 +600,7 @@ fn caption(c: &Canvas<'_>, playback_room: bool) -> Vec<(String, Color32)> {
         };
         lines.push((
             format!("stale plan: {first} since it was made{more}"),
-            super::layout::STALE,
+            colour::STALE,
         ));
     }
     let near = c
@@ -694,7 +612,7 @@ fn caption(c: &Canvas<'_>, playback_room: bool) -> Vec<(String, Color32)> {
         lines.push((
             format!(
                 "{} not covered by a field (magenta halo)",
-                super::count(near, "geometry", "geometries")
+                super::words::count(near, "geometry", "geometries")
             ),
             colour::UNCOVERED,
         ));
@@ -703,7 +621,7 @@ fn caption(c: &Canvas<'_>, playback_room: bool) -> Vec<(String, Color32)> {
         lines.push((
             format!(
                 "{} no scan field can hold (dashed purple)",
-                super::count(c.out_of_reach.len(), "geometry", "geometries")
+                super::words::count(c.out_of_reach.len(), "geometry", "geometries")
             ),
             colour::OUT_OF_REACH,
         ));

@@ -217,7 +217,7 @@ pub struct Editors {
     /// Last error of choosing a built-in profile.
     file_error: Option<String>,
     /// A profile file to load or save, for the window to ask a path for.
-    file_request: Option<super::prompts::PathAction>,
+    file_request: Option<super::prompt::PathAction>,
 }
 
 impl Default for Editors {
@@ -245,7 +245,7 @@ impl Editors {
     }
 
     /// A profile file to load or save that the operator asked for.
-    pub fn take_file_request(&mut self) -> Option<super::prompts::PathAction> {
+    pub fn take_file_request(&mut self) -> Option<super::prompt::PathAction> {
         self.file_request.take()
     }
 
@@ -289,10 +289,10 @@ impl Editors {
         }
         ui.horizontal(|ui| {
             if ui.button("Load TOML…").clicked() {
-                self.file_request = Some(super::prompts::PathAction::LoadProfile);
+                self.file_request = Some(super::prompt::PathAction::LoadProfile);
             }
             if ui.button("Save TOML…").clicked() {
-                self.file_request = Some(super::prompts::PathAction::SaveProfile);
+                self.file_request = Some(super::prompt::PathAction::SaveProfile);
             }
         });
         if let Some(e) = &self.file_error {

@@ -250,7 +250,7 @@ pub fn paint(
     t_s: f64,
     field_mm: [f64; 2],
     done: Option<Color32>,
-    view: &super::canvas::View,
+    view: &super::draw::View,
     rect: Rect,
 ) {
     let to_screen = |q: Pt| view.to_screen(rect, q);
@@ -268,7 +268,7 @@ pub fn paint(
         range
             .filter_map(|k| {
                 // at screen resolution, and none off the canvas
-                super::paint::screen_line(tp.stroke_points(k), false, &to_screen, clip)
+                super::draw::screen_line(tp.stroke_points(k), false, &to_screen, clip)
                     .map(|pts| polyline(pts.into_iter(), marks))
             })
             .collect()

@@ -5,7 +5,7 @@
 
 use super::commands::{Command, History, Outcome};
 use super::toolpaths::{Lowered, Prelowered, ToolpathCache};
-use super::{field_number, field_word};
+use super::words::{field_number, field_word};
 use crate::document::{staleness, Document, MachineProfile, Plan};
 use std::path::PathBuf;
 
@@ -354,7 +354,7 @@ impl Session {
             .map(|g| {
                 rgb.get(g.layer.as_str())
                     .copied()
-                    .unwrap_or(super::paint::colour::CLOSED)
+                    .unwrap_or(super::draw::colour::CLOSED)
             })
             .collect();
         self.stale = self

@@ -1,0 +1,93 @@
+//! How the GUI words what it shows: counts with their noun, fields and regions and their
+//! numbers, pipeline errors with what the operator can do, a plan's staleness. At the bottom of
+//! the GUI's modules: nothing here imports another file of the GUI.
+
+use crate::document::{MachineProfile, ScanField};
+
+/// `n` and the noun for it: "1 geometry", "3 geometries".
+pub fn count(n: usize, one: &str, many: &str) -> String {
+    format!("{n} {}", if n == 1 { one } else { many })
+}
+
+/// A pipeline error in the GUI's words: the message, then what the operator can do, naming
+/// the controls that do it.
+pub fn gui_error(e: &crate::pipeline::PipelineError) -> String {
+    use crate::pipeline::Remedy;
+    match e.remedy() {
+        Some(Remedy::SplitOversize) => format!(
+            "{e}; tick \"Split oversize geometries\" in Solver settings and press \"Re-place \
+             automatically\" to cut them at field borders, or choose \"Automatic\" or \"On the fly\" as the motion"
+        ),
+        Some(Remedy::Place) => format!(
+            "{e}; choose \"Placement: centred\" in the Layers panel to move it within reach"
+        ),
+        None => e.to_string(),
+    }
+}
+
+/// What the window calls a placed field: a "region" when it is larger than the profile's scan
+/// field (on the fly one region may hold what no scan field could: the stage carries the
+/// field across it), else a "field".
+pub fn field_word(field: &ScanField, profile: &MachineProfile) -> &'static str {
+    const TOLERANCE_MM: f64 = 1e-6;
+    let [w, h] = profile.field_mm;
+    if field.size[0] > w + TOLERANCE_MM || field.size[1] > h + TOLERANCE_MM {
+        "region"
+    } else {
+        "field"
+    }
+}
+
+/// How many fields and regions there are, in words: "6 fields", "1 region", "2 fields and
+/// 1 region".
+pub fn fields_count(fields: &[ScanField], profile: &MachineProfile) -> String {
+    let regions = fields
+        .iter()
+        .filter(|f| field_word(f, profile) == "region")
+        .count();
+    match (fields.len() - regions, regions) {
+        (n, 0) => count(n, "field", "fields"),
+        (0, r) => count(r, "region", "regions"),
+        (n, r) => format!(
+            "{} and {}",
+            count(n, "field", "fields"),
+            count(r, "region", "regions")
+        ),
+    }
+}
+
+/// The number shown for field `id`: 1…n in the visiting order of `visiting` (a plan's fields)
+/// for the fields it has, else by placement order (`fields`), after the plan's.
+pub fn field_number(fields: &[ScanField], visiting: Option<&[ScanField]>, id: usize) -> usize {
+    field_numbers(fields, visiting)
+        .get(&id)
+        .copied()
+        .unwrap_or(visiting.map_or(0, <[ScanField]>::len) + fields.len() + 1)
+}
+
+/// [`field_number`] of every field (and every visited one) at once, by id: what a frame that
+/// labels thousands of fields needs (one pass, not one per field).
+pub fn field_numbers(
+    fields: &[ScanField],
+    visiting: Option<&[ScanField]>,
+) -> std::collections::HashMap<usize, usize> {
+    let visited = visiting.unwrap_or(&[]);
+    let mut out: std::collections::HashMap<usize, usize> = visited
+        .iter()
+        .enumerate()
+        .map(|(k, f)| (f.id, k + 1))
+        .collect();
+    let mut next = visited.len() + 1;
+    for f in fields {
+        if let std::collections::hash_map::Entry::Vacant(e) = out.entry(f.id) {
+            e.insert(next);
+            next += 1;
+        }
+    }
+    out
+}
+
+/// What changed since a plan was made, one reason a line.
+pub fn stale_text(why: &[String]) -> String {
+    format!("Changed since this plan was made:\n{}", why.join("\n"))
+}
