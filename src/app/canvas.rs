@@ -35,6 +35,41 @@ enum Drag {
     },
 }
 
+/// What ends with a drag: the field drag's undo group, a code or a seam moved.
+fn drag_end(drag: Drag) -> Option<CanvasAction> {
+    match drag {
+        Drag::Field { .. } => Some(CanvasAction::EndDrag),
+        Drag::Code { code, from, to } if from.dist(to) > 1e-6 => Some(CanvasAction::MoveCode {
+            code,
+            by: to.minus(from),
+        }),
+        Drag::Seam {
+            axis,
+            from_mm,
+            at_mm,
+        } if (at_mm - from_mm).abs() > 1e-6 => Some(CanvasAction::MoveSeam {
+            axis,
+            from_mm,
+            to_mm: at_mm,
+        }),
+        _ => None,
+    }
+}
+
+/// The wheel (or a pinch) zooms `view` about the cursor.
+fn zoom_about_cursor(ui: &egui::Ui, response: &egui::Response, rect: Rect, view: &mut View) {
+    let (scroll, zoom) = ui.input(|i| (i.smooth_scroll_delta.y, i.zoom_delta()));
+    let factor = zoom * (scroll / 200.0).exp();
+    if (factor - 1.0).abs() > 1e-4 {
+        if let Some(cursor) = response.hover_pos() {
+            let before = view.to_mm(rect, cursor);
+            view.scale = (view.scale * factor).clamp(0.01, 1000.0);
+            let after = view.to_screen(rect, before);
+            view.offset += cursor - after;
+        }
+    }
+}
+
 /// How near a seam the pointer grabs it, px.
 const SEAM_GRAB_PX: f32 = 5.0;
 
@@ -209,111 +244,38 @@ impl Canvas<'_> {
         state: &mut CanvasState,
         actions: &mut Vec<CanvasAction>,
     ) {
-        let view = &mut state.view;
         if response.drag_started() {
             let origin = ui.input(|i| i.pointer.press_origin());
-            state.drag = Drag::Pan;
-            let seam = origin.and_then(|o| {
-                self.seam_at(view.to_mm(rect, o), f64::from(SEAM_GRAB_PX / view.scale))
-            });
             let primary =
                 self.editable && response.drag_started_by(PointerButton::Primary) && !self.add_tool;
-            let code = origin
-                .filter(|_| primary)
-                .and_then(|o| self.code_at(view.to_mm(rect, o), f64::from(4.0 / view.scale)));
-            if let (Some(c), Some(o)) = (code, origin) {
-                let at = view.to_mm(rect, o);
-                state.drag = Drag::Code {
-                    code: c.code,
-                    from: at,
-                    to: at,
-                };
-            } else if let (true, Some((axis, from_mm))) = (primary, seam) {
-                state.drag = Drag::Seam {
-                    axis,
-                    from_mm,
-                    at_mm: from_mm,
-                };
-            } else if primary {
-                if let Some(f) = origin.and_then(|o| self.field_at(view.to_mm(rect, o))) {
-                    actions.push(CanvasAction::Select(Some(f.id)));
-                    if !f.locked {
-                        let o = origin.map(|o| view.to_mm(rect, o)).unwrap_or(f.center);
-                        state.drag = Drag::Field {
-                            id: f.id,
-                            grab: f.center.minus(o),
-                        };
-                    }
-                }
-            }
+            state.drag = match origin.filter(|_| primary) {
+                Some(o) => self.drag_from(state.view.to_mm(rect, o), &state.view, actions),
+                None => Drag::Pan,
+            };
         }
         if response.dragged() {
-            match state.drag {
-                Drag::Code { code, from, .. } => {
-                    if let Some(p) = response.interact_pointer_pos() {
-                        let to = view.to_mm(rect, p);
-                        state.drag = Drag::Code { code, from, to };
-                    }
-                }
-                Drag::Field { id, grab } => {
-                    if let Some(p) = response.interact_pointer_pos() {
-                        let center = view.to_mm(rect, p).plus(grab);
-                        actions.push(CanvasAction::Move { id, center });
-                    }
-                }
-                Drag::Seam { axis, from_mm, .. } => {
-                    if let Some(p) = response.interact_pointer_pos() {
-                        let mm = view.to_mm(rect, p);
-                        let to_mm = if axis == 0 { mm.x } else { mm.y };
-                        // where the seam will land: as far as its neighbours allow
-                        let at_mm = self
-                            .tiling
-                            .and_then(|t| {
-                                crate::fields::move_seam(t, axis, from_mm, to_mm, self.cell_max_mm)
-                            })
-                            .map_or(to_mm, |(_, at)| at);
-                        state.drag = Drag::Seam {
-                            axis,
-                            from_mm,
-                            at_mm,
-                        };
-                    }
-                }
-                Drag::Pan | Drag::None => view.offset += response.drag_delta(),
+            let at = response
+                .interact_pointer_pos()
+                .map(|p| state.view.to_mm(rect, p));
+            match (state.drag, at) {
+                (Drag::Pan | Drag::None, _) => state.view.offset += response.drag_delta(),
+                (drag, Some(at)) => state.drag = self.drag_to(drag, at, actions),
+                (_, None) => {}
             }
         }
         if response.drag_stopped() {
-            match state.drag {
-                Drag::Field { .. } => actions.push(CanvasAction::EndDrag),
-                Drag::Code { code, from, to } if from.dist(to) > 1e-6 => {
-                    actions.push(CanvasAction::MoveCode {
-                        code,
-                        by: to.minus(from),
-                    })
-                }
-                Drag::Seam {
-                    axis,
-                    from_mm,
-                    at_mm,
-                } if (at_mm - from_mm).abs() > 1e-6 => actions.push(CanvasAction::MoveSeam {
-                    axis,
-                    from_mm,
-                    to_mm: at_mm,
-                }),
-                _ => {}
-            }
+            actions.extend(drag_end(state.drag));
             state.drag = Drag::None;
         }
+        let view = &mut state.view;
         if self.editable && state.drag == Drag::None {
-            let near_seam = response.hover_pos().is_some_and(|p| {
-                self.seam_at(view.to_mm(rect, p), f64::from(SEAM_GRAB_PX / view.scale))
+            let grab = response.hover_pos().is_some_and(|p| {
+                let mm = view.to_mm(rect, p);
+                self.seam_at(mm, f64::from(SEAM_GRAB_PX / view.scale))
                     .is_some()
+                    || self.code_at(mm, f64::from(4.0 / view.scale)).is_some()
             });
-            let near_code = response.hover_pos().is_some_and(|p| {
-                self.code_at(view.to_mm(rect, p), f64::from(4.0 / view.scale))
-                    .is_some()
-            });
-            if near_seam || near_code {
+            if grab {
                 ui.ctx().set_cursor_icon(egui::CursorIcon::Grab);
             }
         }
@@ -328,16 +290,70 @@ impl Canvas<'_> {
             }
         }
         if response.hovered() {
-            let (scroll, zoom) = ui.input(|i| (i.smooth_scroll_delta.y, i.zoom_delta()));
-            let factor = zoom * (scroll / 200.0).exp();
-            if (factor - 1.0).abs() > 1e-4 {
-                if let Some(cursor) = response.hover_pos() {
-                    let before = view.to_mm(rect, cursor);
-                    view.scale = (view.scale * factor).clamp(0.01, 1000.0);
-                    let after = view.to_screen(rect, before);
-                    view.offset += cursor - after;
+            zoom_about_cursor(ui, response, rect, view);
+        }
+    }
+
+    /// What a primary drag from `at` (mm) moves: a code, a seam, an unlocked field (selected
+    /// too), or the view.
+    fn drag_from(&self, at: Pt, view: &View, actions: &mut Vec<CanvasAction>) -> Drag {
+        if let Some(c) = self.code_at(at, f64::from(4.0 / view.scale)) {
+            return Drag::Code {
+                code: c.code,
+                from: at,
+                to: at,
+            };
+        }
+        if let Some((axis, from_mm)) = self.seam_at(at, f64::from(SEAM_GRAB_PX / view.scale)) {
+            return Drag::Seam {
+                axis,
+                from_mm,
+                at_mm: from_mm,
+            };
+        }
+        match self.field_at(at) {
+            Some(f) => {
+                actions.push(CanvasAction::Select(Some(f.id)));
+                if f.locked {
+                    Drag::Pan
+                } else {
+                    Drag::Field {
+                        id: f.id,
+                        grab: f.center.minus(at),
+                    }
                 }
             }
+            None => Drag::Pan,
+        }
+    }
+
+    /// `drag` followed to the pointer at `at` (mm); a field's move is an action each frame.
+    fn drag_to(&self, drag: Drag, at: Pt, actions: &mut Vec<CanvasAction>) -> Drag {
+        match drag {
+            Drag::Code { code, from, .. } => Drag::Code { code, from, to: at },
+            Drag::Field { id, grab } => {
+                actions.push(CanvasAction::Move {
+                    id,
+                    center: at.plus(grab),
+                });
+                drag
+            }
+            Drag::Seam { axis, from_mm, .. } => {
+                let to_mm = if axis == 0 { at.x } else { at.y };
+                // where the seam will land: as far as its neighbours allow
+                let at_mm = self
+                    .tiling
+                    .and_then(|t| {
+                        crate::fields::move_seam(t, axis, from_mm, to_mm, self.cell_max_mm)
+                    })
+                    .map_or(to_mm, |(_, at)| at);
+                Drag::Seam {
+                    axis,
+                    from_mm,
+                    at_mm,
+                }
+            }
+            Drag::Pan | Drag::None => drag,
         }
     }
 

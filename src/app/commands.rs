@@ -138,12 +138,7 @@ pub fn apply(doc: &mut Document, cmd: &Command) -> Result<Outcome, String> {
         }
         Command::SetProfile(p) => {
             p.validate().map_err(|e| e.to_string())?;
-            doc.profile = (**p).clone();
-            let [sw, sh] = doc.profile.stroke_mm;
-            for f in &mut doc.fields {
-                f.size = doc.profile.field_mm;
-                f.center = Pt::new(f.center.x.clamp(0.0, sw), f.center.y.clamp(0.0, sh));
-            }
+            set_profile(doc, p);
             Ok(uncovered(reallocate(doc)))
         }
         Command::SetSettings(s) => {
@@ -182,25 +177,43 @@ pub fn apply(doc: &mut Document, cmd: &Command) -> Result<Outcome, String> {
         }
         Command::SetContent { doc: new, .. } => {
             new.validate().map_err(|e| e.to_string())?;
-            doc.production = new.production.clone();
-            doc.parts = new.parts.clone();
-            doc.artwork = new.artwork.clone();
-            doc.page_mm = new.page_mm;
-            doc.import = new.import.clone();
-            doc.geometries = new.geometries.clone();
-            doc.geometry_rev = new.geometry_rev;
-            doc.kept_geometries = new.kept_geometries.clone();
-            doc.layers = new.layers.clone();
-            doc.derived_with = new.derived_with.clone();
-            doc.tiling = new.tiling.clone();
-            doc.seams = new.seams.clone();
-            doc.tiling_set = new.tiling_set.clone();
-            doc.fields = new.fields.clone();
-            doc.plans = new.plans.clone();
-            doc.warnings = new.warnings.clone();
+            set_content(doc, new);
             Ok(uncovered(reallocate(doc)))
         }
     }
+}
+
+/// The profile `p` for `doc`: every field gets its scan field's size and stays within the
+/// stage's stroke.
+fn set_profile(doc: &mut Document, p: &MachineProfile) {
+    doc.profile = p.clone();
+    let [sw, sh] = doc.profile.stroke_mm;
+    for f in &mut doc.fields {
+        f.size = doc.profile.field_mm;
+        f.center = Pt::new(f.center.x.clamp(0.0, sw), f.center.y.clamp(0.0, sh));
+    }
+}
+
+/// Takes what a background job made from the document (`new`: geometries, layers, fields,
+/// plans, warnings, the tray) into `doc`; the profile, the settings, the source and the
+/// history's view of the document stay.
+fn set_content(doc: &mut Document, new: &Document) {
+    doc.production = new.production.clone();
+    doc.parts = new.parts.clone();
+    doc.artwork = new.artwork.clone();
+    doc.page_mm = new.page_mm;
+    doc.import = new.import.clone();
+    doc.geometries = new.geometries.clone();
+    doc.geometry_rev = new.geometry_rev;
+    doc.kept_geometries = new.kept_geometries.clone();
+    doc.layers = new.layers.clone();
+    doc.derived_with = new.derived_with.clone();
+    doc.tiling = new.tiling.clone();
+    doc.seams = new.seams.clone();
+    doc.tiling_set = new.tiling_set.clone();
+    doc.fields = new.fields.clone();
+    doc.plans = new.plans.clone();
+    doc.warnings = new.warnings.clone();
 }
 
 /// The artwork (with its page and import choices), the geometries (with their revision and

@@ -628,37 +628,14 @@ pub fn show(
     let playback_t_s = job
         .and_then(Result::ok)
         .and_then(|_| st.playback.shown_t_s());
-    let a = &doc.plans[ka];
-    let b = kb.map(|k| &doc.plans[k]);
-    let canvas = |k: usize, col: Color32| Canvas {
-        label: "",
-        geometries: &doc.geometries,
-        profile: &doc.profile,
-        fields: &doc.plans[k].fields,
-        seams: &doc.plans[k].seams.lines,
-        tiling: doc.plans[k].tiling.as_ref(),
-        cell_max_mm: crate::fields::cell_max_mm(
-            &doc.plans[k].layers,
-            doc.plans[k].profile.field_mm,
-        ),
-        visiting: Some(&doc.plans[k].fields),
-        colours: None,
-        out_of_reach: &[],
-        paths: vec![PathLayer {
-            plan: &doc.plans[k],
-            lowered: toolpaths.get(k).unwrap_or(Err("not lowered yet")),
-            colour: col,
-        }],
-        uncovered: &[],
-        selected: None,
-        editable: false,
-        add_tool: false,
-        layers,
-        stale: stale_of(k),
-        playback_t_s,
-        parts: &[],
-        codes: &[],
-        revision,
+    let canvas = |k: usize, col: Color32| {
+        plan_canvas(
+            doc,
+            toolpaths,
+            k,
+            col,
+            (layers, stale_of(k), playback_t_s, revision),
+        )
     };
     // the metrics table's height (20 rows), or less on a small window (it scrolls then)
     let bottom = 460.0_f32.min(ui.available_height() * 0.45);
@@ -688,6 +665,20 @@ pub fn show(
         }
     }
     ui.add_space(4.0);
+    figures(ui, doc, (ka, kb), &stale_of, (width, bottom));
+}
+
+/// The compared plans' figures: stale notes, the metrics table and, when a plan has a GA
+/// history, the convergence plot beside it; `(width, bottom)` is the space they have, px.
+fn figures<'s>(
+    ui: &mut egui::Ui,
+    doc: &Document,
+    (ka, kb): (usize, Option<usize>),
+    stale_of: &dyn Fn(usize) -> &'s [String],
+    (width, bottom): (f32, f32),
+) {
+    let a = &doc.plans[ka];
+    let b = kb.map(|k| &doc.plans[k]);
     let mut plans = vec![(a, colour::PATH_A, if b.is_some() { "A" } else { "Plan" })];
     if let Some(b) = b {
         plans.push((b, colour::PATH_B, "B"));
@@ -738,6 +729,45 @@ pub fn show(
             convergence_plot(ui, &plans, hha);
         });
     });
+}
+
+/// The canvas of plan `k` drawn in `col`, with the canvas `layers`, the plan's staleness, the
+/// playback time and the canvases' revision (`look`).
+fn plan_canvas<'a>(
+    doc: &'a Document,
+    toolpaths: &'a ToolpathCache,
+    k: usize,
+    col: Color32,
+    (layers, stale, playback_t_s, revision): (Layers, &'a [String], Option<f64>, u64),
+) -> Canvas<'a> {
+    let plan = &doc.plans[k];
+    Canvas {
+        label: "",
+        geometries: &doc.geometries,
+        profile: &doc.profile,
+        fields: &plan.fields,
+        seams: &plan.seams.lines,
+        tiling: plan.tiling.as_ref(),
+        cell_max_mm: crate::fields::cell_max_mm(&plan.layers, plan.profile.field_mm),
+        visiting: Some(&plan.fields),
+        colours: None,
+        out_of_reach: &[],
+        paths: vec![PathLayer {
+            plan,
+            lowered: toolpaths.get(k).unwrap_or(Err("not lowered yet")),
+            colour: col,
+        }],
+        uncovered: &[],
+        selected: None,
+        editable: false,
+        add_tool: false,
+        layers,
+        stale,
+        playback_t_s,
+        parts: &[],
+        codes: &[],
+        revision,
+    }
 }
 
 /// Width the compare view's metrics table would like beside the convergence plot, px.

@@ -250,52 +250,8 @@ impl LayerEditor {
                     out = again(place, import.included.clone());
                 }
             }
-            if import.hidden_layers.is_empty() {
-                return;
-            }
-            ui.label("Layers the drawing hides:")
-                .on_hover_text("Off, frozen or hidden in the file; not marked unless included");
-            for hidden in &import.hidden_layers {
-                let included = import
-                    .included
-                    .iter()
-                    .any(|n| n.eq_ignore_ascii_case(&hidden.name));
-                ui.horizontal(|ui| {
-                    let what = format!(
-                        "{}: {}, {} {}",
-                        layer_label(&hidden.name),
-                        hidden.why,
-                        hidden.skipped,
-                        if hidden.skipped == 1 { "item" } else { "items" }
-                    );
-                    if included {
-                        ui.label(format!("{what}, marked"));
-                        if ui
-                            .button("Leave out")
-                            .on_hover_text("Import the file again without this layer")
-                            .clicked()
-                        {
-                            let rest = import
-                                .included
-                                .iter()
-                                .filter(|n| !n.eq_ignore_ascii_case(&hidden.name))
-                                .cloned()
-                                .collect();
-                            out = again(import.place, rest);
-                        }
-                    } else {
-                        ui.label(RichText::new(format!("{what}, not marked")).weak());
-                        if ui
-                            .button("Include")
-                            .on_hover_text("Import the file again with this layer, to mark it")
-                            .clicked()
-                        {
-                            let mut with = import.included.clone();
-                            with.push(hidden.name.clone());
-                            out = again(import.place, with);
-                        }
-                    }
-                });
+            if let Some(action) = hidden_layers_ui(ui, import) {
+                out = Some(action);
             }
         });
         out
@@ -361,51 +317,8 @@ impl LayerEditor {
         (imported, marked): (usize, usize),
         profile: &MachineProfile,
     ) -> Option<Layer> {
-        let mut out = None;
-        let [r, g, b] = layer.rgb();
-        let colour = Color32::from_rgb(r, g, b);
-        ui.horizontal(|ui| {
-            let (rect, _) = ui.allocate_exact_size(egui::vec2(14.0, 14.0), egui::Sense::hover());
-            ui.painter().rect_filled(rect, 2.0, colour);
-            let mut enabled = layer.pen.enabled;
-            let r = ui
-                .checkbox(
-                    &mut enabled,
-                    RichText::new(layer_label(&layer.name)).strong(),
-                )
-                .on_hover_text(format!(
-                    "Layer '{}'. Marked: untick to leave this layer out of the job",
-                    layer_label(&layer.name)
-                ));
-            if r.changed() {
-                let mut l = layer.clone();
-                l.pen.enabled = enabled;
-                out = Some(l);
-            }
-            let words = if layer.pen.hatch.is_some() {
-                format!("{imported} shapes, {marked} strokes with the hatch")
-            } else {
-                super::words::count(imported, "geometry", "geometries")
-            };
-            ui.label(RichText::new(words).weak());
-        });
-        // two values a row when both fit beside their labels, else one: never a squeezed edit
-        let font = egui::TextStyle::Body.resolve(ui.style());
-        let label_px = COLS
-            .iter()
-            .map(|c| {
-                ui.painter()
-                    .layout_no_wrap(c.label(), font.clone(), Color32::WHITE)
-                    .size()
-                    .x
-            })
-            .fold(0.0, f32::max);
-        let pair_px = label_px + EDIT_PX + 3.0 * GRID_GAP_PX;
-        let pairs = if ui.available_width() >= 2.0 * pair_px {
-            2
-        } else {
-            1
-        };
+        let mut out = layer_header(ui, layer, (imported, marked));
+        let pairs = grid_pairs(ui);
         egui::Grid::new(("layer-grid", k))
             .num_columns(2 * pairs)
             .spacing([GRID_GAP_PX, 3.0])
@@ -791,6 +704,126 @@ pub fn colour_word([r, g, b]: [u8; 3]) -> String {
         _ => "",
     };
     format!("{shade}{base}")
+}
+
+/// The layers the drawing hides (greyed), each with a button that imports it or leaves it out
+/// again.
+fn hidden_layers_ui(ui: &mut egui::Ui, import: &ArtworkImport) -> Option<LayerAction> {
+    if import.hidden_layers.is_empty() {
+        return None;
+    }
+    let mut out = None;
+    let again = |included: Vec<String>| {
+        Some(LayerAction::Reimport(ArtworkImport {
+            place: import.place,
+            hidden_layers: import.hidden_layers.clone(),
+            included,
+        }))
+    };
+    ui.label("Layers the drawing hides:")
+        .on_hover_text("Off, frozen or hidden in the file; not marked unless included");
+    for hidden in &import.hidden_layers {
+        let included = import
+            .included
+            .iter()
+            .any(|n| n.eq_ignore_ascii_case(&hidden.name));
+        ui.horizontal(|ui| {
+            let what = format!(
+                "{}: {}, {} {}",
+                layer_label(&hidden.name),
+                hidden.why,
+                hidden.skipped,
+                if hidden.skipped == 1 { "item" } else { "items" }
+            );
+            if included {
+                ui.label(format!("{what}, marked"));
+                if ui
+                    .button("Leave out")
+                    .on_hover_text("Import the file again without this layer")
+                    .clicked()
+                {
+                    let rest = import
+                        .included
+                        .iter()
+                        .filter(|n| !n.eq_ignore_ascii_case(&hidden.name))
+                        .cloned()
+                        .collect();
+                    out = again(rest);
+                }
+            } else {
+                ui.label(RichText::new(format!("{what}, not marked")).weak());
+                if ui
+                    .button("Include")
+                    .on_hover_text("Import the file again with this layer, to mark it")
+                    .clicked()
+                {
+                    let mut with = import.included.clone();
+                    with.push(hidden.name.clone());
+                    out = again(with);
+                }
+            }
+        });
+    }
+    out
+}
+
+/// A layer's colour, its *Marked* box (a changed layer when it is ticked or unticked) and what
+/// it holds (`imported` geometries or shapes, `marked` strokes with its hatch).
+fn layer_header(
+    ui: &mut egui::Ui,
+    layer: &Layer,
+    (imported, marked): (usize, usize),
+) -> Option<Layer> {
+    let mut out = None;
+    let [r, g, b] = layer.rgb();
+    let colour = Color32::from_rgb(r, g, b);
+    ui.horizontal(|ui| {
+        let (rect, _) = ui.allocate_exact_size(egui::vec2(14.0, 14.0), egui::Sense::hover());
+        ui.painter().rect_filled(rect, 2.0, colour);
+        let mut enabled = layer.pen.enabled;
+        let r = ui
+            .checkbox(
+                &mut enabled,
+                RichText::new(layer_label(&layer.name)).strong(),
+            )
+            .on_hover_text(format!(
+                "Layer '{}'. Marked: untick to leave this layer out of the job",
+                layer_label(&layer.name)
+            ));
+        if r.changed() {
+            let mut l = layer.clone();
+            l.pen.enabled = enabled;
+            out = Some(l);
+        }
+        let words = if layer.pen.hatch.is_some() {
+            format!("{imported} shapes, {marked} strokes with the hatch")
+        } else {
+            super::words::count(imported, "geometry", "geometries")
+        };
+        ui.label(RichText::new(words).weak());
+    });
+    out
+}
+
+/// Values a row of the layer grid: two when both fit beside their labels, else one (never a
+/// squeezed edit).
+fn grid_pairs(ui: &egui::Ui) -> usize {
+    let font = egui::TextStyle::Body.resolve(ui.style());
+    let label_px = COLS
+        .iter()
+        .map(|c| {
+            ui.painter()
+                .layout_no_wrap(c.label(), font.clone(), Color32::WHITE)
+                .size()
+                .x
+        })
+        .fold(0.0, f32::max);
+    let pair_px = label_px + EDIT_PX + 3.0 * GRID_GAP_PX;
+    if ui.available_width() >= 2.0 * pair_px {
+        2
+    } else {
+        1
+    }
 }
 
 #[cfg(test)]

@@ -65,116 +65,125 @@ impl App {
 
     fn menu_bar(&mut self, ui: &mut egui::Ui) {
         egui::MenuBar::new().ui(ui, |ui| {
-            let ctx = ui.ctx().clone();
-            ui.menu_button("File", |ui| {
-                if ui
-                    .add(egui::Button::new("New").shortcut_text("Ctrl+N"))
-                    .clicked()
-                {
-                    self.request_new();
-                }
-                if ui
-                    .add(egui::Button::new("Open SVG, DXF or project…").shortcut_text("Ctrl+O"))
-                    .clicked()
-                {
-                    self.request_open(None, &ctx);
-                }
-                ui.menu_button("Open recent", |ui| {
-                    if self.prefs.recent.0.is_empty() {
-                        ui.label("(none)");
-                    }
-                    for p in self.prefs.recent.0.clone() {
-                        if ui.button(p.display().to_string()).clicked() {
-                            self.request_open(Some(p), &ctx);
-                        }
-                    }
-                });
-                ui.separator();
-                let doc = self.has_document();
-                if ui
-                    .add_enabled(
-                        doc,
-                        egui::Button::new("Save project").shortcut_text("Ctrl+S"),
-                    )
-                    .clicked()
-                {
-                    self.request_save(false, &ctx);
-                }
-                if ui
-                    .add_enabled(
-                        doc,
-                        egui::Button::new("Save project as…").shortcut_text("Ctrl+Shift+S"),
-                    )
-                    .clicked()
-                {
-                    self.request_save(true, &ctx);
-                }
-                ui.separator();
-                let plan = self.active_plan().is_some();
-                for (kind, label, keys) in [
-                    (ExportKind::Gcode, "Export G-code…", "Ctrl+E"),
-                    (ExportKind::Report, "Export report (JSON)…", ""),
-                    (ExportKind::Preview, "Export SVG preview…", ""),
-                    (ExportKind::Trajectory, "Export trajectory (CSV)…", ""),
-                ] {
-                    let b = egui::Button::new(label).shortcut_text(keys);
-                    if ui
-                        .add_enabled(plan, b)
-                        .on_disabled_hover_text("Run a solver first")
-                        .clicked()
-                    {
-                        self.request_export(kind, &ctx);
-                    }
-                }
-                ui.separator();
-                if ui
-                    .add(egui::Button::new("Quit").shortcut_text("Ctrl+Q"))
-                    .clicked()
-                {
-                    self.request_quit(&ctx);
-                }
-            });
-            ui.menu_button("Edit", |ui| {
-                let u = self
-                    .session
-                    .history()
-                    .undo_label()
-                    .map(|w| format!("Undo {w}"));
-                if ui
-                    .add_enabled(
-                        u.is_some(),
-                        egui::Button::new(u.unwrap_or("Undo".into())).shortcut_text("Ctrl+Z"),
-                    )
-                    .clicked()
-                {
-                    self.undo();
-                }
-                let r = self
-                    .session
-                    .history()
-                    .redo_label()
-                    .map(|w| format!("Redo {w}"));
-                if ui
-                    .add_enabled(
-                        r.is_some(),
-                        egui::Button::new(r.unwrap_or("Redo".into())).shortcut_text("Ctrl+Shift+Z"),
-                    )
-                    .clicked()
-                {
-                    self.redo();
-                }
-            });
-            ui.menu_button("View", |ui| {
-                self.layer_toggles(ui);
-                if ui
-                    .add(egui::Button::new("Fit to view").shortcut_text("F"))
-                    .clicked()
-                {
-                    self.panels.workbench.fit_requested = true;
-                    self.panels.compare.canvas.fit_requested = true;
-                }
-            });
+            ui.menu_button("File", |ui| self.file_menu(ui));
+            ui.menu_button("Edit", |ui| self.edit_menu(ui));
+            ui.menu_button("View", |ui| self.view_menu(ui));
         });
+    }
+
+    /// New, open, save, export and quit.
+    fn file_menu(&mut self, ui: &mut egui::Ui) {
+        let ctx = ui.ctx().clone();
+        if ui
+            .add(egui::Button::new("New").shortcut_text("Ctrl+N"))
+            .clicked()
+        {
+            self.request_new();
+        }
+        if ui
+            .add(egui::Button::new("Open SVG, DXF or project…").shortcut_text("Ctrl+O"))
+            .clicked()
+        {
+            self.request_open(None, &ctx);
+        }
+        ui.menu_button("Open recent", |ui| {
+            if self.prefs.recent.0.is_empty() {
+                ui.label("(none)");
+            }
+            for p in self.prefs.recent.0.clone() {
+                if ui.button(p.display().to_string()).clicked() {
+                    self.request_open(Some(p), &ctx);
+                }
+            }
+        });
+        ui.separator();
+        let doc = self.has_document();
+        if ui
+            .add_enabled(
+                doc,
+                egui::Button::new("Save project").shortcut_text("Ctrl+S"),
+            )
+            .clicked()
+        {
+            self.request_save(false, &ctx);
+        }
+        if ui
+            .add_enabled(
+                doc,
+                egui::Button::new("Save project as…").shortcut_text("Ctrl+Shift+S"),
+            )
+            .clicked()
+        {
+            self.request_save(true, &ctx);
+        }
+        ui.separator();
+        let plan = self.active_plan().is_some();
+        for (kind, label, keys) in [
+            (ExportKind::Gcode, "Export G-code…", "Ctrl+E"),
+            (ExportKind::Report, "Export report (JSON)…", ""),
+            (ExportKind::Preview, "Export SVG preview…", ""),
+            (ExportKind::Trajectory, "Export trajectory (CSV)…", ""),
+        ] {
+            let b = egui::Button::new(label).shortcut_text(keys);
+            if ui
+                .add_enabled(plan, b)
+                .on_disabled_hover_text("Run a solver first")
+                .clicked()
+            {
+                self.request_export(kind, &ctx);
+            }
+        }
+        ui.separator();
+        if ui
+            .add(egui::Button::new("Quit").shortcut_text("Ctrl+Q"))
+            .clicked()
+        {
+            self.request_quit(&ctx);
+        }
+    }
+
+    /// Undo and redo, named for what they undo and redo.
+    fn edit_menu(&mut self, ui: &mut egui::Ui) {
+        let u = self
+            .session
+            .history()
+            .undo_label()
+            .map(|w| format!("Undo {w}"));
+        if ui
+            .add_enabled(
+                u.is_some(),
+                egui::Button::new(u.unwrap_or("Undo".into())).shortcut_text("Ctrl+Z"),
+            )
+            .clicked()
+        {
+            self.undo();
+        }
+        let r = self
+            .session
+            .history()
+            .redo_label()
+            .map(|w| format!("Redo {w}"));
+        if ui
+            .add_enabled(
+                r.is_some(),
+                egui::Button::new(r.unwrap_or("Redo".into())).shortcut_text("Ctrl+Shift+Z"),
+            )
+            .clicked()
+        {
+            self.redo();
+        }
+    }
+
+    /// The canvas layers and fitting the view.
+    fn view_menu(&mut self, ui: &mut egui::Ui) {
+        self.layer_toggles(ui);
+        if ui
+            .add(egui::Button::new("Fit to view").shortcut_text("F"))
+            .clicked()
+        {
+            self.panels.workbench.fit_requested = true;
+            self.panels.compare.canvas.fit_requested = true;
+        }
     }
 
     fn layer_toggles(&mut self, ui: &mut egui::Ui) {
@@ -227,57 +236,7 @@ impl App {
                 self.redo();
             }
             ui.separator();
-            ui.selectable_value(&mut self.view.add_tool, false, "Select")
-                .on_hover_text(
-                    "Click a field to select it, drag it to move it; drag empty space to pan",
-                );
-            ui.selectable_value(&mut self.view.add_tool, true, "Add field")
-                .on_hover_text(
-                    "Click to add a field (double-click also adds one with the select tool)",
-                );
-            let sel = self
-                .view
-                .selected
-                .and_then(|id| self.session.doc().fields.iter().find(|f| f.id == id))
-                .map(|f| (f.id, f.locked));
-            if ui
-                .add_enabled(sel.is_some(), egui::Button::new("Delete field"))
-                .on_hover_text("Delete key")
-                .clicked()
-            {
-                if let Some((id, _)) = sel {
-                    let _ = self.execute(Command::DeleteField { id });
-                }
-            }
-            let lock_label = if sel.is_some_and(|s| s.1) {
-                "Unlock"
-            } else {
-                "Lock"
-            };
-            if ui
-                .add_enabled(sel.is_some(), egui::Button::new(lock_label))
-                .on_hover_text("Locked fields do not move and survive automatic re-placement")
-                .clicked()
-            {
-                if let Some((id, locked)) = sel {
-                    let _ = self.execute(Command::SetLocked {
-                        id,
-                        locked: !locked,
-                    });
-                }
-            }
-            if ui
-                .add_enabled(
-                    self.has_document() && self.runtime.job.is_none(),
-                    egui::Button::new("Re-place automatically"),
-                )
-                .on_hover_text(
-                    "Replace the unlocked fields by the automatic placement; locked fields stay",
-                )
-                .clicked()
-            {
-                self.replace_fields(&ctx);
-            }
+            self.field_tools(ui);
             ui.separator();
             let blocker = self.solve_blocker();
             for (algo, label) in SOLVERS {
@@ -296,6 +255,62 @@ impl App {
             ui.selectable_value(&mut self.view.tab, Tab::Workbench, "Workbench");
             ui.selectable_value(&mut self.view.tab, Tab::Compare, "Compare");
         });
+    }
+
+    /// Select and add tools, and what the selected field can have done to it.
+    fn field_tools(&mut self, ui: &mut egui::Ui) {
+        let ctx = ui.ctx().clone();
+        ui.selectable_value(&mut self.view.add_tool, false, "Select")
+            .on_hover_text(
+                "Click a field to select it, drag it to move it; drag empty space to pan",
+            );
+        ui.selectable_value(&mut self.view.add_tool, true, "Add field")
+            .on_hover_text(
+                "Click to add a field (double-click also adds one with the select tool)",
+            );
+        let sel = self
+            .view
+            .selected
+            .and_then(|id| self.session.doc().fields.iter().find(|f| f.id == id))
+            .map(|f| (f.id, f.locked));
+        if ui
+            .add_enabled(sel.is_some(), egui::Button::new("Delete field"))
+            .on_hover_text("Delete key")
+            .clicked()
+        {
+            if let Some((id, _)) = sel {
+                let _ = self.execute(Command::DeleteField { id });
+            }
+        }
+        let lock_label = if sel.is_some_and(|s| s.1) {
+            "Unlock"
+        } else {
+            "Lock"
+        };
+        if ui
+            .add_enabled(sel.is_some(), egui::Button::new(lock_label))
+            .on_hover_text("Locked fields do not move and survive automatic re-placement")
+            .clicked()
+        {
+            if let Some((id, locked)) = sel {
+                let _ = self.execute(Command::SetLocked {
+                    id,
+                    locked: !locked,
+                });
+            }
+        }
+        if ui
+            .add_enabled(
+                self.has_document() && self.runtime.job.is_none(),
+                egui::Button::new("Re-place automatically"),
+            )
+            .on_hover_text(
+                "Replace the unlocked fields by the automatic placement; locked fields stay",
+            )
+            .clicked()
+        {
+            self.replace_fields(&ctx);
+        }
     }
 
     fn status_bar(&mut self, ui: &mut egui::Ui) {
@@ -447,72 +462,7 @@ impl App {
             }
         }
         if self.has_document() {
-            let closed = self.session.closed();
-            ui.label(format!(
-                "{} ({closed} closed, {} open), {}",
-                super::words::count(
-                    self.session.doc().geometries.len(),
-                    "geometry",
-                    "geometries"
-                ),
-                self.session.doc().geometries.len() - closed,
-                super::words::fields_count(&self.session.doc().fields, &self.session.doc().profile)
-            ));
-            let far = self.session.out_of_reach().len();
-            let near = self.session.uncovered().len() - far;
-            // larger than a field (cut them, or mark on the fly) or beyond the reach (move the
-            // artwork): each told what helps it
-            let [fw, fh] = self.session.doc().profile.field_mm;
-            let large = self
-                .session
-                .out_of_reach()
-                .iter()
-                .filter(|&&g| {
-                    let b = self.session.doc().geometries[g].bbox();
-                    b.width() > fw || b.height() > fh
-                })
-                .count();
-            let beyond = far - large;
-            let advice = [
-                (
-                    large,
-                    "larger than a scan field: tick \"Split oversize geometries\" in Solver \
-                     settings and press \"Re-place automatically\", or choose \"On the fly\" as \
-                     the motion.",
-                ),
-                (
-                    beyond,
-                    "beyond the stage's stroke plus half a field: choose \"Placement: \
-                     centred\" in the Layers panel to move the artwork within reach.",
-                ),
-            ];
-            for (n, what) in advice.into_iter().filter(|(n, _)| *n > 0) {
-                ui.add(
-                    egui::Label::new(
-                        RichText::new(format!(
-                            "{} (dashed purple) cannot be held by any scan field, {} {what}",
-                            super::words::count(n, "geometry", "geometries"),
-                            if n == 1 { "it is" } else { "they are" },
-                        ))
-                        .color(colour::OUT_OF_REACH),
-                    )
-                    .wrap(),
-                );
-            }
-            if near > 0 {
-                ui.add(
-                    egui::Label::new(
-                        RichText::new(format!(
-                            "{} (magenta halo on the canvas) {} not covered by a scan field \
-                     yet: add a field (Add field) or press \"Re-place automatically\".",
-                            super::words::count(near, "geometry", "geometries"),
-                            if near == 1 { "is" } else { "are" }
-                        ))
-                        .color(colour::UNCOVERED),
-                    )
-                    .wrap(),
-                );
-            }
+            self.coverage_ui(ui);
         }
         if let Some(p) = self.session.problem() {
             ui.add(egui::Label::new(RichText::new(p).color(ERROR)).wrap());
@@ -532,6 +482,81 @@ impl App {
             compare::metrics_table(ui, "active-metrics", plan, None);
         }
         ui.separator();
+        self.warnings_and_recent_ui(ui);
+    }
+
+    /// What the document holds and what no field holds yet, each with what helps it.
+    fn coverage_ui(&mut self, ui: &mut egui::Ui) {
+        let closed = self.session.closed();
+        ui.label(format!(
+            "{} ({closed} closed, {} open), {}",
+            super::words::count(
+                self.session.doc().geometries.len(),
+                "geometry",
+                "geometries"
+            ),
+            self.session.doc().geometries.len() - closed,
+            super::words::fields_count(&self.session.doc().fields, &self.session.doc().profile)
+        ));
+        let far = self.session.out_of_reach().len();
+        let near = self.session.uncovered().len() - far;
+        // larger than a field (cut them, or mark on the fly) or beyond the reach (move the
+        // artwork): each told what helps it
+        let [fw, fh] = self.session.doc().profile.field_mm;
+        let large = self
+            .session
+            .out_of_reach()
+            .iter()
+            .filter(|&&g| {
+                let b = self.session.doc().geometries[g].bbox();
+                b.width() > fw || b.height() > fh
+            })
+            .count();
+        let beyond = far - large;
+        let advice = [
+            (
+                large,
+                "larger than a scan field: tick \"Split oversize geometries\" in Solver \
+                 settings and press \"Re-place automatically\", or choose \"On the fly\" as \
+                 the motion.",
+            ),
+            (
+                beyond,
+                "beyond the stage's stroke plus half a field: choose \"Placement: \
+                 centred\" in the Layers panel to move the artwork within reach.",
+            ),
+        ];
+        for (n, what) in advice.into_iter().filter(|(n, _)| *n > 0) {
+            ui.add(
+                egui::Label::new(
+                    RichText::new(format!(
+                        "{} (dashed purple) cannot be held by any scan field, {} {what}",
+                        super::words::count(n, "geometry", "geometries"),
+                        if n == 1 { "it is" } else { "they are" },
+                    ))
+                    .color(colour::OUT_OF_REACH),
+                )
+                .wrap(),
+            );
+        }
+        if near > 0 {
+            ui.add(
+                egui::Label::new(
+                    RichText::new(format!(
+                        "{} (magenta halo on the canvas) {} not covered by a scan field \
+                 yet: add a field (Add field) or press \"Re-place automatically\".",
+                        super::words::count(near, "geometry", "geometries"),
+                        if near == 1 { "is" } else { "are" }
+                    ))
+                    .color(colour::UNCOVERED),
+                )
+                .wrap(),
+            );
+        }
+    }
+
+    /// The document's warnings (open on each import that has some) and the recent files.
+    fn warnings_and_recent_ui(&mut self, ui: &mut egui::Ui) {
         let n = self.session.doc().warnings.len();
         let title = if n > 0 {
             // import, cut and whole-or-cut warnings alike: what the drawing and the placement say
@@ -674,10 +699,6 @@ impl App {
             });
             return;
         }
-        let plan = self
-            .session
-            .active()
-            .and_then(|k| self.session.doc().plans.get(k));
         let lowered = self
             .session
             .active()
@@ -690,48 +711,14 @@ impl App {
         let playback_t_s = lowered
             .and_then(Result::ok)
             .and_then(|_| self.panels.playback.shown_t_s());
-        let canvas = Canvas {
-            label: "Work area",
-            geometries: &self.session.doc().geometries,
-            profile: &self.session.doc().profile,
-            fields: &self.session.doc().fields,
-            seams: &self.session.doc().seams.lines,
-            tiling: self.session.doc().tiling.as_ref(),
-            cell_max_mm: crate::fields::cell_max_mm(
-                &self.session.doc().layers,
-                self.session.doc().profile.field_mm,
-            ),
-            visiting: plan.map(|p| p.fields.as_slice()),
-            // layer colours when the layers tell something apart (several, or a hatch)
-            colours: (self.session.doc().layers.len() > 1
-                || self
-                    .session
-                    .doc()
-                    .layers
-                    .iter()
-                    .any(|l| l.pen.hatch.is_some()))
-            .then_some(self.session.colours()),
-            out_of_reach: self.session.out_of_reach(),
-            paths: plan
-                .zip(lowered)
-                .map(|(p, lowered)| PathLayer {
-                    plan: p,
-                    lowered,
-                    colour: colour::PATH_A,
-                })
-                .into_iter()
-                .collect(),
-            uncovered: self.session.uncovered(),
-            selected: self.view.selected,
-            editable: true,
-            add_tool: self.view.add_tool,
-            layers: self.prefs.layers,
-            stale: &stale,
+        let canvas = workbench_canvas(
+            &self.session,
+            (self.view.selected, self.view.add_tool),
+            self.prefs.layers,
+            &stale,
             playback_t_s,
-            parts: self.session.part_boxes(),
-            codes: self.session.code_boxes(),
-            revision: self.canvas_revision(),
-        };
+            self.canvas_revision(),
+        );
         let motion = lowered.and_then(Result::ok).and_then(|l| l.motion.as_ref());
         let header_px = 2.0 * ui.spacing().interact_size.y;
         let plots_px = motion_plots::PLOTS_HEIGHT_PX.min(ui.available_height() * 0.4);
@@ -782,5 +769,53 @@ fn motion_plots_header(ui: &mut egui::Ui, open: &mut bool) {
         .clicked()
     {
         *open = !shown;
+    }
+}
+
+/// The workbench's canvas over `session`'s document and the plan shown: the field `selected`
+/// and the add tool (`tools`), the canvas `layers`, the plan's staleness and the playback time.
+fn workbench_canvas<'a>(
+    session: &'a super::session::Session,
+    (selected, add_tool): (Option<usize>, bool),
+    layers: super::scene::Layers,
+    stale: &'a [String],
+    playback_t_s: Option<f64>,
+    revision: u64,
+) -> Canvas<'a> {
+    let doc = session.doc();
+    let plan = session.active().and_then(|k| doc.plans.get(k));
+    let lowered = session.active().and_then(|k| session.toolpaths().get(k));
+    Canvas {
+        label: "Work area",
+        geometries: &doc.geometries,
+        profile: &doc.profile,
+        fields: &doc.fields,
+        seams: &doc.seams.lines,
+        tiling: doc.tiling.as_ref(),
+        cell_max_mm: crate::fields::cell_max_mm(&doc.layers, doc.profile.field_mm),
+        visiting: plan.map(|p| p.fields.as_slice()),
+        // layer colours when the layers tell something apart (several, or a hatch)
+        colours: (doc.layers.len() > 1 || doc.layers.iter().any(|l| l.pen.hatch.is_some()))
+            .then_some(session.colours()),
+        out_of_reach: session.out_of_reach(),
+        paths: plan
+            .zip(lowered)
+            .map(|(p, lowered)| PathLayer {
+                plan: p,
+                lowered,
+                colour: colour::PATH_A,
+            })
+            .into_iter()
+            .collect(),
+        uncovered: session.uncovered(),
+        selected,
+        editable: true,
+        add_tool,
+        layers,
+        stale,
+        playback_t_s,
+        parts: session.part_boxes(),
+        codes: session.code_boxes(),
+        revision,
     }
 }

@@ -13,6 +13,8 @@
 //! (edits and undo), [`motion_plots`] (the on-the-fly stage route and motion plots), [`files`]
 //! (open/save/export/recent), `layout` (menus, toolbar, side panels, status bar).
 
+#![deny(clippy::too_many_lines)]
+
 pub mod canvas;
 pub mod commands;
 pub mod compare;
@@ -912,59 +914,8 @@ impl App {
                 let what = kind.filter().0;
                 self.set_status(format!("wrote the {what} to {}", path.display()), false);
             }
-            JobOutcome::Done(JobResult::Plan { mut plan, lowered }) => {
-                // an automatic motion is named for the motion the solve chose
-                let name = if plan.settings.motion == MotionMode::Auto {
-                    self.unique_plan_name(plan.name.clone())
-                } else {
-                    name
-                };
-                plan.name = if cancelled {
-                    format!("{name} (stopped)")
-                } else {
-                    name
-                };
-                let lowered = lowered.renamed(&plan.name);
-                let m = &plan.metrics;
-                let job = m.job_time_s.map_or("job time unknown".to_string(), |t| {
-                    format!("job time {t:.2} s")
-                });
-                let stage = match (plan.motion, m.motion) {
-                    (Motion::OnTheFly, Some(f)) => format!(
-                        "{}, stage route {:.1} mm",
-                        plan.motion_words(),
-                        f.stage_route_mm
-                    ),
-                    _ => format!("stage travel {:.1} mm, {} scan fields", m.base_mm, m.fields),
-                };
-                let msg = format!(
-                    "{}: {job}, idle travel {:.1} mm, {stage} (solved in {:.2} s)",
-                    plan.name,
-                    m.idle_mm,
-                    elapsed.as_secs_f64()
-                );
-                let k = self.session.add_plan(*plan, lowered);
-                // a new plan is shown from its start
-                self.panels.playback.t_s = 0.0;
-                self.panels.playback.playing = false;
-                self.panels.compare.push(k, &self.session.doc().plans);
-                match self.session.toolpaths().get(k) {
-                    Some(Err(why)) => {
-                        let msg = format!("{msg}; {why}");
-                        self.set_status(msg, true);
-                    }
-                    _ => self.set_status(msg.clone(), false),
-                }
-                if let Some((kind, path)) = self.runtime.export_after_solve.take() {
-                    if cancelled {
-                        self.set_status(
-                            format!("{msg}; stopped, so {} was not written", path.display()),
-                            true,
-                        );
-                    } else {
-                        self.export_in_background(kind, &path, ui_ctx);
-                    }
-                }
+            JobOutcome::Done(JobResult::Plan { plan, lowered }) => {
+                self.solved(*plan, *lowered, (name, cancelled, elapsed), ui_ctx)
             }
             JobOutcome::Failed(e) if cancelled => {
                 self.runtime.export_after_solve = None;
@@ -973,6 +924,69 @@ impl App {
             JobOutcome::Failed(e) => {
                 self.runtime.export_after_solve = None;
                 self.set_status(format!("{name} failed: {e}"), true)
+            }
+        }
+    }
+
+    /// Takes a solve's plan into the session and shows it: named (`stopped` when `cancelled`),
+    /// said in the status line, and exported when a re-solve and export waits for it.
+    fn solved(
+        &mut self,
+        mut plan: Plan,
+        lowered: toolpaths::Prelowered,
+        (name, cancelled, elapsed): (String, bool, Duration),
+        ui_ctx: &egui::Context,
+    ) {
+        // an automatic motion is named for the motion the solve chose
+        let name = if plan.settings.motion == MotionMode::Auto {
+            self.unique_plan_name(plan.name.clone())
+        } else {
+            name
+        };
+        plan.name = if cancelled {
+            format!("{name} (stopped)")
+        } else {
+            name
+        };
+        let lowered = lowered.renamed(&plan.name);
+        let m = &plan.metrics;
+        let job = m.job_time_s.map_or("job time unknown".to_string(), |t| {
+            format!("job time {t:.2} s")
+        });
+        let stage = match (plan.motion, m.motion) {
+            (Motion::OnTheFly, Some(f)) => format!(
+                "{}, stage route {:.1} mm",
+                plan.motion_words(),
+                f.stage_route_mm
+            ),
+            _ => format!("stage travel {:.1} mm, {} scan fields", m.base_mm, m.fields),
+        };
+        let msg = format!(
+            "{}: {job}, idle travel {:.1} mm, {stage} (solved in {:.2} s)",
+            plan.name,
+            m.idle_mm,
+            elapsed.as_secs_f64()
+        );
+        let k = self.session.add_plan(plan, lowered);
+        // a new plan is shown from its start
+        self.panels.playback.t_s = 0.0;
+        self.panels.playback.playing = false;
+        self.panels.compare.push(k, &self.session.doc().plans);
+        match self.session.toolpaths().get(k) {
+            Some(Err(why)) => {
+                let msg = format!("{msg}; {why}");
+                self.set_status(msg, true);
+            }
+            _ => self.set_status(msg.clone(), false),
+        }
+        if let Some((kind, path)) = self.runtime.export_after_solve.take() {
+            if cancelled {
+                self.set_status(
+                    format!("{msg}; stopped, so {} was not written", path.display()),
+                    true,
+                );
+            } else {
+                self.export_in_background(kind, &path, ui_ctx);
             }
         }
     }

@@ -243,136 +243,147 @@ impl App {
 
     /// Draws the prompt, if any, as a modal window.
     pub(super) fn prompt_ui(&mut self, ui: &mut egui::Ui) {
-        let Some(prompt) = self.panels.prompt.take() else {
+        let Some(mut shown) = self.panels.prompt.take() else {
             return;
         };
         let ctx = ui.ctx().clone();
-        let mut keep = true;
-        let mut next: Option<Continuation> = None;
-        let mut shown = prompt.clone();
-        egui::Modal::new(egui::Id::unique("galvoplan-prompt")).show(&ctx, |ui| {
+        // what a stale export is asked with
+        let why: Vec<String> = self
+            .session
+            .active()
+            .map_or(&[][..], |k| self.plan_staleness(k))
+            .to_vec();
+        let name = self
+            .active_plan()
+            .map_or_else(|| "this plan".to_string(), |p| p.name.clone());
+        let modal = egui::Modal::new(egui::Id::unique("galvoplan-prompt")).show(&ctx, |ui| {
             ui.set_max_width(460.0);
-            match &mut shown {
-                Prompt::Path { action, text, note } => {
-                    let (title, button, _, _) = action.words();
-                    ui.heading(title);
-                    ui.add(egui::Label::new(note.as_str()).wrap());
-                    let l = ui.label("File path");
-                    let r = ui
-                        .add(
-                            egui::TextEdit::singleline(text)
-                                .desired_width(440.0)
-                                .hint_text("/path/to/file"),
-                        )
-                        .labelled_by(l.id);
-                    let enter = r.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
-                    ui.horizontal(|ui| {
-                        let go = ui.button(button).clicked() || enter;
-                        if go && !text.trim().is_empty() {
-                            let (a, p) = (*action, PathBuf::from(text.trim()));
-                            next = Some(Box::new(move |app: &mut App, ctx: &egui::Context| {
-                                app.perform(a, p, ctx)
-                            }));
-                            keep = false;
-                        }
-                        if ui.button("Cancel").clicked() {
-                            keep = false;
-                        }
-                    });
-                }
-                Prompt::Unsaved(then) => {
-                    ui.heading("Unsaved changes");
-                    ui.add(
-                        egui::Label::new(
-                            "The document has changes that are not saved in a project file \
-                             (scan fields, layers, plans). They are lost unless you save them.",
-                        )
-                        .wrap(),
-                    );
-                    ui.horizontal(|ui| {
-                        if ui.button("Save project").clicked() {
-                            keep = false;
-                            let then = then.clone();
-                            next = Some(Box::new(move |app: &mut App, ctx: &egui::Context| {
-                                app.request_save(false, ctx);
-                                if !app.has_unsaved_changes() {
-                                    app.then(then, ctx);
-                                }
-                            }));
-                        }
-                        if ui.button("Discard changes").clicked() {
-                            keep = false;
-                            let then = then.clone();
-                            next = Some(Box::new(move |app: &mut App, ctx: &egui::Context| {
-                                app.then(then, ctx)
-                            }));
-                        }
-                        if ui.button("Cancel").clicked() {
-                            keep = false;
-                        }
-                    });
-                }
-                Prompt::StaleExport(kind) => {
-                    ui.heading("The plan shown is stale");
-                    let why = self
-                        .session
-                        .active()
-                        .map_or(&[][..], |k| self.plan_staleness(k));
-                    let name = self
-                        .active_plan()
-                        .map_or_else(|| "this plan".to_string(), |p| p.name.clone());
-                    ui.add(
-                        egui::Label::new(format!(
-                            "The document changed since {name} was made. Exported as planned, \
-                             the file is {name} with the settings it was made with, not the \
-                             ones shown now:"
-                        ))
-                        .wrap(),
-                    );
-                    for w in why.iter().take(6) {
-                        ui.label(format!("• {w}"));
-                    }
-                    if why.len() > 6 {
-                        ui.label(format!("… and {} more", why.len() - 6));
-                    }
-                    ui.horizontal(|ui| {
-                        let resolve = ui
-                            .button("Re-solve and export")
-                            .on_hover_text("solve again with the current settings, then export");
-                        if resolve.clicked() {
-                            keep = false;
-                            let a = PathAction::ResolveExport(*kind);
-                            next = Some(Box::new(move |app: &mut App, ctx: &egui::Context| {
-                                app.choose_path(a, ctx)
-                            }));
-                        }
-                        if ui.button("Export as planned").clicked() {
-                            keep = false;
-                            let a = PathAction::Export(*kind);
-                            next = Some(Box::new(move |app: &mut App, ctx: &egui::Context| {
-                                app.choose_path(a, ctx)
-                            }));
-                        }
-                        if ui.button("Cancel").clicked() {
-                            keep = false;
-                        }
-                        // the safe answer is the default: Enter re-solves
-                        if ui.memory(|m| m.focused().is_none()) {
-                            resolve.request_focus();
-                        }
-                    });
-                }
-            }
+            let answer = match &mut shown {
+                Prompt::Path { action, text, note } => path_prompt(ui, *action, text, note),
+                Prompt::Unsaved(then) => unsaved_prompt(ui, then),
+                Prompt::StaleExport(kind) => stale_prompt(ui, *kind, &name, &why),
+            };
             ui.label(RichText::new("Esc closes this window.").small().weak());
+            answer
         });
-        if ui.input(|i| i.key_pressed(egui::Key::Escape)) {
-            keep = false;
-        }
-        if keep {
-            self.panels.prompt = Some(shown);
-        }
-        if let Some(f) = next {
-            f(self, &ctx);
+        let escaped = ui.input(|i| i.key_pressed(egui::Key::Escape));
+        match modal.inner {
+            None if !escaped => self.panels.prompt = Some(shown),
+            Some(Answer::Then(f)) => f(self, &ctx),
+            _ => {}
         }
     }
+}
+
+/// What the operator answered a prompt: close it, or close it and go on.
+enum Answer {
+    Close,
+    Then(Continuation),
+}
+
+/// The path field for `action` (no file dialog); an answer once the path is given or the
+/// operator cancels.
+fn path_prompt(
+    ui: &mut egui::Ui,
+    action: PathAction,
+    text: &mut String,
+    note: &str,
+) -> Option<Answer> {
+    let (title, button, _, _) = action.words();
+    ui.heading(title);
+    ui.add(egui::Label::new(note).wrap());
+    let l = ui.label("File path");
+    let r = ui
+        .add(
+            egui::TextEdit::singleline(text)
+                .desired_width(440.0)
+                .hint_text("/path/to/file"),
+        )
+        .labelled_by(l.id);
+    let enter = r.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
+    ui.horizontal(|ui| {
+        let go = ui.button(button).clicked() || enter;
+        if go && !text.trim().is_empty() {
+            let p = PathBuf::from(text.trim());
+            return Some(Answer::Then(Box::new(
+                move |app: &mut App, ctx: &egui::Context| app.perform(action, p, ctx),
+            )));
+        }
+        ui.button("Cancel").clicked().then_some(Answer::Close)
+    })
+    .inner
+}
+
+/// The unsaved-changes question before `then`.
+fn unsaved_prompt(ui: &mut egui::Ui, then: &Then) -> Option<Answer> {
+    ui.heading("Unsaved changes");
+    ui.add(
+        egui::Label::new(
+            "The document has changes that are not saved in a project file \
+             (scan fields, layers, plans). They are lost unless you save them.",
+        )
+        .wrap(),
+    );
+    ui.horizontal(|ui| {
+        if ui.button("Save project").clicked() {
+            let then = then.clone();
+            return Some(Answer::Then(Box::new(
+                move |app: &mut App, ctx: &egui::Context| {
+                    app.request_save(false, ctx);
+                    if !app.has_unsaved_changes() {
+                        app.then(then, ctx);
+                    }
+                },
+            )));
+        }
+        if ui.button("Discard changes").clicked() {
+            let then = then.clone();
+            return Some(Answer::Then(Box::new(
+                move |app: &mut App, ctx: &egui::Context| app.then(then, ctx),
+            )));
+        }
+        ui.button("Cancel").clicked().then_some(Answer::Close)
+    })
+    .inner
+}
+
+/// The question before exporting plan `name`, stale for the reasons `why`.
+fn stale_prompt(ui: &mut egui::Ui, kind: ExportKind, name: &str, why: &[String]) -> Option<Answer> {
+    ui.heading("The plan shown is stale");
+    ui.add(
+        egui::Label::new(format!(
+            "The document changed since {name} was made. Exported as planned, \
+             the file is {name} with the settings it was made with, not the \
+             ones shown now:"
+        ))
+        .wrap(),
+    );
+    for w in why.iter().take(6) {
+        ui.label(format!("• {w}"));
+    }
+    if why.len() > 6 {
+        ui.label(format!("… and {} more", why.len() - 6));
+    }
+    let choose = |a: PathAction| {
+        Some(Answer::Then(Box::new(
+            move |app: &mut App, ctx: &egui::Context| app.choose_path(a, ctx),
+        )))
+    };
+    ui.horizontal(|ui| {
+        let resolve = ui
+            .button("Re-solve and export")
+            .on_hover_text("solve again with the current settings, then export");
+        // the safe answer is the default: Enter re-solves
+        if ui.memory(|m| m.focused().is_none()) {
+            resolve.request_focus();
+        }
+        if resolve.clicked() {
+            return choose(PathAction::ResolveExport(kind));
+        }
+        if ui.button("Export as planned").clicked() {
+            return choose(PathAction::Export(kind));
+        }
+        ui.button("Cancel").clicked().then_some(Answer::Close)
+    })
+    .inner
 }

@@ -204,29 +204,9 @@ impl TrayPanel {
         ui.label(RichText::new("Codes on every part").strong());
         let mut remove = None;
         for (k, row) in self.codes.iter_mut().enumerate() {
-            ui.push_id(("code", k), |ui| {
-                combo(ui, "Code kind", &mut row.kind, CODE_KINDS);
-                let text = |ui: &mut egui::Ui, label: &str, value: &mut String, hint: &str| {
-                    ui.horizontal(|ui| {
-                        let l = ui.label(label);
-                        ui.add(
-                            egui::TextEdit::singleline(value)
-                                .hint_text(hint)
-                                .desired_width(150.0),
-                        )
-                        .labelled_by(l.id);
-                    });
-                };
-                text(ui, "Code content", &mut row.content, "GP{serial:05}");
-                text(ui, "Code X (mm)", &mut row.x, "from the part's left");
-                text(ui, "Code Y (mm)", &mut row.y, "from the part's top");
-                text(ui, "Code size (mm)", &mut row.size, "width");
-                text(ui, "Code options", &mut row.options, "e.g. inverted");
-                ui.weak("drag the code on the canvas to move it on every part");
-                if ui.button("Remove this code").clicked() {
-                    remove = Some(k);
-                }
-            });
+            if ui.push_id(("code", k), |ui| code_row_ui(ui, row)).inner {
+                remove = Some(k);
+            }
             ui.separator();
         }
         if let Some(k) = remove {
@@ -462,4 +442,27 @@ pub fn code_boxes(doc: &Document) -> Vec<CodeBox> {
             })
         })
         .collect()
+}
+
+/// One code's kind, content, place, size and options; true when *Remove this code* is pressed.
+fn code_row_ui(ui: &mut egui::Ui, row: &mut CodeRow) -> bool {
+    combo(ui, "Code kind", &mut row.kind, CODE_KINDS);
+    let text = |ui: &mut egui::Ui, label: &str, value: &mut String, hint: &str| {
+        ui.horizontal(|ui| {
+            let l = ui.label(label);
+            ui.add(
+                egui::TextEdit::singleline(value)
+                    .hint_text(hint)
+                    .desired_width(150.0),
+            )
+            .labelled_by(l.id);
+        });
+    };
+    text(ui, "Code content", &mut row.content, "GP{serial:05}");
+    text(ui, "Code X (mm)", &mut row.x, "from the part's left");
+    text(ui, "Code Y (mm)", &mut row.y, "from the part's top");
+    text(ui, "Code size (mm)", &mut row.size, "width");
+    text(ui, "Code options", &mut row.options, "e.g. inverted");
+    ui.weak("drag the code on the canvas to move it on every part");
+    ui.button("Remove this code").clicked()
 }
