@@ -777,6 +777,7 @@ fn choice_warning(message: String) -> Warning {
         element: String::new(),
         line: None,
         message,
+        note: false,
     }
 }
 

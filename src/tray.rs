@@ -238,6 +238,7 @@ fn quiet_zone_warnings(job: &Job, first: &Made) -> Vec<crate::document::Warning>
                      move one of them, or the code may not scan",
                     lo.x, lo.y, hi.x, hi.y, g.source.element
                 ),
+                note: false,
             });
         }
     }

@@ -430,6 +430,63 @@ fn plan_takes_dxf_and_text_labels() {
     }
 }
 
+/// A drawing whose 30 TEXT entities ask for a font that is not installed: one warning line
+/// with the count and five of them, not 30 lines. Common CAD fonts (Arial, Times, Courier) are
+/// drawn with their closest face without a warning, and the report still records each
+/// substitution.
+#[test]
+fn the_same_font_warning_for_many_texts_is_one_line_and_cad_fonts_map_silently() {
+    let dir = tempfile::tempdir().unwrap();
+    let gcode = dir.path().join("job.gcode").display().to_string();
+    let report = dir.path().join("job.json").display().to_string();
+    let path = |f: &str| common::root().join(f).display().to_string();
+    let warnings = |out: &std::process::Output| -> Vec<String> {
+        String::from_utf8_lossy(&out.stderr)
+            .lines()
+            .filter(|l| l.contains("warning"))
+            .map(str::to_string)
+            .collect()
+    };
+    let out = galvoplan(&[
+        "plan",
+        &path("tests/data/dxf/fonts-30-texts.dxf"),
+        "-o",
+        &gcode,
+    ]);
+    assert!(out.status.success());
+    let lines = warnings(&out);
+    assert_eq!(lines.len(), 1, "{lines:#?}");
+    assert!(
+        lines[0].contains("font family 'isocpeur' not found")
+            && lines[0].contains("(30 elements: ")
+            && lines[0].contains("… and 25 more"),
+        "{}",
+        lines[0]
+    );
+    let out = galvoplan(&[
+        "plan",
+        &path("tests/data/dxf/fonts-cad.dxf"),
+        "-o",
+        &gcode,
+        "--report",
+        &report,
+    ]);
+    assert!(out.status.success());
+    assert!(warnings(&out).is_empty(), "{:#?}", warnings(&out));
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    let recorded: Vec<&str> = r["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|w| w.as_str())
+        .filter(|w| w.contains("is not installed; drawn with its closest"))
+        .collect();
+    assert_eq!(recorded.len(), 12, "{recorded:#?}");
+    assert!(recorded.iter().any(|w| w.contains("'times'")));
+    assert!(recorded.iter().any(|w| w.contains("'cour'")));
+}
+
 #[test]
 fn tsp_orders_a_generated_set_and_measures_it_against_the_held_karp_bound() {
     let dir = tempfile::tempdir().unwrap();

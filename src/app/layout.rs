@@ -557,7 +557,9 @@ impl App {
 
     /// The document's warnings (open on each import that has some) and the recent files.
     fn warnings_and_recent_ui(&mut self, ui: &mut egui::Ui) {
-        let n = self.session.doc().warnings.len();
+        // the same message for many elements is one line with its count and a few of them
+        let lines = crate::document::grouped(&self.session.doc().warnings);
+        let n = lines.len();
         let title = if n > 0 {
             // import, cut and whole-or-cut warnings alike: what the drawing and the placement say
             RichText::new(format!("Warnings ({n})"))
@@ -574,12 +576,10 @@ impl App {
                 if n == 0 {
                     ui.label("none");
                 }
-                for w in &self.session.doc().warnings {
+                for w in lines {
                     ui.add(
-                        egui::Label::new(
-                            RichText::new(w.to_string()).color(Color32::from_rgb(180, 83, 9)),
-                        )
-                        .wrap(),
+                        egui::Label::new(RichText::new(w).color(Color32::from_rgb(180, 83, 9)))
+                            .wrap(),
                     );
                 }
             });

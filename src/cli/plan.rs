@@ -44,7 +44,7 @@ pub fn run(a: &PlanArgs) -> Result<()> {
     import_progress(1);
     let loaded = loaded?;
     let (mut doc, import_s) = (loaded.doc, loaded.import_s);
-    for w in &doc.warnings {
+    for w in galvoplan::document::grouped(&doc.warnings) {
         eprintln!("galvoplan: warning: {}: {w}", a.input.display());
     }
     let hidden = loaded.skipped_layers.len();
@@ -84,7 +84,9 @@ pub fn run(a: &PlanArgs) -> Result<()> {
     let imported_warnings = doc.warnings.len();
     let result = plan_document_lowered(&mut doc, &ctx);
     progress.finish();
-    for w in doc.warnings.iter().skip(imported_warnings) {
+    for w in
+        galvoplan::document::grouped(&doc.warnings[imported_warnings.min(doc.warnings.len())..])
+    {
         eprintln!("galvoplan: warning: {}: {w}", a.input.display());
     }
     let (mut plan, toolpath) = result?;

@@ -54,7 +54,7 @@ pub use settings::{
 use crate::geom::seam::{SeamForm, SeamStats};
 use crate::geom::tiling::Tiling;
 use serde::{Deserialize, Serialize};
-pub use warning::{short_list, Warning, LIST_MAX};
+pub use warning::{grouped, short_list, Warning, LIST_MAX};
 
 /// The parts of the layer table and profile that decide the marked geometries: per layer its
 /// name, whether it is enabled, its hatch and seam form; the field size (hatch is cut at the

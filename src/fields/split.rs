@@ -403,6 +403,7 @@ pub fn split_oversize(
                 "geometry {} ({w:.2} × {h:.2} mm) {SPLIT_WORDS} {pieces} strokes at field borders",
                 i + 1
             ),
+            note: false,
         });
     }
     (warnings, cut.stats, Some(tiling))

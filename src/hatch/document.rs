@@ -60,6 +60,7 @@ pub fn hatch_geometries(
                     "nothing left to hatch inside the {} mm edge offset",
                     settings.edge_offset()
                 ),
+                note: false,
             });
         }
         out.hatch_geometries += h.len();

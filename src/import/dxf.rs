@@ -261,6 +261,7 @@ fn units_mm(units: Units, warnings: &mut Vec<Warning>) -> f64 {
             element: "$INSUNITS".into(),
             line: None,
             message: format!("{why}; read as millimetres"),
+            note: false,
         });
         1.0
     })
@@ -417,6 +418,7 @@ impl<'d> Walk<'d> {
                 element: format!("{element} (layer {})", e.layer),
                 line: e.line,
                 message: format!("{} entities are not supported; skipped", e.kind),
+                note: false,
             });
         }
         out
@@ -432,6 +434,7 @@ impl<'d> Walk<'d> {
                 element: format!("layer {name} {why}"),
                 line: None,
                 message: format!("{n} {what} skipped (hidden in the drawing)"),
+                note: false,
             });
             layers.push(SkippedLayer {
                 name: name.clone(),
@@ -455,6 +458,7 @@ impl<'d> Walk<'d> {
                     "{n} {} flagged invisible in the drawing; skipped: {listed}{tail}",
                     if n == 1 { "entity is" } else { "entities are" },
                 ),
+                note: false,
             });
         }
         (out, layers)
@@ -462,10 +466,22 @@ impl<'d> Walk<'d> {
 
     /// Adds a warning once (a block's entity warns once, not once per insert).
     fn warn(&mut self, element: String, layer: &str, message: impl Into<String>) {
+        self.warn_or_note(element, layer, message, false);
+    }
+
+    /// [`Self::warn`], or a note (`note`: recorded, not listed among the warnings).
+    fn warn_or_note(
+        &mut self,
+        element: String,
+        layer: &str,
+        message: impl Into<String>,
+        note: bool,
+    ) {
         let w = Warning {
             element: format!("{element} (layer {layer})"),
             line: None,
             message: message.into(),
+            note,
         };
         if self.warned.insert((w.element.clone(), w.message.clone())) {
             self.warnings.push(w);
@@ -711,7 +727,7 @@ impl<'d> Walk<'d> {
         match dxf_text::outlines(&run, self.opts, tol_local, budget) {
             Ok((outlines, warnings)) => {
                 for w in warnings {
-                    self.warn(element.to_string(), layer, w.message);
+                    self.warn_or_note(element.to_string(), layer, w.message, w.note);
                 }
                 paths.extend(
                     outlines

@@ -65,6 +65,14 @@ pub enum FontMiss {
         /// What was used.
         used: String,
     },
+    /// A common CAD font that is not installed, drawn with its closest face (a note: the
+    /// operator expects it, the report records it).
+    Mapped {
+        /// The requested family list.
+        requested: String,
+        /// The face used.
+        used: String,
+    },
     /// A character is in no font at all: the font's missing-glyph box is drawn.
     Char {
         /// The character.
@@ -76,7 +84,9 @@ impl FontMiss {
     /// The requested family list this miss belongs to (empty for a missing character).
     pub fn requested(&self) -> &str {
         match self {
-            FontMiss::Family { requested } | FontMiss::Face { requested, .. } => requested,
+            FontMiss::Family { requested }
+            | FontMiss::Face { requested, .. }
+            | FontMiss::Mapped { requested, .. } => requested,
             FontMiss::Char { .. } => "",
         }
     }
@@ -91,6 +101,9 @@ impl FontMiss {
                 asked,
                 used,
             } => format!("font '{requested}' has no {asked} face; using {used}"),
+            FontMiss::Mapped { requested, used } => {
+                format!("font '{requested}' is not installed; drawn with its closest, {used}")
+            }
             FontMiss::Char { c } => format!(
                 "character '{c}' (U+{:04X}) is in no available font; its missing-glyph box is outlined",
                 u32::from(*c)
@@ -163,6 +176,58 @@ fn query_for<'a>(font: &usvg::Font, families: &'a [Family<'a>]) -> Query<'a> {
     }
 }
 
+/// Fonts CAD drawings name that are rarely installed on a Linux machine, by the generic family
+/// closest to them (lower case, without a file extension): the Windows core fonts and
+/// AutoCAD's shape fonts (SHX; their single-stroke letters are closest to a sans face).
+const CAD_SANS: &[&str] = &[
+    "arial",
+    "arial narrow",
+    "helvetica",
+    "verdana",
+    "tahoma",
+    "calibri",
+    "segoe ui",
+    "txt",
+    "simplex",
+    "romans",
+    "isocp",
+    "isoct",
+    "monotxt8",
+    "gdt",
+    "osifont",
+];
+const CAD_SERIF: &[&str] = &[
+    "times",
+    "times new roman",
+    "romanc",
+    "romant",
+    "cambria",
+    "georgia",
+];
+const CAD_MONO: &[&str] = &["courier", "courier new", "cour", "monotxt", "consolas"];
+
+/// The generic family closest to the first named family of `families` when that is a common
+/// CAD font (see [`CAD_SANS`]).
+fn cad_alias(families: &[usvg::FontFamily]) -> Option<Family<'static>> {
+    let name = families.iter().find_map(|f| match f {
+        usvg::FontFamily::Named(n) => Some(n.trim().to_ascii_lowercase()),
+        _ => None,
+    })?;
+    let stem = name
+        .strip_suffix(".shx")
+        .or_else(|| name.strip_suffix(".ttf"))
+        .unwrap_or(&name);
+    if CAD_SANS.contains(&stem) {
+        Some(Family::SansSerif)
+    } else if CAD_SERIF.contains(&stem) {
+        Some(Family::Serif)
+    } else if CAD_MONO.contains(&stem) {
+        Some(Family::Monospace)
+    } else {
+        None
+    }
+}
+
 fn select_font(font: &usvg::Font, db: &Database, misses: &Misses) -> Option<fontdb::ID> {
     let families: Vec<Family> = font
         .families()
@@ -193,6 +258,22 @@ fn select_font(font: &usvg::Font, db: &Database, misses: &Misses) -> Option<font
             }
         }
         return Some(id);
+    }
+    if let Some(generic) = cad_alias(font.families()) {
+        // the closest generic family, else the bundled sans (always there)
+        let closest = [generic];
+        let sans = [Family::SansSerif];
+        let found = db
+            .query(&query_for(font, &closest))
+            .or_else(|| db.query(&query_for(font, &sans)));
+        if let Some(id) = found {
+            let used = db
+                .face(id)
+                .and_then(|f| f.families.first().map(|f| f.0.clone()))
+                .unwrap_or_else(|| BUNDLED_FAMILY.to_string());
+            misses.push(FontMiss::Mapped { requested, used });
+            return Some(id);
+        }
     }
     misses.push(FontMiss::Family { requested });
     let bundled = [Family::Name(BUNDLED_FAMILY)];
@@ -228,6 +309,7 @@ pub fn miss_warnings(misses: Vec<FontMiss>, element_of: impl Fn(&str) -> String)
             element: element_of(m.requested()),
             line: None,
             message: m.message(),
+            note: matches!(m, FontMiss::Mapped { .. }),
         })
         .collect()
 }

@@ -138,6 +138,7 @@ pub fn place_artwork(im: &mut Imported, opts: &ImportOptions) -> Result<(), Plac
                 crate::geom::format_mm(dx, n),
                 crate::geom::format_mm(dy, n)
             ),
+            note: false,
         });
     }
     Ok(())

@@ -352,6 +352,7 @@ impl Walker<'_> {
                             "mask #{} is not a plain clip ({why}); the masked content was skipped",
                             m.id()
                         ),
+                        note: false,
                     });
                     return;
                 }
@@ -765,6 +766,7 @@ impl Walker<'_> {
                     element: format!("{element} subpath {sub_index}"),
                     line: None,
                     message: format!("{why}; skipped"),
+                    note: false,
                 }),
             }
         }
@@ -778,6 +780,7 @@ impl Walker<'_> {
                 element: element.clone(),
                 line: *line,
                 message: "visibility:hidden; skipped".into(),
+                note: false,
             }),
             many => {
                 let names: Vec<String> = many
@@ -795,6 +798,7 @@ impl Walker<'_> {
                         many.len(),
                         short_list(&names, "; ")
                     ),
+                    note: false,
                 });
             }
         }

@@ -379,6 +379,7 @@ pub(super) fn scan(xml: &Document, hidden: &HiddenLayers) -> Scan {
                 element: describe(&node),
                 line: Some(line_of(xml, &node)),
                 message,
+                note: false,
             });
         };
         if name == "flowRoot" {
@@ -418,6 +419,7 @@ pub(super) fn scan(xml: &Document, hidden: &HiddenLayers) -> Scan {
                                 "{n} {} skipped (hidden in the drawing)",
                                 if n == 1 { "element" } else { "elements" }
                             ),
+                            note: false,
                         });
                         out.skipped_layers.push(SkippedLayer {
                             name: layer,
