@@ -2006,3 +2006,35 @@ fn code_box_of_part(h: &Harness<'_, App>, part: u32) -> (f64, f64) {
             (x.min(p.x), y.min(p.y))
         })
 }
+
+/// Hovering Run HHA and Run HGA tells in one sentence each how they differ; the settings that
+/// only a GA specialist knew by name say what they do.
+#[test]
+fn the_solvers_and_their_settings_say_what_they_do() {
+    let mut h = opened(&demo());
+    for (button, says) in [
+        ("Run HHA", "Heuristic ordering: fields in a good order"),
+        ("Run HGA", "Genetic algorithm: starts from the HHA plan"),
+    ] {
+        let at = h.get_by_label(button).rect().center();
+        h.hover_at(at);
+        for _ in 0..40 {
+            h.step();
+            if h.query_by_label_contains(says).is_some() {
+                break;
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        h.get_by_label_contains(says);
+    }
+    // the machine is named in an operator's words, not by a paper's numbering
+    assert_eq!(
+        h.state().session.doc().profile.name,
+        "Reference machine: 300 mm stage, 70 mm field"
+    );
+    let specs = galvoplan::document::spec::settings_specs();
+    for key in ["ga.elite_fraction", "direction_weight", "ga.mutation_rate"] {
+        let s = specs.iter().find(|s| s.key == key).unwrap();
+        assert!(s.help.split_whitespace().count() >= 8, "{key}: {}", s.help);
+    }
+}

@@ -239,13 +239,11 @@ impl App {
             self.field_tools(ui);
             ui.separator();
             let blocker = self.solve_blocker();
-            for (algo, label) in SOLVERS {
+            for (algo, label, what) in SOLVERS {
                 let b = ui.add_enabled(blocker.is_none(), egui::Button::new(*label));
                 let b = match &blocker {
                     Some(why) => b.on_disabled_hover_text(why),
-                    None => b.on_hover_text(
-                        "Order the geometries on the current fields, in the background",
-                    ),
+                    None => b.on_hover_text(*what),
                 };
                 if b.clicked() {
                     self.start_solve(*algo, ui.ctx());

@@ -63,12 +63,31 @@ use toolpaths::Lowered;
 /// Key of the preferences in eframe's storage.
 const PREFS_KEY: &str = "galvoplan-prefs";
 
-/// Solvers offered by the GUI: (algorithm, button label).
-pub const SOLVERS: &[(Algo, &str)] = &[
-    (Algo::Hha, "Run HHA"),
-    (Algo::Hga, "Run HGA"),
-    (Algo::Baseline, "Run baseline"),
-    (Algo::AsIs, "Run as-is"),
+/// Solvers offered by the GUI: (algorithm, button label, what it does in one sentence).
+pub const SOLVERS: &[(Algo, &str, &str)] = &[
+    (
+        Algo::Hha,
+        "Run HHA",
+        "Heuristic ordering: fields in a good order, then each field's marks in a short path; \
+         a plan in seconds.",
+    ),
+    (
+        Algo::Hga,
+        "Run HGA",
+        "Genetic algorithm: starts from the HHA plan and keeps searching for a shorter job for \
+         as long as it improves or the time limit allows (can be cancelled).",
+    ),
+    (
+        Algo::Baseline,
+        "Run baseline",
+        "A simple ordering to compare the others with: fields as placed, the nearest mark next \
+         inside each.",
+    ),
+    (
+        Algo::AsIs,
+        "Run as-is",
+        "The drawing's own order, no optimisation: what the machine would do without galvoplan.",
+    ),
 ];
 
 /// What is kept between runs (eframe storage). The default profile is the built-in seed

@@ -292,7 +292,7 @@ impl Default for MachineProfile {
     fn default() -> Self {
         Self {
             version: PROFILE_VERSION,
-            name: "seed000 (300 × 300 mm stroke, 70 × 70 mm field)".into(),
+            name: "Reference machine: 300 mm stage, 70 mm field".into(),
             stroke_mm: [300.0, 300.0],
             field_mm: [70.0, 70.0],
             axis_x: AxisLimits::default(),

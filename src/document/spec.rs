@@ -692,7 +692,8 @@ pub fn settings_specs() -> Vec<FieldSpec<SolverSettings>> {
             "Direction weight",
             "",
             "direction_weight",
-            "the heuristic's directional penalty weight w",
+            "how strongly HHA keeps each field's marks running one way (fewer turns back): 0 \
+             ignores direction, higher favours sweeping over shorter travel",
             NonNegative,
             |t| t.direction_weight
         ),
@@ -727,7 +728,7 @@ pub fn settings_specs() -> Vec<FieldSpec<SolverSettings>> {
             "GA elite fraction",
             "",
             "ga.elite_fraction",
-            "0 … 1",
+            "share of the best plans carried unchanged into each next generation (0 … 1)",
             Range(0.0, 1.0),
             |t| t.ga.elite_fraction
         ),
@@ -735,7 +736,8 @@ pub fn settings_specs() -> Vec<FieldSpec<SolverSettings>> {
             "GA mutation rate",
             "",
             "ga.mutation_rate",
-            "0 … 1",
+            "chance that a new plan is changed at random, to keep the search from settling \
+             early (0 … 1)",
             Range(0.0, 1.0),
             |t| t.ga.mutation_rate
         ),
