@@ -2038,3 +2038,35 @@ fn the_solvers_and_their_settings_say_what_they_do() {
         assert!(s.help.split_whitespace().count() >= 8, "{key}: {}", s.help);
     }
 }
+
+/// F shows the machine's whole reach (so the artwork's place on the stage can be checked by
+/// eye), and *Re-place automatically* fits the view to the new fields.
+#[test]
+fn f_fits_the_whole_base_stroke_and_re_placing_refits() {
+    let mut h = opened(&demo());
+    h.key_press(Key::F);
+    settle(&mut h);
+    let rect = h.state().workbench_rect().unwrap();
+    let [sw, sh] = h.state().session.doc().profile.stroke_mm;
+    for corner in [(0.0, 0.0), (sw, 0.0), (0.0, sh), (sw, sh)] {
+        let p = h
+            .state()
+            .mm_screen_pos(galvoplan::geom::Pt::new(corner.0, corner.1))
+            .unwrap();
+        assert!(rect.contains(p), "{corner:?} at {p:?} outside {rect:?}");
+    }
+    let whole = h.state().workbench_px_per_mm();
+    h.get_by_label("Re-place automatically").click();
+    h.step();
+    wait_idle(&mut h, Duration::from_secs(60));
+    // fitted to the artwork and its fields again: closer than the whole machine
+    assert!(
+        h.state().workbench_px_per_mm() > whole * 1.05,
+        "{} vs {whole}",
+        h.state().workbench_px_per_mm()
+    );
+    for f in &h.state().session.doc().fields {
+        let p = h.state().mm_screen_pos(f.center).unwrap();
+        assert!(rect.contains(p), "field {} off the canvas", f.id);
+    }
+}

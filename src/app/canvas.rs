@@ -80,8 +80,11 @@ pub struct CanvasState {
     pub view: View,
     /// The rectangle of the last frame (screen coordinates).
     pub rect: Option<Rect>,
-    /// Fit to the reach of the machine on the next frame.
+    /// Fit the content (artwork and fields) on the next frame.
     pub fit_requested: bool,
+    /// With `fit_requested`: fit the machine's whole reach with the content (F, *Fit to
+    /// view*), so that where the artwork lies on the stage can be seen.
+    pub fit_whole: bool,
     drag: Drag,
     /// The tray cell the context menu is open for: (cell, it is skipped).
     context_cell: Option<(u32, bool)>,
@@ -194,7 +197,17 @@ impl Canvas<'_> {
                 rect.max,
             );
             let (lo, hi) = self.content_bounds();
+            let (lo, hi) = if state.fit_whole {
+                let (rlo, rhi) = Canvas::reach(self.profile);
+                (
+                    Pt::new(lo.x.min(rlo.x), lo.y.min(rlo.y)),
+                    Pt::new(hi.x.max(rhi.x), hi.y.max(rhi.y)),
+                )
+            } else {
+                (lo, hi)
+            };
             state.view.fit(below_caption, lo, hi);
+            state.fit_whole = false;
             state.view.offset += below_caption.min - rect.min;
             state.fit_requested = false;
         }

@@ -179,10 +179,10 @@ impl App {
         self.layer_toggles(ui);
         if ui
             .add(egui::Button::new("Fit to view").shortcut_text("F"))
+            .on_hover_text("the machine's whole reach with the artwork and fields")
             .clicked()
         {
-            self.panels.workbench.fit_requested = true;
-            self.panels.compare.canvas.fit_requested = true;
+            self.fit_whole();
         }
     }
 

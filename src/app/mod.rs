@@ -481,7 +481,8 @@ impl App {
                     doc: Box::new(work),
                     what: "re-place fields automatically".into(),
                     problem: None,
-                    refit: false,
+                    // the new fields may lie where the view does not reach
+                    refit: true,
                 })
             },
         );
@@ -807,11 +808,24 @@ impl App {
         Some(self.panels.workbench.view.to_screen(rect, c))
     }
 
+    /// Fits the canvases to the machine's whole reach with the content (F, *Fit to view*).
+    fn fit_whole(&mut self) {
+        for c in [&mut self.panels.workbench, &mut self.panels.compare.canvas] {
+            c.fit_requested = true;
+            c.fit_whole = true;
+        }
+    }
+
     /// Screen position of machine point `p` (mm) on the workbench canvas (after the first
     /// frame).
     pub fn mm_screen_pos(&self, p: crate::geom::Pt) -> Option<egui::Pos2> {
         let rect = self.panels.workbench.rect?;
         Some(self.panels.workbench.view.to_screen(rect, p))
+    }
+
+    /// The workbench canvas's rectangle on screen (after the first frame).
+    pub fn workbench_rect(&self) -> Option<egui::Rect> {
+        self.panels.workbench.rect
     }
 
     /// The workbench canvas's zoom: screen pixels per mm.
@@ -1197,8 +1211,7 @@ impl App {
             }
         }
         if fit {
-            self.panels.workbench.fit_requested = true;
-            self.panels.compare.canvas.fit_requested = true;
+            self.fit_whole();
         }
     }
 }
