@@ -191,10 +191,15 @@ const ROWS: &[Row] = &[
         only_some: false,
     },
     Row {
-        label: "Stage speed variation (mm/s)",
-        help: "sum of the stage's speed changes between samples: lower is \
-               a smoother ride",
-        value: |p| p.metrics.motion.map(|f| f.stage_speed_variation_mm_s),
+        label: "Mean stage acceleration (mm/s²)",
+        help: "the stage's speed changes averaged over the job (their sum, sampled every \
+               millisecond, divided by the job time): lower is a smoother ride; the report \
+               keeps the sum as stage_speed_variation_mm_s",
+        value: |p| {
+            let f = p.metrics.motion?;
+            let t = p.metrics.job_time_s.filter(|t| *t > 0.0)?;
+            Some(f.stage_speed_variation_mm_s / t)
+        },
         decimals: 0,
         kind: RowKind::Ranked,
         only_some: false,
