@@ -891,7 +891,7 @@ fn motion_plots_show_an_on_the_fly_plan() {
     let plan = h.state().active_plan().unwrap().clone();
     let f = plan.metrics.motion.unwrap();
     let mean = f.stage_speed_variation_mm_s / plan.metrics.job_time_s.unwrap();
-    h.get_by_label("Mean stage acceleration (mm/s²)");
+    h.get_by_label("Stage acceleration (mm/s²)");
     h.get_by_label(&format!("{mean:.0}"));
     assert!(h.query_by_label_contains("Stage speed variation").is_none());
     h.get_by_label_contains("Scanner offset (tool - stage), mm");

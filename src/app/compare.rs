@@ -191,8 +191,8 @@ const ROWS: &[Row] = &[
         only_some: false,
     },
     Row {
-        label: "Mean stage acceleration (mm/s²)",
-        help: "the stage's speed changes averaged over the job (their sum, sampled every \
+        label: "Stage acceleration (mm/s²)",
+        help: "mean: the stage.s speed changes averaged over the job (their sum, sampled every \
                millisecond, divided by the job time): lower is a smoother ride; the report \
                keeps the sum as stage_speed_variation_mm_s",
         value: |p| {
