@@ -192,7 +192,7 @@ const ROWS: &[Row] = &[
     },
     Row {
         label: "Stage acceleration (mm/s²)",
-        help: "mean: the stage.s speed changes averaged over the job (their sum, sampled every \
+        help: "mean: the stage's speed changes averaged over the job (their sum, sampled every \
                millisecond, divided by the job time): lower is a smoother ride; the report \
                keeps the sum as stage_speed_variation_mm_s",
         value: |p| {
