@@ -603,6 +603,16 @@ impl Stages<'_> {
     }
 }
 
+/// Refinement rounds: none for a lone field (its path is searched freely afterwards), one
+/// before the time objective's own search, else up to [`REFINE_ROUNDS`].
+fn refine_rounds(lone: bool, time_follows: bool) -> usize {
+    match (lone, time_follows) {
+        (true, _) => 0,
+        (false, true) => REFINE_ROUNDS_BEFORE_TIME,
+        (false, false) => REFINE_ROUNDS,
+    }
+}
+
 /// HHA's time budgets: a time limit is HHA's own only when HHA is the algorithm (HGA spends
 /// it on generations); under the time objective the refinement is preliminary too (the time
 /// objective's search of each field's path comes last and gets the full budget).
@@ -677,17 +687,7 @@ pub fn hha_order(
         until: budgets.limited(FIELD_PATHS_SHARE),
         start_only: lone_before_time || lone_free,
     };
-    let slots = |fo: &[usize]| -> Vec<&ScanField> { fo.iter().map(|&k| live[k]).collect() };
-    let mut best = stages.route(slots(&by_centre), ctx)?;
-    let (mut paths_s, mut vertices_s) = (best.paths_s, best.vertices_s);
-    if let Some(fo) = by_gap {
-        let routed = stages.route(slots(&fo), ctx)?;
-        paths_s += routed.paths_s;
-        vertices_s += routed.vertices_s;
-        if routed.idle_mm < best.idle_mm - 1e-9 {
-            best = routed;
-        }
-    }
+    let (best, paths_s, vertices_s) = stages.best_route(&live, &by_centre, by_gap, ctx)?;
     stage_s.push(("field_paths".into(), paths_s));
     stage_s.push(("vertices".into(), vertices_s));
     let Routed {
@@ -699,13 +699,7 @@ pub fn hha_order(
     ctx.progress("order", 3, 4, "HHA: refine");
     if settings.hha_improve {
         let t = Instant::now();
-        let rounds = if lone_before_time || lone_free {
-            0
-        } else if time_follows {
-            REFINE_ROUNDS_BEFORE_TIME
-        } else {
-            REFINE_ROUNDS
-        };
+        let rounds = refine_rounds(lone_before_time || lone_free, time_follows);
         let refine = Refine {
             geometries,
             cent: &cent,
@@ -728,6 +722,32 @@ pub fn hha_order(
         field_order: ordered.iter().map(|f| f.id).collect(),
         steps,
     })
+}
+
+impl Stages<'_> {
+    /// The field order by centres and, when there is one, by gaps, each routed through its
+    /// fields' paths and vertices; the one of lower idle travel, with the time both took in
+    /// the path and vertex stages, s.
+    fn best_route<'f>(
+        &self,
+        live: &[&'f ScanField],
+        by_centre: &[usize],
+        by_gap: Option<Vec<usize>>,
+        ctx: &JobCtx,
+    ) -> Result<(Routed<'f>, f64, f64), Cancelled> {
+        let slots = |fo: &[usize]| -> Vec<&'f ScanField> { fo.iter().map(|&k| live[k]).collect() };
+        let mut best = self.route(slots(by_centre), ctx)?;
+        let (mut paths_s, mut vertices_s) = (best.paths_s, best.vertices_s);
+        if let Some(fo) = by_gap {
+            let routed = self.route(slots(&fo), ctx)?;
+            paths_s += routed.paths_s;
+            vertices_s += routed.vertices_s;
+            if routed.idle_mm < best.idle_mm - 1e-9 {
+                best = routed;
+            }
+        }
+        Ok((best, paths_s, vertices_s))
+    }
 }
 
 /// HHA's refinement: every field's path searched again between its neighbours' ends, on the
