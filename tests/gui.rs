@@ -1183,20 +1183,26 @@ fn two_layers_solved() -> Harness<'static, App> {
 fn a_pen_edit_makes_the_plan_stale_and_re_solve_and_export_writes_the_new_feed() {
     let mut h = two_layers_solved();
     assert!(h.state().plan_staleness(0).is_empty());
+    // a pen that now sets what its profile gave is no change
+    let profile_speed = h.state().session.doc().profile.scanner.mark_speed_mm_s;
+    enter_nth(&mut h, "Mark speed (mm/s)", 1, &profile_speed.to_string());
+    settle(&mut h);
+    assert!(h.state().plan_staleness(0).is_empty());
     enter_nth(&mut h, "Mark speed (mm/s)", 1, "300");
     settle(&mut h);
-    // stale, with the reason in words, in the plan list and under the metrics
-    assert_eq!(
-        h.state().plan_staleness(0),
-        ["fill: mark speed unset → 300 mm/s"]
-    );
+    // stale, with the reason in words (the speed the plan had, not "unset"), in the plan list
+    // and under the metrics
+    let why = format!("fill: mark speed {profile_speed} → 300 mm/s");
+    assert_eq!(h.state().plan_staleness(0), [why.as_str()]);
     h.get_by_label("stale");
-    h.get_by_label_contains("HHA · job time · step-and-scan · seed 1 is stale: fill: mark speed unset → 300 mm/s since it was made");
+    h.get_by_label_contains(&format!(
+        "HHA · job time · step-and-scan · seed 1 is stale: {why} since it was made"
+    ));
     // export asks; re-solving is the default answer and writes the new feed
     h.key_press_modifiers(ctrl(), Key::E);
     settle(&mut h);
     h.get_by_label("The plan shown is stale");
-    h.get_by_label("• fill: mark speed unset → 300 mm/s");
+    h.get_by_label(&format!("• {why}"));
     h.get_by_label("Re-solve and export").click();
     settle(&mut h);
     let dir = tempfile::tempdir().unwrap();

@@ -116,7 +116,10 @@ pub fn staleness(plan: &Plan, doc: &Document) -> Vec<String> {
         &plan.profile,
         &doc.profile,
     ));
-    why.extend(layer_differences(&plan.layers, &doc.layers));
+    why.extend(layer_differences(
+        (&plan.layers, &plan.profile),
+        (&doc.layers, &doc.profile),
+    ));
     let planned = PlanInputs::of_plan(plan).settings;
     let now = SolverSettings {
         algo: plan.algo,
@@ -130,22 +133,42 @@ pub fn staleness(plan: &Plan, doc: &Document) -> Vec<String> {
     why
 }
 
-/// Pen changes between two layer tables, per layer by name.
-fn layer_differences(planned: &[Layer], now: &[Layer]) -> Vec<String> {
+/// Pen changes between two layer tables (each with the profile its unset values come from),
+/// per layer by name. A value a pen leaves to its profile is compared, and said, as the
+/// profile's value ("mark speed 1000 → 500 mm/s", not "unset → 500"): a pen that now sets what
+/// the profile gave is no change.
+fn layer_differences(
+    (planned, planned_profile): (&[Layer], &super::MachineProfile),
+    (now, profile): (&[Layer], &super::MachineProfile),
+) -> Vec<String> {
     let specs = super::spec::pen_specs();
     let mut why = Vec::new();
     for l in now {
         match planned.iter().find(|p| p.name == l.name) {
             Some(p) => why.extend(
-                super::spec::differences(&specs, &p.pen, &l.pen)
-                    .into_iter()
-                    .map(|d| format!("{}: {d}", l.name)),
+                super::spec::differences(
+                    &specs,
+                    &with_profile(&p.pen, planned_profile),
+                    &with_profile(&l.pen, profile),
+                )
+                .into_iter()
+                .map(|d| format!("{}: {d}", l.name)),
             ),
             None if !planned.is_empty() => why.push(format!("{}: a new layer", l.name)),
             None => {}
         }
     }
     why
+}
+
+/// `pen` with the values it leaves to `profile` (speed, power, dot dwell) set to the profile's.
+fn with_profile(pen: &super::Pen, profile: &super::MachineProfile) -> super::Pen {
+    super::Pen {
+        mark_speed_mm_s: Some(pen.mark_speed_mm_s(profile)),
+        power: pen.power(profile),
+        dot_dwell_s: Some(pen.dot_dwell_s(profile)),
+        ..pen.clone()
+    }
 }
 
 /// The fields as a comparable key (ids, centres and sizes to the bit, allocation as a set).
