@@ -2083,3 +2083,20 @@ fn f_fits_the_whole_base_stroke_and_re_placing_refits() {
         assert!(rect.contains(p), "field {} off the canvas", f.id);
     }
 }
+
+/// A plan stale for several reasons names the first under the metrics, and "and N more" opens
+/// the others.
+#[test]
+fn the_other_stale_reasons_are_one_click_away() {
+    let mut h = two_layers_solved();
+    enter_nth(&mut h, "Mark speed (mm/s)", 1, "300");
+    settle(&mut h);
+    enter_nth(&mut h, "Mark speed (mm/s)", 0, "250");
+    settle(&mut h);
+    let why = h.state().plan_staleness(0).to_vec();
+    assert_eq!(why.len(), 2, "{why:?}");
+    assert!(h.query_by_label(&format!("• {}", why[1])).is_none());
+    h.get_by_label_contains("and 1 more").click();
+    settle(&mut h);
+    h.get_by_label(&format!("• {}", why[1]));
+}

@@ -401,15 +401,11 @@ fn value_cell(ui: &mut egui::Ui, row: &Row, mine: Option<f64>, other: Option<f64
 pub fn stale_notes(ui: &mut egui::Ui, plans: &[(&Plan, &[String])]) {
     for (plan, why) in plans {
         let Some(first) = why.first() else { continue };
-        let more = match why.len() {
-            1 => String::new(),
-            n => format!(" (and {} more)", n - 1),
-        };
         ui.add(
             egui::Label::new(
                 RichText::new(format!(
-                    "{} is stale: {first} since it was made{more}; its figures are those of \
-                     the plan as made",
+                    "{} is stale: {first} since it was made; its figures are those of the plan \
+                     as made",
                     plan.name
                 ))
                 .color(colour::STALE),
@@ -417,6 +413,21 @@ pub fn stale_notes(ui: &mut egui::Ui, plans: &[(&Plan, &[String])]) {
             .wrap(),
         )
         .on_hover_text(super::words::stale_text(why));
+        if why.len() > 1 {
+            // the other reasons, one click away
+            egui::CollapsingHeader::new(
+                RichText::new(format!("and {} more", why.len() - 1)).color(colour::STALE),
+            )
+            .id_salt(("stale-more", plan.name.as_str()))
+            .show(ui, |ui| {
+                for w in &why[1..] {
+                    ui.add(
+                        egui::Label::new(RichText::new(format!("• {w}")).color(colour::STALE))
+                            .wrap(),
+                    );
+                }
+            });
+        }
     }
 }
 
