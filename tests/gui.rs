@@ -2100,3 +2100,23 @@ fn the_other_stale_reasons_are_one_click_away() {
     settle(&mut h);
     h.get_by_label(&format!("• {}", why[1]));
 }
+
+/// An export onto the drawing it was made from is refused, and the path field stays open with
+/// the reason inside it (nothing written, the drawing kept).
+#[test]
+fn a_refused_export_keeps_its_path_field_open_with_the_reason() {
+    let mut h = two_layers_solved();
+    let source = two_layers();
+    let before = std::fs::read(&source).unwrap();
+    h.key_press_modifiers(ctrl(), Key::E);
+    settle(&mut h);
+    h.get_by_label("Export G-code");
+    enter_nth(&mut h, "File path", 0, &source.display().to_string());
+    settle(&mut h);
+    // still open, saying why
+    assert!(h.state().prompt().is_some(), "{}", h.state().status());
+    h.get_by_label("File path");
+    h.get_by_label_contains("Choose another file.");
+    assert!(h.state().status().contains(&source.display().to_string()));
+    assert_eq!(std::fs::read(&source).unwrap(), before);
+}

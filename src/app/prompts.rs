@@ -163,6 +163,18 @@ impl App {
 
     /// Does a file action on a chosen path.
     fn perform(&mut self, action: PathAction, path: PathBuf, ctx: &egui::Context) {
+        if let PathAction::Export(kind) | PathAction::ResolveExport(kind) = action {
+            // a refused export keeps its path field open, with the reason inside it
+            if let Err(e) = self.check_export_path(kind, &path) {
+                self.set_status(e.clone(), true);
+                self.panels.prompt = Some(Prompt::Path {
+                    action,
+                    text: path.display().to_string(),
+                    note: format!("{e}. Choose another file."),
+                });
+                return;
+            }
+        }
         let result = match action {
             PathAction::Open => {
                 self.open_in_background(&path, ctx);
