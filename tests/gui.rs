@@ -2120,3 +2120,15 @@ fn a_refused_export_keeps_its_path_field_open_with_the_reason() {
     assert!(h.state().status().contains(&source.display().to_string()));
     assert_eq!(std::fs::read(&source).unwrap(), before);
 }
+
+/// The advice for geometries larger than a field never proposes what is already chosen: with
+/// step-and-scan it offers splitting or on the fly; with on the fly chosen, only splitting.
+#[test]
+fn the_oversize_advice_never_proposes_what_is_chosen() {
+    let (mut h, _) = opened_oversize();
+    let choose_otf = "or choose \"On the fly\" as the motion";
+    h.get_by_label_contains(choose_otf);
+    set_motion(&mut h, "On the fly (stage moves while marking)");
+    wait_idle(&mut h, Duration::from_secs(60));
+    assert!(h.query_by_label_contains(choose_otf).is_none());
+}

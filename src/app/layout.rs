@@ -511,13 +511,9 @@ impl App {
             })
             .count();
         let beyond = far - large;
+        let large_advice = oversize_advice(&self.session.doc().settings);
         let advice = [
-            (
-                large,
-                "larger than a scan field: tick \"Split oversize geometries\" in Solver \
-                 settings and press \"Re-place automatically\", or choose \"On the fly\" as \
-                 the motion.",
-            ),
+            (large, large_advice.as_str()),
             (
                 beyond,
                 "beyond the stage's stroke plus half a field: choose \"Placement: \
@@ -815,5 +811,46 @@ fn workbench_canvas<'a>(
         parts: session.part_boxes(),
         codes: session.code_boxes(),
         revision,
+    }
+}
+
+/// What helps geometries larger than a scan field, never proposing what `settings` already
+/// chose: splitting them at field borders, marking them on the fly, or both.
+fn oversize_advice(settings: &crate::document::SolverSettings) -> String {
+    use crate::document::MotionMode;
+    let split = "tick \"Split oversize geometries\" in Solver settings and press \"Re-place \
+                 automatically\"";
+    let flies = settings.motion != MotionMode::Step;
+    match (settings.split_oversize, flies) {
+        (false, false) => {
+            format!("larger than a scan field: {split}, or choose \"On the fly\" as the motion.")
+        }
+        (false, true) => format!(
+            "larger than a scan field: the next solve marks them on the fly (a region carries \
+             them); to mark them step-and-scan, {split}."
+        ),
+        (true, _) => "larger than a scan field: press \"Re-place automatically\" to cut them at \
+                      field borders (splitting is ticked)."
+            .to_string(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_oversize_advice_offers_only_what_is_not_chosen() {
+        let mut s = crate::document::SolverSettings {
+            motion: crate::document::MotionMode::Step,
+            ..Default::default()
+        };
+        let step = oversize_advice(&s);
+        assert!(step.contains("Split oversize") && step.contains("choose \"On the fly\""));
+        s.motion = crate::document::MotionMode::OnTheFly;
+        let otf = oversize_advice(&s);
+        assert!(!otf.contains("choose \"On the fly\"") && otf.contains("marks them on the fly"));
+        s.split_oversize = true;
+        assert!(!oversize_advice(&s).contains("tick \"Split"));
     }
 }
