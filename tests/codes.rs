@@ -148,6 +148,19 @@ fn gs1_datamatrix_scans_with_its_element_strings() {
     );
 }
 
+/// assets/examples/part.svg made into the tray `tray` says, on the default machine and settings.
+fn part_tray(tray: TraySettings) -> galvoplan::pipeline::Loaded {
+    let part = common::root().join("assets/examples/part.svg");
+    load_production(
+        &part,
+        MachineProfile::default(),
+        SolverSettings::default(),
+        &ImportOptions::default(),
+        &tray,
+    )
+    .unwrap()
+}
+
 /// The tray job of the acceptance: 6 × 8 parts, a DataMatrix and a QR code each with its
 /// part's content; every one of the 96 codes, cut out of the planned toolpath's marks at its
 /// part, reads as its part's content.
@@ -158,21 +171,14 @@ fn every_code_of_a_tray_reads_its_part_content_from_the_toolpath() {
         CodeSpec::parse("datamatrix:GP{serial:05}@3,3:6").unwrap(),
         CodeSpec::parse("qr:{csv:lot}/{serial}@14,2:9").unwrap(),
     ];
-    let loaded = load_production(
-        &root.join("part.svg"),
-        MachineProfile::default(),
-        SolverSettings::default(),
-        &ImportOptions::default(),
-        &TraySettings {
-            tray: Some(Tray::parse("6x8@40,32").unwrap()),
-            serial: Some(galvoplan::document::Serial::parse("1001").unwrap()),
-            data: Some(galvoplan::document::DataTable::read(&root.join("lots.csv")).unwrap()),
-            stamp: Some(Stamp::parse("2026-12-07").unwrap()),
-            codes: Some(codes.clone()),
-            ..TraySettings::default()
-        },
-    )
-    .unwrap();
+    let loaded = part_tray(TraySettings {
+        tray: Some(Tray::parse("6x8@40,32").unwrap()),
+        serial: Some(galvoplan::document::Serial::parse("1001").unwrap()),
+        data: Some(galvoplan::document::DataTable::read(&root.join("lots.csv")).unwrap()),
+        stamp: Some(Stamp::parse("2026-12-07").unwrap()),
+        codes: Some(codes.clone()),
+        ..TraySettings::default()
+    });
     let mut doc = loaded.doc;
     let (_, toolpath) = plan_document_lowered(&mut doc, &JobCtx::default()).unwrap();
     let strokes: Vec<Vec<Pt>> = (0..toolpath.strokes.len())
@@ -285,22 +291,14 @@ fn dots_put_one_spot_at_each_marked_module_centre() {
 /// written as a dwell with the laser on.
 #[test]
 fn dots_are_marked_for_their_pens_dwell_through_the_job() {
-    let root = common::root().join("assets/examples");
-    let loaded = load_production(
-        &root.join("part.svg"),
-        MachineProfile::default(),
-        SolverSettings::default(),
-        &ImportOptions::default(),
-        &TraySettings {
-            tray: Some(Tray::parse("2x1@40,32").unwrap()),
-            serial: Some(galvoplan::document::Serial::parse("1001").unwrap()),
-            codes: Some(vec![
-                CodeSpec::parse("datamatrix:GP{serial:05}@3,3:6:dots").unwrap()
-            ]),
-            ..TraySettings::default()
-        },
-    )
-    .unwrap();
+    let loaded = part_tray(TraySettings {
+        tray: Some(Tray::parse("2x1@40,32").unwrap()),
+        serial: Some(galvoplan::document::Serial::parse("1001").unwrap()),
+        codes: Some(vec![
+            CodeSpec::parse("datamatrix:GP{serial:05}@3,3:6:dots").unwrap()
+        ]),
+        ..TraySettings::default()
+    });
     let mut doc = loaded.doc;
     let codes = doc
         .layers

@@ -552,7 +552,7 @@ impl App {
     /// The document's warnings (open on each import that has some) and the recent files.
     fn warnings_and_recent_ui(&mut self, ui: &mut egui::Ui) {
         // the same message for many elements is one line with its count and a few of them
-        let lines = crate::document::grouped(&self.session.doc().warnings);
+        let lines = self.session.warning_lines();
         let n = lines.len();
         let title = if n > 0 {
             // import, cut and whole-or-cut warnings alike: what the drawing and the placement say

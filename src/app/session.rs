@@ -48,6 +48,8 @@ pub struct Session {
     code_boxes: Vec<super::tray_panel::CodeBox>,
     /// Each geometry's layer colour.
     colours: Vec<egui::Color32>,
+    /// The document's warnings as listed (grouped, notes left out).
+    warning_lines: Vec<String>,
     /// Counts imports: the warnings list opens again on each one.
     imports: u64,
     /// Counts refreshes of what the canvases draw (with `revision`: the canvases' raster
@@ -127,6 +129,12 @@ impl Session {
             doc,
             ..Self::default()
         }
+    }
+
+    /// The document's warnings as the Warnings list shows them ([`crate::document::grouped`]),
+    /// made when the document changes, not every frame.
+    pub fn warning_lines(&self) -> &[String] {
+        &self.warning_lines
     }
 
     /// Each plan's lowered toolpath.
@@ -337,6 +345,7 @@ impl Session {
             self.active = self.doc.plans.len().checked_sub(1);
         }
         self.toolpaths.sync(&self.doc);
+        self.warning_lines = crate::document::grouped(&self.doc.warnings);
         self.canvas_revision += 1;
         let rgb: std::collections::HashMap<&str, egui::Color32> = self
             .doc
