@@ -11,10 +11,21 @@ S=../shared
 source "$S/tools/setup.sh" >/dev/null
 OUT="${OUT:-/tmp/galvoplan-motion}"
 mkdir -p "$OUT"
+# A trajectory samples the plan on the profile's clock; a continuous plan's short marks fall between
+# 1 ms samples, so the check plans on a copy of the profile with a 1 ms scan-head clock.
+clocked() { # profile.toml -> a copy with [controller] clock_period_s = 0.001
+  local c="$OUT/$(basename "$1" .toml)-clock-1ms.toml"
+  if grep -q '^\[controller\]' "$1"; then
+    sed 's/^\[controller\]/[controller]\nclock_period_s = 0.001/' "$1" >"$c"
+  else
+    { cat "$1"; printf '\n[controller]\nclock_period_s = 0.001\n'; } >"$c"
+  fi
+  echo "$c"
+}
 run() { # name svg profile cost
-  local name=$1 svg=$2 prof=$3 cost=$4
+  local name=$1 svg=$2 cost=$4 prof; prof=$(clocked "$3")
   local o="$OUT/$name-$cost"
-  if ! "$B" plan "$svg" --profile "$prof" --cost "$cost" -o "$o.gcode" --report "$o.json" \
+  if ! "$B" plan "$svg" --profile "$prof" --motion step --cost "$cost" -o "$o.gcode" --report "$o.json" \
       --trajectory "$o.csv" "${EXTRA[@]}" 2>"$o.log"; then
     echo "$name $cost PLAN-FAILED $(tail -1 "$o.log")"; return
   fi

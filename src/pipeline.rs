@@ -859,13 +859,14 @@ fn complete_plan(
     Ok((plan, toolpath))
 }
 
-/// The machine motion of one of the document's plans: on its own geometries, machine, pens
-/// and motion ([`crate::motion::lower_motion`]), whatever the document's current ones.
+/// The machine motion of one of the document's plans: on its own geometries, machine, pens,
+/// motion and controller clock ([`crate::motion::lower_motion`]), whatever the document's
+/// current ones.
 pub fn lower_plan(doc: &Document, plan: &Plan) -> Result<Toolpath, PipelineError> {
-    lower_plan_on(doc, plan, None)
+    lower_plan_on(doc, plan, plan.profile.controller.marks_clock_s())
 }
 
-/// [`lower_plan`] on a controller clock of `period_s` (what a trajectory at that period runs).
+/// [`lower_plan`] on a clock of `clock_s` instead of its profile's (None: continuous).
 pub fn lower_plan_on(
     doc: &Document,
     plan: &Plan,

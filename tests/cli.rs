@@ -264,6 +264,93 @@ fn plan_writes_a_trajectory_whose_duration_is_the_reported_job_time() {
     assert!(!out.status.success());
 }
 
+/// The job time a `plan` run reports on stderr ("job time 6.089 s").
+fn reported_job_time(out: &std::process::Output) -> String {
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    let at = err.find("job time ").expect("a job time") + "job time ".len();
+    err[at..].split(' ').next().unwrap_or_default().to_string()
+}
+
+#[test]
+fn a_trajectory_never_changes_the_plans_job_time() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = |n: &str| dir.path().join(n).display().to_string();
+    let root = common::root();
+    let clocked = root.join("tests/data/profiles/scan-head-clock.toml");
+    let clocked = clocked.display().to_string();
+    for svg in ["assets/examples/demo.svg", "assets/examples/oversize.svg"] {
+        let svg = root.join(svg).display().to_string();
+        for profile in ["seed000", "linuxcnc", clocked.as_str()] {
+            let out = d("job.gcode");
+            let plan = |extra: &[&str]| {
+                let mut args = vec!["plan", &svg, "--profile", profile, "--motion", "auto"];
+                args.extend(["-o", out.as_str()]);
+                args.extend(extra);
+                galvoplan(&args)
+            };
+            let without = reported_job_time(&plan(&[]));
+            let csv = d("job.csv");
+            let with = reported_job_time(&plan(&["--trajectory", &csv]));
+            assert_eq!(without, with, "{svg} on {profile}");
+            // the trajectory's last sample is the end of that same job
+            let text = std::fs::read_to_string(&csv).unwrap();
+            let last = text.lines().last().unwrap().split(',').next().unwrap();
+            let (last, job): (f64, f64) = (last.parse().unwrap(), with.parse().unwrap());
+            assert!(last >= job - 5e-4 && last < job + 1.5e-3, "{last} vs {job}");
+        }
+    }
+    // a profile with a clock samples on it: another period is refused, naming the clock
+    let svg = root.join("assets/examples/demo.svg").display().to_string();
+    let (out, csv) = (d("job.gcode"), d("job.csv"));
+    for profile in ["linuxcnc", clocked.as_str()] {
+        let refused = galvoplan(&[
+            "plan",
+            &svg,
+            "--profile",
+            profile,
+            "-o",
+            &out,
+            "--trajectory",
+            &csv,
+            "--trajectory-period-ms",
+            "2",
+        ]);
+        assert!(!refused.status.success());
+        let err = String::from_utf8_lossy(&refused.stderr);
+        assert!(err.contains("clock of 1 ms"), "{err}");
+    }
+    // the same period is taken
+    let same = galvoplan(&[
+        "plan",
+        &svg,
+        "--profile",
+        &clocked,
+        "-o",
+        &out,
+        "--trajectory",
+        &csv,
+        "--trajectory-period-ms",
+        "1",
+    ]);
+    reported_job_time(&same);
+    // the scan head's clock makes the plan: marks start and end on ticks, so the job is longer
+    let on = |profile: &str| {
+        let t = reported_job_time(&galvoplan(&[
+            "plan",
+            &svg,
+            "--profile",
+            profile,
+            "--motion",
+            "step",
+            "-o",
+            &out,
+        ]));
+        t.parse::<f64>().unwrap()
+    };
+    assert!(on(&clocked) > on("seed000"));
+}
+
 #[test]
 fn on_the_fly_plans_oversize_artwork_without_splitting() {
     let dir = tempfile::tempdir().unwrap();

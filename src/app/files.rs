@@ -9,7 +9,7 @@ use crate::export::{preview_svg, report_json, trajectory_csv, trajectory_period_
 use crate::import::{HiddenLayers, ImportOptions};
 use crate::job::JobCtx;
 use crate::motion::Toolpath;
-use crate::pipeline::{derive_geometries, lower_plan, lower_plan_on};
+use crate::pipeline::{derive_geometries, lower_plan};
 use crate::pipeline::{load_artwork, place_document_fields};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -239,14 +239,9 @@ pub fn export_text(
         return Ok(report_json(&source, plan, &doc.warnings));
     }
     let lowered;
-    let toolpath = match (kind, toolpath) {
-        (ExportKind::Trajectory, _) => {
-            let period_s = trajectory_period_s(1.0).map_err(|e| e.to_string())?;
-            lowered = lower_plan_on(doc, plan, Some(period_s)).map_err(|e| e.to_string())?;
-            &lowered
-        }
-        (_, Some(t)) => t,
-        (_, None) => {
+    let toolpath = match toolpath {
+        Some(t) => t,
+        None => {
             lowered = lower_plan(doc, plan).map_err(|e| e.to_string())?;
             &lowered
         }
@@ -256,7 +251,9 @@ pub fn export_text(
             .map_err(|e| format!("{source}: {e}"))?,
         ExportKind::Preview => preview_svg(toolpath, plan, doc.page_mm),
         ExportKind::Trajectory => {
-            let period_s = trajectory_period_s(1.0).map_err(|e| e.to_string())?;
+            // sampled on the controller's clock when the profile has one, else every 1 ms
+            let clock_ms = plan.profile.controller.clock_s().map_or(1.0, |s| s * 1e3);
+            let period_s = trajectory_period_s(clock_ms).map_err(|e| e.to_string())?;
             trajectory_csv(toolpath, period_s)
         }
         ExportKind::Report => report_json(&source, plan, &doc.warnings),

@@ -519,14 +519,11 @@ struct PlanArgs {
     /// (`t_s,stage_x_mm,stage_y_mm,scan_x_mm,scan_y_mm,laser`).
     #[arg(long, value_name = "OUT.csv")]
     trajectory: Option<PathBuf>,
-    /// Sampling period of the trajectory (the controller's clock), ms.
-    #[arg(
-        long,
-        value_name = "MS",
-        default_value_t = 1.0,
-        requires = "trajectory"
-    )]
-    trajectory_period_ms: f64,
+    /// Sampling period of the trajectory, ms: the profile's controller clock when it has one
+    /// (another period is refused), else 1 ms. The trajectory samples the plan; it never
+    /// changes it.
+    #[arg(long, value_name = "MS", requires = "trajectory")]
+    trajectory_period_ms: Option<f64>,
     /// Write the toolpath's exact states at every segment end and mark vertex (on the fly: and
     /// every millisecond of planned time, the on-the-fly program's samples) as CSV, in the
     /// trajectory's columns: what a controller's canonical moves are checked against.

@@ -12,9 +12,7 @@ use galvoplan::import::Place;
 use galvoplan::job::Progress;
 use galvoplan::job::ProgressSink;
 use galvoplan::job::{CancelToken, JobCtx};
-use galvoplan::pipeline::{
-    apply_pen_library, load_production, lower_plan_on, plan_document_lowered,
-};
+use galvoplan::pipeline::{apply_pen_library, load_production, plan_document_lowered};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -26,7 +24,7 @@ pub fn run(a: &PlanArgs) -> Result<()> {
     let period_s = a
         .trajectory
         .as_ref()
-        .map(|_| trajectory_period_s(a.trajectory_period_ms))
+        .map(|_| sampling_period_s(&profile, a.trajectory_period_ms))
         .transpose()?;
     let pens = a.job.pens()?;
     let progress = Arc::new(BarProgress::new());
@@ -92,20 +90,9 @@ pub fn run(a: &PlanArgs) -> Result<()> {
     let (mut plan, toolpath) = result?;
     let t0 = Instant::now();
     let source = a.input.display().to_string();
-    // with a trajectory, everything is written from the toolpath on the controller's clock (the
-    // same strokes; the report then gives its time)
-    let toolpath = match period_s {
-        Some(_) => lower_plan_on(&doc, &plan, period_s)?,
-        // the toolpath the plan was ordered and measured on
-        None => toolpath,
-    };
-    let trajectory = period_s.map(|p| {
-        plan.metrics.job_time_s = Some(toolpath.duration_s());
-        plan.metrics.job_time_breakdown_s = Some(toolpath.breakdown());
-        plan.metrics.motion = Some(toolpath.motion_figures(p));
-        plan.metrics.motion_regions = toolpath.motion_regions();
-        trajectory_csv(&toolpath, p)
-    });
+    // the trajectory samples the toolpath the plan was ordered and measured on (on the
+    // profile's clock when it has one): an export never changes the plan's figures
+    let trajectory = period_s.map(|p| trajectory_csv(&toolpath, p));
     let waypoints = a.waypoints.as_ref().map(|_| waypoints_csv(&toolpath));
     // streamed into the output file (atomically: written whole or not at all)
     let mut gcode_error = None;
@@ -173,6 +160,25 @@ pub fn run(a: &PlanArgs) -> Result<()> {
         m.solve_s.total * 1e3
     );
     Ok(())
+}
+
+/// The trajectory's sampling period, s: the profile's clock (a `--trajectory-period-ms` that
+/// differs from it is refused), else the period asked for, else 1 ms.
+fn sampling_period_s(
+    profile: &galvoplan::document::MachineProfile,
+    asked_ms: Option<f64>,
+) -> Result<f64> {
+    let Some(clock_s) = profile.controller.clock_s() else {
+        return Ok(trajectory_period_s(asked_ms.unwrap_or(1.0))?);
+    };
+    match asked_ms {
+        Some(ms) if (ms * 1e-3 - clock_s).abs() > 1e-12 * clock_s.max(1e-3) => anyhow::bail!(
+            "--trajectory-period-ms {ms}: the profile '{}' plans on its controller's clock of {} ms; a trajectory is sampled on that clock (leave the option out)",
+            profile.name,
+            clock_s * 1e3
+        ),
+        _ => Ok(trajectory_period_s(clock_s * 1e3)?),
+    }
 }
 
 /// The date-time a parts log records (local time, to the second).

@@ -14,7 +14,9 @@ use thiserror::Error;
 /// * 3: `[gcode] mode = "linuxcnc"` with `laser_output`, `power_output`, `path_tol_mm`; a
 ///   `[controller]` table (the controller's time law). Every version-2 file is a valid
 ///   version-3 file.
-pub const PROFILE_VERSION: u32 = 3;
+/// * 4: `[controller] clock_period_s`, a scan head's clock (plans made on it). Every version-3
+///   file is a valid version-4 file.
+pub const PROFILE_VERSION: u32 = 4;
 
 /// Limits of one base-stage axis (seed 002, Table 2 style).
 ///
@@ -247,6 +249,31 @@ pub struct Controller {
     pub servo_period_s: f64,
     /// Scanner axes' acceleration as the controller drives them, mm/s².
     pub scanner_accel_mm_s2: f64,
+    /// A scan-head controller's clock period, s: when given, every plan is made on it (each
+    /// mark starts and ends on a tick), and a trajectory is sampled on it. None: the plan is
+    /// continuous. A LinuxCNC controller's clock is its servo period.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub clock_period_s: Option<f64>,
+}
+
+impl Controller {
+    /// The controller's clock period, s, if it has one: the servo period of LinuxCNC, the
+    /// scan head's clock when the profile gives one.
+    pub fn clock_s(&self) -> Option<f64> {
+        match self.kind {
+            ControllerKind::Linuxcnc => Some(self.servo_period_s),
+            ControllerKind::Ideal => self.clock_period_s,
+        }
+    }
+
+    /// The clock the lowering puts marks on ([`crate::motion::Toolpath::on_clock`]): the scan
+    /// head's. LinuxCNC's time law already counts every move in whole servo periods.
+    pub fn marks_clock_s(&self) -> Option<f64> {
+        match self.kind {
+            ControllerKind::Linuxcnc => None,
+            ControllerKind::Ideal => self.clock_period_s,
+        }
+    }
 }
 
 impl Default for Controller {
@@ -255,6 +282,7 @@ impl Default for Controller {
             kind: ControllerKind::Ideal,
             servo_period_s: 1e-3,
             scanner_accel_mm_s2: 1e6,
+            clock_period_s: None,
         }
     }
 }
@@ -361,10 +389,11 @@ fn upgrade(table: &mut toml::Table) {
     let Some(version) = table.get("version").and_then(toml::Value::as_integer) else {
         return;
     };
-    if version == 1 || version == 2 {
-        // 1 → 2 and 2 → 3 only added fields, each with a default that keeps the earlier
-        // behaviour (acceleration as given, no settling, tool-centre G-code, ideal controller)
-        table.insert("version".into(), toml::Value::Integer(3));
+    if (1..=3).contains(&version) {
+        // 1 → 2, 2 → 3 and 3 → 4 only added fields, each with a default that keeps the earlier
+        // behaviour (acceleration as given, no settling, tool-centre G-code, ideal controller,
+        // no scan-head clock)
+        table.insert("version".into(), toml::Value::Integer(4));
     }
 }
 

@@ -637,6 +637,14 @@ fn controller_specs() -> Vec<FieldSpec<MachineProfile>> {
             Range(1e-5, 0.01),
             |p| p.controller.servo_period_s
         ),
+        optional!(
+            "Scan-head clock",
+            "s",
+            "controller.clock_period_s",
+            "the scan head's clock period: every mark starts and ends on a tick; empty: continuous",
+            Range(1e-6, 0.1),
+            |p| p.controller.clock_period_s
+        ),
         number!(
             "Scanner accel",
             "mm/s²",
@@ -1127,6 +1135,8 @@ pub mod rows {
     /// LinuxCNC's servo period.
     pub const SERVO_PERIOD: Row<MachineProfile> =
         Row::new("controller.servo_period_s", profile_specs);
+    /// A scan head's clock.
+    pub const CLOCK: Row<MachineProfile> = Row::new("controller.clock_period_s", profile_specs);
     /// LinuxCNC's scanner acceleration.
     pub const SCANNER_ACCEL: Row<MachineProfile> =
         Row::new("controller.scanner_accel_mm_s2", profile_specs);
@@ -1177,6 +1187,9 @@ pub const PROFILE_APPLIES: &[AppliesWhen] = &[
     }),
     (&[rows::SERVO_PERIOD], |p| {
         p.controller.kind == ControllerKind::Linuxcnc
+    }),
+    (&[rows::CLOCK], |p| {
+        p.controller.kind == ControllerKind::Ideal
     }),
     // also the scanner's acceleration in linuxcnc-config's machine
     (&[rows::SCANNER_ACCEL], |p| {

@@ -34,9 +34,10 @@ pub fn trajectory_period_s(period_ms: f64) -> Result<f64, PeriodError> {
 }
 
 /// Samples `toolpath` every `period_s` from t = 0 to its end (the last sample at or after the
-/// end): one CSV row per sample, tool-centre point = stage + scan, laser 0/1. Run the toolpath
-/// [`Toolpath::on_clock`] of the same period first so that every mark starts and ends on a
-/// sample.
+/// end): one CSV row per sample, tool-centre point = stage + scan, laser 0/1. The toolpath is
+/// sampled, never changed: on a profile with a controller clock (and `period_s` that clock)
+/// every mark starts and ends on a sample; a continuous plan's marks shorter than a period may
+/// fall between samples (sample it finer to see them).
 pub fn trajectory_csv(toolpath: &Toolpath, period_s: f64) -> String {
     let end_s = toolpath.duration_s();
     let samples = crate::motion::ticks_covering(end_s, period_s) + 1;

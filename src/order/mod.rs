@@ -487,7 +487,8 @@ impl<'a> Candidates<'a> {
         } else {
             self.ctx
         };
-        match lower_motion(self.real, &plan, None, ctx) {
+        let clock_s = plan.profile.controller.marks_clock_s();
+        match lower_motion(self.real, &plan, clock_s, ctx) {
             Err(MotionError::OnTheFly(OtfError::Cancelled(c))) => Err(OrderError::Cancelled(c)),
             other => Ok(other?),
         }
