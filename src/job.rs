@@ -59,6 +59,21 @@ impl ProgressSink for NoProgress {
     fn report(&self, _: &Progress) {}
 }
 
+/// A sink that prefixes every message with a label ([`JobCtx::labelled`]).
+struct Labelled {
+    label: &'static str,
+    inner: Arc<dyn ProgressSink>,
+}
+
+impl ProgressSink for Labelled {
+    fn report(&self, p: &Progress) {
+        self.inner.report(&Progress {
+            message: format!("{}: {}", self.label, p.message),
+            ..p.clone()
+        });
+    }
+}
+
 /// Records a run for later inspection (implemented with rerun behind the `rerun` feature).
 pub trait RunRecorder: Send + Sync {
     /// The imported geometry.
@@ -104,6 +119,18 @@ impl JobCtx {
             progress,
             recorder: None,
             started: Instant::now(),
+        }
+    }
+    /// The same job (cancel, recorder, clock) with every progress message prefixed by `label`
+    /// ("Marked whole: "): what candidates planned side by side report, so that their
+    /// interleaved words say which is which.
+    pub fn labelled(&self, label: &'static str) -> Self {
+        Self {
+            progress: Arc::new(Labelled {
+                label,
+                inner: self.progress.clone(),
+            }),
+            ..self.clone()
         }
     }
     /// Adds a run recorder.

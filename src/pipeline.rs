@@ -586,8 +586,15 @@ fn whole_or_cut(
     let whole_region = whole_work_region(&doc.geometries);
     let mut on_the_fly = judge.clone();
     on_the_fly.settings.motion = MotionMode::OnTheFly;
+    let whole_ctx = ctx.labelled("Marked whole");
     let order_whole = || {
-        order_plan(&doc.geometries, &whole_region.fields, &on_the_fly, ctx).map_err(as_order_error)
+        order_plan(
+            &doc.geometries,
+            &whole_region.fields,
+            &on_the_fly,
+            &whole_ctx,
+        )
+        .map_err(as_order_error)
     };
     let (mut made, lower_bound, note) = if judge.settings.stage_route != StageRouteKind::Taut {
         let whole = order_whole()?;
@@ -604,15 +611,13 @@ fn whole_or_cut(
         // the candidates are independent: planned side by side (each is deterministic)
         let started = Instant::now();
         let (whole, cuts_made) = rayon::join(order_whole, || {
-            tilings
-                .into_par_iter()
-                .map(cut)
-                .collect::<Result<Vec<_>, PipelineError>>()
+            tilings.into_par_iter().map(cut).collect::<Vec<_>>()
         });
-        let (whole, cuts_made) = (whole?, cuts_made?);
+        let (whole, cuts_made) = finished_candidates(whole, cuts_made)?;
         // the order stage's wall time (the candidates' own times, in the detail, overlap)
         let order_s = started.elapsed().as_secs_f64();
         choose_whole_or_cut(doc, whole, whole_region, cuts_made, order_s)
+            .ok_or_else(|| as_order_error(OrderError::Cancelled(crate::job::Cancelled)))?
     };
     // this choice replaces the last one's words
     doc.warnings
@@ -625,11 +630,54 @@ fn whole_or_cut(
     Ok((lower_bound, reusable.then_some(made)))
 }
 
-/// The tilings a cut is tried on: the document's and, when nothing is cut yet and no seam was
+/// The whole and cut candidates that were made: after a cancel, those finished (at least one;
+/// the solve then names its plan stopped); any other error is the solve's.
+#[allow(clippy::type_complexity)] // two results, each its own candidate type
+fn finished_candidates(
+    whole: Result<(Plan, Toolpath), PipelineError>,
+    cuts: Vec<Result<CutCandidate, PipelineError>>,
+) -> Result<(Option<(Plan, Toolpath)>, Vec<CutCandidate>), PipelineError> {
+    let cancelled = |e: &PipelineError| {
+        matches!(
+            e,
+            PipelineError::Order {
+                source: OrderError::Cancelled(_),
+                ..
+            } | PipelineError::Fields {
+                source: crate::fields::FieldError::Cancelled(_),
+                ..
+            }
+        )
+    };
+    let mut stop = None;
+    let whole = match whole {
+        Ok(made) => Some(made),
+        Err(e) if cancelled(&e) => {
+            stop = Some(e);
+            None
+        }
+        Err(e) => return Err(e),
+    };
+    let mut made = Vec::new();
+    for c in cuts {
+        match c {
+            Ok(c) => made.push(c),
+            Err(e) if cancelled(&e) => stop = Some(e),
+            Err(e) => return Err(e),
+        }
+    }
+    match stop {
+        Some(e) if whole.is_none() && made.is_empty() => Err(e),
+        _ => Ok((whole, made)),
+    }
+}
+
+/// The tilings a cut is tried on, each with its label (the order stage's detail) and words (its
+/// progress): the document's and, when nothing is cut yet and no seam was
 /// set by hand, also the plain field grid anchored at the corner (on the fly its pieces can run
 /// faster: oversize.svg on the LinuxCNC clock 18.36 s against 20.71 s).
-fn cut_tilings(doc: &Document) -> Vec<(&'static str, Option<Tiling>)> {
-    let mut tilings = vec![("cut", doc.tiling.clone())];
+fn cut_tilings(doc: &Document) -> Vec<(&'static str, &'static str, Option<Tiling>)> {
+    let mut tilings = vec![("cut", "Cut at field borders", doc.tiling.clone())];
     if doc.seams.cuts == 0 && doc.tiling_set.is_none() {
         let extent = doc
             .geometries
@@ -641,6 +689,7 @@ fn cut_tilings(doc: &Document) -> Vec<(&'static str, Option<Tiling>)> {
         let cell = [fw - FIELD_GRID_SLACK_MM, fh - FIELD_GRID_SLACK_MM];
         tilings.push((
             "cut on the field grid",
+            "Cut on the field grid",
             Some(Tiling::anchored(extent, cell)),
         ));
     }
@@ -653,10 +702,11 @@ fn plan_cut(
     doc: &Document,
     locked: &[ScanField],
     judge: &PlanInputs,
-    (label, tiling): (&'static str, Option<Tiling>),
+    (label, words, tiling): (&'static str, &'static str, Option<Tiling>),
     file: &str,
     ctx: &JobCtx,
 ) -> Result<CutCandidate, PipelineError> {
+    let ctx = &ctx.labelled(words);
     let mut pieces = doc.geometries.clone();
     let (warnings, seams, tiling) = split_oversize(
         &mut pieces,
@@ -688,17 +738,20 @@ fn plan_cut(
     })
 }
 
-/// Keeps the faster of `whole` (one region, on the fly) and the best cut candidate on the
-/// lowered job time, installs its geometries and fields in `doc`, and says why; the plan's
+/// Keeps the faster of `whole` (one region, on the fly; none when a cancel stopped it) and the
+/// best cut candidate on the lowered job time (none when neither was made), installs its geometries and fields in `doc`, and says why; the plan's
 /// order stage gets every candidate's ordering time in its detail and `order_s` as its time.
 fn choose_whole_or_cut(
     doc: &mut Document,
-    whole: (Plan, Toolpath),
+    whole: Option<(Plan, Toolpath)>,
     whole_region: Placement,
     cuts: Vec<CutCandidate>,
     order_s: f64,
-) -> ((Plan, Toolpath), usize, String) {
-    let mut detail = vec![("whole".to_string(), whole.0.metrics.solve_s.order)];
+) -> Option<((Plan, Toolpath), usize, String)> {
+    let mut detail: Vec<(String, f64)> = whole
+        .iter()
+        .map(|w| ("whole".to_string(), w.0.metrics.solve_s.order))
+        .collect();
     detail.extend(
         cuts.iter()
             .map(|c| (c.label.to_string(), c.made.0.metrics.solve_s.order)),
@@ -706,21 +759,31 @@ fn choose_whole_or_cut(
     let best = cuts
         .into_iter()
         .min_by(|a, b| a.job_s().total_cmp(&b.job_s()));
-    let whole_s = format_s(whole.1.duration_s());
-    let (mut made, lower_bound, note) = match best {
-        Some(c) if c.job_s() < whole.1.duration_s() => {
+    let cut_wins = match (&best, &whole) {
+        (Some(c), Some(w)) => c.job_s() < w.1.duration_s(),
+        (Some(_), None) => true,
+        (None, _) => false,
+    };
+    let whole_s = whole.as_ref().map_or_else(
+        || "– (stopped before it was planned)".into(),
+        |w| format_s(w.1.duration_s()),
+    );
+    let (mut made, lower_bound, note) = match (best, whole) {
+        (Some(c), _) if cut_wins => {
             let cut_s = format_s(c.job_s());
             cut_geometries(doc, c.pieces, c.warnings, c.seams, c.tiling);
             doc.fields = c.placement.fields;
             let note = format!("cut at field borders: the job takes {cut_s} s cut against {whole_s} s marked whole on the fly");
             (c.made, c.placement.lower_bound, note)
         }
-        best => {
+        (best, Some(whole)) => {
             let cut_s = best.map_or_else(|| "–".into(), |c| format_s(c.job_s()));
             doc.fields = whole_region.fields;
             let note = format!("marked whole on the fly: the job takes {whole_s} s against {cut_s} s cut at field borders");
             (whole, whole_region.lower_bound, note)
         }
+        // finished_candidates keeps at least one
+        (_, None) => return None,
     };
     let solve = &mut made.0.metrics.solve_s;
     solve.order_detail = detail
@@ -728,7 +791,7 @@ fn choose_whole_or_cut(
         .chain(solve.order_detail.drain(..))
         .collect();
     solve.order = order_s;
-    (made, lower_bound, note)
+    Some((made, lower_bound, note))
 }
 
 /// How the warning about the whole-or-cut choice begins (a placement replaces the last one's).

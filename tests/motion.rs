@@ -799,3 +799,105 @@ fn a_mixed_job_holds_the_stage_still_while_its_step_and_scan_fields_are_marked()
         .lines()
         .any(|l| l.starts_with("; field") && l.ends_with(", on the fly")));
 }
+
+/// Every progress message of a solve, and a cancel sent when one of them contains `cancel_at`.
+struct Watch {
+    seen: std::sync::Mutex<Vec<galvoplan::job::Progress>>,
+    cancel_at: Option<(&'static str, galvoplan::job::CancelToken)>,
+}
+
+impl galvoplan::job::ProgressSink for Watch {
+    fn report(&self, p: &galvoplan::job::Progress) {
+        if let Some((at, token)) = &self.cancel_at {
+            if p.message.contains(at) {
+                token.cancel();
+            }
+        }
+        self.seen.lock().unwrap().push(p.clone());
+    }
+}
+
+/// The oversize example on the fly: several candidate plans (fields, bands, rings centred).
+fn solve_watched(
+    cancel_at: Option<&'static str>,
+) -> (
+    Result<Plan, galvoplan::pipeline::PipelineError>,
+    Vec<galvoplan::job::Progress>,
+) {
+    let path = common::root().join("assets/examples/oversize.svg");
+    let settings = SolverSettings {
+        motion: galvoplan::document::MotionMode::OnTheFly,
+        ..SolverSettings::default()
+    };
+    let profile = MachineProfile::default();
+    let (mut doc, _) = load_svg(&path, profile, settings, &ImportOptions::default()).unwrap();
+    let token = galvoplan::job::CancelToken::new();
+    let watch = std::sync::Arc::new(Watch {
+        seen: std::sync::Mutex::new(Vec::new()),
+        cancel_at: cancel_at.map(|at| (at, token.clone())),
+    });
+    let ctx = JobCtx::new(token, watch.clone());
+    let plan = plan_document(&mut doc, &ctx);
+    let seen = watch.seen.lock().unwrap().clone();
+    (plan, seen)
+}
+
+#[test]
+fn an_on_the_fly_solve_reports_every_candidate_and_never_says_done_early() {
+    let (plan, seen) = solve_watched(None);
+    plan.unwrap();
+    let words: Vec<&str> = seen.iter().map(|p| p.message.as_str()).collect();
+    assert!(
+        words.iter().all(|w| !w.to_lowercase().contains("done")),
+        "{words:?}"
+    );
+    // each solve side by side (marked whole, cut) says which it is, and counts its candidates
+    // up to all of them, after its ordering
+    let mut labels: Vec<&str> = words
+        .iter()
+        .filter_map(|w| w.split_once(": On the fly:").map(|(label, _)| label))
+        .collect();
+    labels.sort_unstable();
+    labels.dedup();
+    assert!(labels.len() >= 2, "{words:?}");
+    for label in labels {
+        let own: Vec<_> = seen
+            .iter()
+            .filter(|p| p.message.starts_with(&format!("{label}: ")))
+            .collect();
+        let motion: Vec<_> = own.iter().filter(|p| p.stage == "motion").collect();
+        let (first, last) = (motion[0], motion[motion.len() - 1]);
+        assert_eq!(first.done, 0, "{label}: {words:?}");
+        assert!(first.total >= 2, "several candidates: {words:?}");
+        assert_eq!(last.done, last.total, "{label}: {words:?}");
+        let order_last = own.iter().rposition(|p| p.stage == "order").unwrap();
+        let motion_first = own.iter().position(|p| p.stage == "motion").unwrap();
+        assert!(order_last < motion_first, "{label}: {words:?}");
+        assert!(
+            motion.windows(2).all(|w| w[0].done <= w[1].done),
+            "{words:?}"
+        );
+    }
+}
+
+#[test]
+fn a_cancel_among_the_candidates_keeps_the_fastest_finished() {
+    let (whole, _) = solve_watched(None);
+    let whole_s = whole.unwrap().metrics.job_time_s.unwrap();
+    let (plan, seen) = solve_watched(Some("1 of"));
+    let plan = plan.expect("a cancel after the first candidate keeps it");
+    let kept_s = plan.metrics.job_time_s.unwrap();
+    assert!(kept_s >= whole_s - 1e-9, "{kept_s} vs {whole_s}");
+    let words: Vec<&str> = seen.iter().map(|p| p.message.as_str()).collect();
+    assert!(
+        words
+            .iter()
+            .any(|w| w.contains("On the fly: stopping, keeping the fastest of the")),
+        "{words:?}"
+    );
+    // a cancel before any candidate finished still ends with the first one made
+    let (plan, seen) = solve_watched(Some("0 of"));
+    plan.expect("the algorithm's ordering is lowered to the end");
+    let words: Vec<&str> = seen.iter().map(|p| p.message.as_str()).collect();
+    assert!(words.iter().any(|w| w.contains("stopping")), "{words:?}");
+}

@@ -44,6 +44,12 @@ pub(super) fn faster_mixed(
     let Some(reach_mm) = still_reach_mm(profile).filter(|_| tried) else {
         return Ok(None);
     };
+    ctx.progress(
+        "motion",
+        0,
+        1,
+        "Mixed: trying fields marked step-and-scan in the on-the-fly plan",
+    );
     let stepping = Candidates::new(nodes, inputs, Motion::Step, ctx);
     let Ok(step) = stepping.toolpath(&flying.ordering) else {
         // an order step-and-scan cannot mark (a geometry larger than its field)

@@ -276,11 +276,14 @@ fn finish(
         detail.push(("bands".into(), t.elapsed().as_secs_f64()));
         return Ok(best);
     }
+    let ctx = lower.ctx;
     if settings.cost_model == CostModel::Time {
+        ctx.progress("motion", 0, 1, "Step and scan: ordering for job time");
         let best = time_ordering(lower, ordering, until)?;
         detail.push(("time".into(), t.elapsed().as_secs_f64()));
         return Ok(best);
     }
+    ctx.progress("motion", 0, 1, "Step and scan: timing the plan");
     let toolpath = lower.toolpath(&ordering)?;
     Ok((ordering, toolpath))
 }
@@ -479,14 +482,27 @@ impl<'a> Candidates<'a> {
         ordering: &Ordering,
         step_fields: &[usize],
     ) -> Result<Toolpath, OrderError> {
-        let mut plan = self.plan(ordering);
-        plan.step_fields = step_fields.to_vec();
         let finish = JobCtx::default();
         let ctx = if self.ctx.is_cancelled() {
             &finish
         } else {
             self.ctx
         };
+        self.lower_with(ordering, step_fields, ctx)
+    }
+    /// The toolpath of an ordering, lowered to the end whatever cancel comes.
+    fn toolpath_to_the_end(&self, ordering: &Ordering) -> Result<Toolpath, OrderError> {
+        self.lower_with(ordering, &[], &JobCtx::default())
+    }
+    /// The toolpath of an ordering with `step_fields` marked step-and-scan, on `ctx`.
+    fn lower_with(
+        &self,
+        ordering: &Ordering,
+        step_fields: &[usize],
+        ctx: &JobCtx,
+    ) -> Result<Toolpath, OrderError> {
+        let mut plan = self.plan(ordering);
+        plan.step_fields = step_fields.to_vec();
         let clock_s = plan.profile.controller.marks_clock_s();
         match lower_motion(self.real, &plan, clock_s, ctx) {
             Err(MotionError::OnTheFly(OtfError::Cancelled(c))) => Err(OrderError::Cancelled(c)),
@@ -523,6 +539,9 @@ fn run_algorithm(
 /// On the fly: the algorithm's ordering, the sweep of field-wide bands
 /// ([`bands::band_order`]) or either with its nested rings centred
 /// ([`nested::nested_centred`]), whichever runs faster on the taut route, with that toolpath.
+/// Each candidate's lowering is reported as it ends ([`Tally`]). A cancel keeps the fastest
+/// candidate finished so far (the solve then names its plan stopped): the algorithm's ordering
+/// is lowered to the end whatever comes, the other candidates stop.
 fn faster_on_the_fly(
     lower: &Candidates,
     ordering: Ordering,
@@ -533,12 +552,6 @@ fn faster_on_the_fly(
     let bands = (bands.steps != ordering.steps).then_some(bands);
     let reach_mm = band_mm / 2.0 - lower.inputs.profile.otf_margin_mm;
     let nest = |o: &Ordering| nested::nested_centred(o, lower.geometries, reach_mm);
-    let lowered = |o: Option<Ordering>| -> Result<Option<(Ordering, Toolpath)>, OrderError> {
-        match o.filter(|_| !lower.ctx.is_cancelled()) {
-            Some(o) => lower.toolpath(&o).map(|t| Some((o, t))),
-            None => Ok(None),
-        }
-    };
     let centred = nest(&ordering);
     // the lowerings side by side where the stage stops and goes (texture.toml: the wait-first
     // tracking leaves the second core idle once the window rule has given up; 23.6 -> 17.6 s,
@@ -548,28 +561,123 @@ fn faster_on_the_fly(
     // on the faster of the two orderings only.
     if centred.is_some() && lower.real.len() < FLY_SKIP_STROKES_MIN {
         let centred_bands = bands.as_ref().and_then(nest);
-        let ((by_fields, by_bands), (by_centred, by_centred_bands)) = rayon::join(
-            || rayon::join(|| lower.toolpath(&ordering), || lowered(bands)),
-            || rayon::join(|| lowered(centred), || lowered(centred_bands)),
+        // four candidates at most: those that are not are counted out
+        let tally = Tally::new(lower, 4);
+        let by_fields = ordering.clone();
+        let ((a, b), (c, d)) = rayon::join(
+            || rayon::join(|| tally.keep(by_fields), || tally.lower(bands)),
+            || rayon::join(|| tally.lower(centred), || tally.lower(centred_bands)),
         );
-        let mut best = (ordering, by_fields?);
-        for candidate in [by_bands?, by_centred?, by_centred_bands?]
-            .into_iter()
-            .flatten()
-        {
-            best = faster(best, candidate);
+        return tally.fastest([a, b, c, d]);
+    }
+    let tally = Tally::new(lower, 3);
+    let by_fields = tally.keep(ordering);
+    let by_bands = tally.lower(bands);
+    let best = tally.fastest([by_fields, by_bands])?;
+    let by_centred = tally.lower(nest(&best.0));
+    tally.fastest([Ok(Some(best)), by_centred])
+}
+
+/// The on-the-fly candidates of one solve as they are lowered: progress in words ("On the fly:
+/// 2 of 4 candidate plans made, the fastest 12.31 s") and the fastest of those finished.
+struct Tally<'a> {
+    lower: &'a Candidates<'a>,
+    /// Candidates finished, the fastest job time among them, and candidates in all.
+    done: std::sync::Mutex<(usize, f64, usize)>,
+}
+
+impl<'a> Tally<'a> {
+    fn new(lower: &'a Candidates<'a>, total: usize) -> Self {
+        let tally = Self {
+            lower,
+            done: std::sync::Mutex::new((0, f64::INFINITY, total)),
+        };
+        tally.report();
+        tally
+    }
+
+    /// Reports how many candidates are made.
+    fn report(&self) {
+        let Ok(done) = self.done.lock() else { return };
+        let (n, best_s, total) = *done;
+        drop(done);
+        let message = match (self.lower.ctx.is_cancelled(), best_s.is_finite()) {
+            (false, false) => format!("On the fly: {n} of {total} candidate plans made"),
+            (false, true) => {
+                format!("On the fly: {n} of {total} candidate plans made, the fastest {best_s:.2} s")
+            }
+            (true, false) => "On the fly: stopping once the first candidate plan is made".into(),
+            (true, true) => format!(
+                "On the fly: stopping, keeping the fastest of the {n} candidate plans made ({best_s:.2} s)"
+            ),
+        };
+        self.lower
+            .ctx
+            .progress("motion", n as u64, total as u64, message);
+    }
+
+    /// Lowers candidate `o` (none: not a candidate of this job; not started after a cancel,
+    /// stopped by one).
+    fn lower(&self, o: Option<Ordering>) -> Result<Option<(Ordering, Toolpath)>, OrderError> {
+        let Some(o) = o.filter(|_| !self.lower.ctx.is_cancelled()) else {
+            // one candidate fewer to wait for
+            if let Ok(mut done) = self.done.lock() {
+                done.2 = done.2.saturating_sub(1).max(done.0);
+            }
+            self.report();
+            return Ok(None);
+        };
+        let toolpath = self.lower.toolpath(&o)?;
+        Ok(Some(self.made(o, toolpath)))
+    }
+
+    /// Lowers candidate `o` to the end, cancelled or not: the plan a cancel keeps.
+    fn keep(&self, o: Ordering) -> Result<Option<(Ordering, Toolpath)>, OrderError> {
+        let toolpath = self.lower.toolpath_to_the_end(&o)?;
+        Ok(Some(self.made(o, toolpath)))
+    }
+
+    /// Counts a finished candidate and reports.
+    fn made(&self, o: Ordering, toolpath: Toolpath) -> (Ordering, Toolpath) {
+        if let Ok(mut done) = self.done.lock() {
+            done.0 += 1;
+            done.1 = done.1.min(toolpath.duration_s());
         }
-        return Ok(best);
+        self.report();
+        (o, toolpath)
     }
-    let by_fields = lower.toolpath(&ordering)?;
-    let mut best = (ordering, by_fields);
-    if let Some(by_bands) = lowered(bands)? {
-        best = faster(best, by_bands);
+
+    /// The fastest of `candidates` (the first on a tie): a cancelled one is left out, and an
+    /// error is only returned when no candidate was made.
+    fn fastest<const N: usize>(
+        &self,
+        candidates: [Result<Option<(Ordering, Toolpath)>, OrderError>; N],
+    ) -> Result<(Ordering, Toolpath), OrderError> {
+        if self.lower.ctx.is_cancelled() {
+            // says what the cancel keeps
+            self.report();
+        }
+        let mut best: Option<(Ordering, Toolpath)> = None;
+        let mut cancelled = None;
+        for c in candidates {
+            match c {
+                Ok(Some(c)) => {
+                    best = Some(match best {
+                        Some(b) => faster(b, c),
+                        None => c,
+                    })
+                }
+                Ok(None) => {}
+                Err(OrderError::Cancelled(c)) => cancelled = Some(c),
+                Err(e) => return Err(e),
+            }
+        }
+        match (best, cancelled) {
+            (Some(best), _) => Ok(best),
+            (None, Some(c)) => Err(OrderError::Cancelled(c)),
+            (None, None) => Err(OrderError::Cancelled(crate::job::Cancelled)),
+        }
     }
-    if let Some(by_centred) = lowered(nest(&best.0))? {
-        best = faster(best, by_centred);
-    }
-    Ok(best)
 }
 
 /// The fields of `order` (ids) in that order.

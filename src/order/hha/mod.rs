@@ -717,7 +717,7 @@ pub fn hha_order(
         steps = super::time::best_free_field_path(geometries, &steps, &seeds, until, ctx)?;
         stage_s.push(("free path".into(), t.elapsed().as_secs_f64()));
     }
-    ctx.progress("order", 4, 4, "HHA: done");
+    ctx.progress("order", 4, 4, "HHA: order made");
     Ok(Ordering {
         field_order: ordered.iter().map(|f| f.id).collect(),
         steps,
