@@ -299,3 +299,31 @@ fn a_cut_is_the_placements_choice_and_a_step_placement_starts_again_from_whole_g
     assert_eq!(doc.geometries.len(), whole);
     assert_eq!(choices(&doc), 0);
 }
+
+/// A layer named after its stroke colour (an SVG without layer groups) is said by a colour
+/// word in stale reasons, and a value its pen leaves to the profile by the profile's value.
+#[test]
+fn stale_reasons_name_a_colour_layer_in_words() {
+    use galvoplan::document::staleness;
+    let dir = tempfile::tempdir().unwrap();
+    let svg = dir.path().join("grey.svg");
+    std::fs::write(
+        &svg,
+        r##"<svg xmlns="http://www.w3.org/2000/svg" width="40mm" height="40mm" viewBox="0 0 40 40">
+<path d="M5 5 L30 5 L30 30" fill="none" stroke="#1f2937"/></svg>"##,
+    )
+    .unwrap();
+    let (mut doc, _) = load_svg(
+        &svg,
+        MachineProfile::default(),
+        SolverSettings::default(),
+        &ImportOptions::default(),
+    )
+    .unwrap();
+    let plan = plan_document(&mut doc, &JobCtx::default()).unwrap();
+    doc.plans.push(plan);
+    assert_eq!(doc.layers[0].name, "#1f2937");
+    doc.layers[0].pen.mark_speed_mm_s = Some(500.0);
+    let why = staleness(&doc.plans[0], &doc);
+    assert_eq!(why, ["dark grey (#1f2937): mark speed 1000 → 500 mm/s"]);
+}

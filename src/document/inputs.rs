@@ -152,9 +152,11 @@ fn layer_differences(
                     &with_profile(&l.pen, profile),
                 )
                 .into_iter()
-                .map(|d| format!("{}: {d}", l.name)),
+                .map(|d| format!("{}: {d}", super::layer_label(&l.name))),
             ),
-            None if !planned.is_empty() => why.push(format!("{}: a new layer", l.name)),
+            None if !planned.is_empty() => {
+                why.push(format!("{}: a new layer", super::layer_label(&l.name)))
+            }
             None => {}
         }
     }

@@ -26,8 +26,8 @@ pub use hatch::{
 };
 pub use inputs::{staleness, GeometryRevision, PlanInputs};
 pub use pens::{
-    parse_colour, passes_of, pen_of, sync_layers, validate_layers, Layer, MarkTiming, Pen,
-    PenLibrary, PensError, DEFAULT_LAYER, MAX_PASSES, PENS_VERSION,
+    colour_word, layer_label, parse_colour, passes_of, pen_of, sync_layers, validate_layers, Layer,
+    MarkTiming, Pen, PenLibrary, PensError, DEFAULT_LAYER, MAX_PASSES, PENS_VERSION,
 };
 pub use plan::{
     GenerationRecord, Metrics, MotionFigures, MotionRegion, ObjectiveKind, Plan, ScanField,

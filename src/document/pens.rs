@@ -456,6 +456,86 @@ impl PenLibrary {
     }
 }
 
+/// How the window names a layer: its own name, or for a layer named after its stroke colour
+/// (`#rrggbb`, what an SVG without layer groups gives) a colour word and the hex, e.g.
+/// `dark grey (#1f2937)`. Display only (the window, stale reasons): the document and pens files
+/// keep the name.
+pub fn layer_label(name: &str) -> String {
+    match crate::document::parse_colour(name) {
+        Some(rgb) => format!("{} ({name})", colour_word(rgb)),
+        None => name.to_string(),
+    }
+}
+
+/// A plain word for a colour: black, white, (dark/light) grey, or a hue (red, orange, brown,
+/// yellow, olive, green, teal, cyan, blue, purple, magenta, pink) with "dark" or "light" when
+/// it is far from mid lightness.
+pub fn colour_word([r, g, b]: [u8; 3]) -> String {
+    let (r, g, b) = (
+        f32::from(r) / 255.0,
+        f32::from(g) / 255.0,
+        f32::from(b) / 255.0,
+    );
+    let max = r.max(g).max(b);
+    let min = r.min(g).min(b);
+    let chroma = max - min;
+    let light = (max + min) / 2.0;
+    if chroma < 0.12 {
+        return match light {
+            l if l < 0.1 => "black",
+            l if l < 0.33 => "dark grey",
+            l if l < 0.7 => "grey",
+            l if l < 0.93 => "light grey",
+            _ => "white",
+        }
+        .to_string();
+    }
+    let hue = if max == r {
+        60.0 * ((g - b) / chroma).rem_euclid(6.0)
+    } else if max == g {
+        60.0 * ((b - r) / chroma + 2.0)
+    } else {
+        60.0 * ((r - g) / chroma + 4.0)
+    };
+    let saturation = chroma / (1.0 - (2.0 * light - 1.0).abs()).max(1e-6);
+    let base = match hue {
+        h if !(12.0..345.0).contains(&h) => {
+            if light < 0.45 && saturation < 0.5 {
+                "brown"
+            } else {
+                "red"
+            }
+        }
+        h if h < 45.0 => {
+            if light < 0.45 {
+                "brown"
+            } else {
+                "orange"
+            }
+        }
+        h if h < 70.0 => {
+            if light < 0.35 {
+                "olive"
+            } else {
+                "yellow"
+            }
+        }
+        h if h < 165.0 => "green",
+        h if h < 175.0 => "teal",
+        h if h < 192.0 => "cyan",
+        h if h < 255.0 => "blue",
+        h if h < 290.0 => "purple",
+        _ if light > 0.6 => "pink",
+        _ => "magenta",
+    };
+    let shade = match light {
+        l if l < 0.28 && base != "brown" && base != "olive" => "dark ",
+        l if l > 0.78 && base != "pink" => "light ",
+        _ => "",
+    };
+    format!("{shade}{base}")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
