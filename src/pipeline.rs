@@ -502,6 +502,57 @@ pub fn place_document_fields(doc: &mut Document, ctx: &JobCtx) -> Result<usize, 
     place_and_choose(doc, ctx).map(|(lower_bound, _)| lower_bound)
 }
 
+/// [`place_document_fields`] for a workbench: where step-and-scan geometries are larger than
+/// a field (and neither splitting nor on the fly is chosen), fields are still placed for every
+/// geometry that fits, and the larger ones are left uncovered; returns that error beside the
+/// placement (`Some`), for the caller to say once. Any other error is returned.
+pub fn place_what_fits(
+    doc: &mut Document,
+    ctx: &JobCtx,
+) -> Result<Option<PipelineError>, PipelineError> {
+    let oversize = match place_document_fields(doc, ctx) {
+        Ok(_) => return Ok(None),
+        Err(
+            e @ PipelineError::Fields {
+                source: FieldError::Oversize { .. },
+                ..
+            },
+        ) => e,
+        Err(e) => return Err(e),
+    };
+    let field_mm = doc.profile.field_mm;
+    let fits: Vec<usize> = (0..doc.geometries.len())
+        .filter(|&i| !crate::fields::is_oversize(&doc.geometries[i], field_mm))
+        .collect();
+    let subset: Vec<crate::document::Geometry> =
+        fits.iter().map(|&i| doc.geometries[i].clone()).collect();
+    let locked: Vec<ScanField> = doc.fields.iter().filter(|f| f.locked).cloned().collect();
+    let file = doc.source.clone().unwrap_or_else(|| "document".into());
+    let placement = place_fields(&subset, &doc.profile, &doc.settings, &[], ctx)
+        .map_err(|source| PipelineError::Fields { file, source })?;
+    // locked fields stay where they are, holding what they held
+    let mut fields = locked;
+    let next_id = fields.iter().map(|f| f.id + 1).max().unwrap_or(0);
+    let held: std::collections::HashSet<usize> = fields
+        .iter()
+        .flat_map(|f| f.geometries.iter().copied())
+        .collect();
+    for (k, mut f) in placement.fields.into_iter().enumerate() {
+        f.id = next_id + k;
+        f.geometries = f
+            .geometries
+            .iter()
+            .map(|&j| fits[j])
+            .filter(|g| !held.contains(g))
+            .collect();
+        if !f.geometries.is_empty() {
+            fields.push(f);
+        }
+    }
+    doc.fields = fields;
+    Ok(Some(oversize))
+}
+
 /// A plan and its toolpath made while choosing the geometries, reusable by the solve.
 type Made = Option<(Plan, Toolpath)>;
 

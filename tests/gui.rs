@@ -19,8 +19,8 @@ fn demo() -> PathBuf {
     common::root().join("assets/examples/demo.svg")
 }
 
-/// `assets/examples/oversize.svg` opened (no fields could be placed: every geometry is
-/// uncovered) and its geometry count.
+/// `assets/examples/oversize.svg` opened in step-and-scan (fields for what fits; the strokes
+/// larger than a field uncovered) and its geometry count.
 fn opened_oversize() -> (Harness<'static, App>, usize) {
     let h = opened(&common::root().join("assets/examples/oversize.svg"));
     let n = h.state().session.doc().geometries.len();
@@ -525,47 +525,44 @@ fn project_round_trip_and_drag_and_drop() {
 }
 
 #[test]
-fn oversize_geometries_are_shown_uncovered_until_split() {
+fn oversize_artwork_opens_with_fields_for_what_fits_and_the_remedies_as_buttons() {
     let (mut h, n) = opened_oversize();
-    // fields could not be placed: the document is open, every geometry is uncovered (red)
-    assert_eq!(h.state().uncovered().len(), n);
-    assert!(
-        h.state().status().contains("larger than"),
-        "{}",
-        h.state().status()
-    );
-    assert!(h.state().solve_blocker().is_some());
-    // what no field can hold is told apart from what is merely uncovered, in the GUI's words
+    // fields for everything that fits (the small circle and square); only the strokes larger
+    // than a field are left uncovered, told apart from what is merely uncovered
     let far = h.state().out_of_reach().len();
     assert!(far > 0 && far < n, "{far} of {n}");
-    h.get_by_label_contains("cannot be held by any scan field");
+    assert_eq!(h.state().uncovered().len(), far);
+    assert!(!h.state().session.doc().fields.is_empty());
+    assert!(h.state().solve_blocker().is_some());
+    // said once, which they are, with the two remedies as buttons
+    let said = h.query_all_by_label_contains("larger than the 70 × 70 mm scan field");
+    assert_eq!(said.count(), 1);
+    h.get_by_label_contains("(closed outline 280.00");
     assert!(!h.state().status().contains("--split-oversize"));
-    assert!(h.state().status().contains("Split oversize geometries"));
-    section(&mut h, "Solver settings");
-    h.get_by_label("Split oversize geometries (on re-place)")
-        .click();
-    settle(&mut h);
-    assert!(h.state().session.doc().settings.split_oversize);
-    h.get_by_label("Re-place automatically").click();
+    assert!(h.query_by_label_contains("subpath").is_none());
+    h.get_by_label("Mark on the fly");
+    h.get_by_label("Split at field borders").click();
     h.step();
     wait_idle(&mut h, Duration::from_secs(60));
+    assert!(h.state().session.doc().settings.split_oversize);
     assert!(h.state().session.doc().geometries.len() > n);
     assert!(h.state().uncovered().is_empty());
     // the split pieces are reported as warnings in the panel
     let w = h.state().session.doc().warnings.len();
     assert!(w > 0);
     h.get_by_label(&format!("Warnings ({w})"));
-    // undo restores the unsplit geometries
+    // undo restores the unsplit geometries, with their fields for what fits
     h.get_by_label("Undo").click();
     settle(&mut h);
     assert_eq!(h.state().session.doc().geometries.len(), n);
-    assert_eq!(h.state().uncovered().len(), n);
+    assert_eq!(h.state().uncovered().len(), far);
 }
 
 #[test]
 fn switching_to_on_the_fly_places_fields_for_what_was_uncovered() {
     let (mut h, n) = opened_oversize();
-    assert_eq!(h.state().uncovered().len(), n);
+    let far = h.state().out_of_reach().len();
+    assert_eq!(h.state().uncovered().len(), far);
     section(&mut h, "Solver settings");
     h.get_by_label("Motion").click();
     settle(&mut h);
@@ -2126,9 +2123,29 @@ fn a_refused_export_keeps_its_path_field_open_with_the_reason() {
 #[test]
 fn the_oversize_advice_never_proposes_what_is_chosen() {
     let (mut h, _) = opened_oversize();
-    let choose_otf = "or choose \"On the fly\" as the motion";
-    h.get_by_label_contains(choose_otf);
-    set_motion(&mut h, "On the fly (stage moves while marking)");
+    h.get_by_label("Mark on the fly").click();
+    h.step();
     wait_idle(&mut h, Duration::from_secs(60));
-    assert!(h.query_by_label_contains(choose_otf).is_none());
+    assert_eq!(
+        h.state().session.doc().settings.motion,
+        galvoplan::document::MotionMode::OnTheFly
+    );
+    assert!(h.query_by_label("Mark on the fly").is_none());
+    h.get_by_label_contains("The next solve marks them on the fly");
+    h.get_by_label("Split at field borders");
+}
+
+#[test]
+fn hovering_a_shape_says_what_it_is_not_its_internal_path() {
+    let (mut h, _) = opened_oversize();
+    // the small circle 'dot' (r 6 mm at 60, 150): hovered on its rightmost point
+    let at = h
+        .state()
+        .mm_screen_pos(galvoplan::geom::Pt::new(66.0, 150.0))
+        .unwrap();
+    h.hover_at(at);
+    h.step();
+    settle(&mut h);
+    h.get_by_label_contains("circle ⌀12.00 mm, layer");
+    h.get_by_label_contains("from 'dot'");
 }

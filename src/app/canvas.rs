@@ -550,6 +550,49 @@ impl Canvas<'_> {
         });
     }
 
+    /// The hover lines of stroke `k`: what shape it is and its layer, where it came from, its
+    /// field and its place in each plan shown.
+    fn stroke_lines(&self, k: usize, lines: &mut Vec<String>) {
+        let g = &self.geometries[k];
+        lines.push(format!(
+            "{}, layer {}",
+            g.shape_words(),
+            super::layers::layer_label(&g.layer)
+        ));
+        // where it came from, by the drawing's own name when it gives one (an SVG id)
+        let from = match g.source.element.strip_prefix('#') {
+            Some(id) => format!(", from '{id}'"),
+            None => String::new(),
+        };
+        lines.push(format!(
+            "  stroke {} of the job{from}, {} vertices",
+            k + 1,
+            g.points.len()
+        ));
+        match self.fields.iter().find(|f| f.geometries.contains(&k)) {
+            Some(f) => lines.push(format!(
+                "  allocated to {} {}",
+                super::words::field_word(f, self.profile),
+                super::words::field_number(self.fields, self.visiting, f.id)
+            )),
+            None if self.out_of_reach.contains(&k) => lines.push(
+                "  no scan field can hold it: larger than a field or beyond the stage's reach"
+                    .into(),
+            ),
+            None if self.uncovered.contains(&k) => {
+                lines.push("  not covered by any field (magenta halo): add one, or re-place".into())
+            }
+            None => {}
+        }
+        for path in &self.paths {
+            let Ok(l) = path.lowered else { continue };
+            if let Some(i) = l.stroke_of_geometry(k) {
+                let n = l.toolpath.strokes.len();
+                lines.push(format!("  {}: stroke {} of {n}", path.plan.name, i + 1));
+            }
+        }
+    }
+
     fn hover_info(&self, response: egui::Response, rect: Rect, view: &View) -> egui::Response {
         let Some(pos) = response.hover_pos() else {
             return response;
@@ -564,37 +607,7 @@ impl Canvas<'_> {
             lines.extend(b.words.iter().cloned());
         }
         if let Some(k) = geometry {
-            let g = &self.geometries[k];
-            lines.push(format!(
-                "geometry {}: {}, layer {}, {}, {} vertices, {:.2} mm long",
-                k + 1,
-                g.describe(),
-                super::layers::layer_label(&g.layer),
-                if g.closed { "closed" } else { "open" },
-                g.points.len(),
-                g.length_mm()
-            ));
-            match self.fields.iter().find(|f| f.geometries.contains(&k)) {
-                Some(f) => lines.push(format!(
-                    "  allocated to {} {}",
-                    super::words::field_word(f, self.profile),
-                    super::words::field_number(self.fields, self.visiting, f.id)
-                )),
-                None if self.out_of_reach.contains(&k) => lines.push(
-                    "  no scan field can hold it: larger than a field or beyond the stage's reach"
-                        .into(),
-                ),
-                None if self.uncovered.contains(&k) => lines
-                    .push("  not covered by any field (magenta halo): add one, or re-place".into()),
-                None => {}
-            }
-            for path in &self.paths {
-                let Ok(l) = path.lowered else { continue };
-                if let Some(i) = l.stroke_of_geometry(k) {
-                    let n = l.toolpath.strokes.len();
-                    lines.push(format!("  {}: stroke {} of {n}", path.plan.name, i + 1));
-                }
-            }
+            self.stroke_lines(k, &mut lines);
         }
         if let Some(f) = field {
             let word = super::words::field_word(f, self.profile);
@@ -609,7 +622,7 @@ impl Canvas<'_> {
                 super::words::field_number(self.fields, self.visiting, f.id),
                 f.center.x,
                 f.center.y,
-                super::words::count(f.geometries.len(), "geometry", "geometries"),
+                super::words::count(f.geometries.len(), "stroke", "strokes"),
                 if f.locked { ", locked" } else { "" }
             ));
             if word == "region" {

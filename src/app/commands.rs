@@ -15,7 +15,7 @@ use crate::geom::seam::SeamStats;
 use crate::geom::tiling::Tiling;
 use crate::geom::Pt;
 use crate::job::JobCtx;
-use crate::pipeline::place_document_fields;
+use crate::pipeline::place_what_fits;
 
 /// Number of undo steps kept.
 pub const UNDO_LIMIT: usize = 200;
@@ -131,7 +131,7 @@ pub fn apply(doc: &mut Document, cmd: &Command) -> Result<Outcome, String> {
         }
         Command::ReplaceAutomatically => {
             let mut work = doc.clone();
-            place_document_fields(&mut work, &JobCtx::default())
+            place_what_fits(&mut work, &JobCtx::default())
                 .map_err(|e| super::words::gui_error(&e))?;
             *doc = work;
             Ok(uncovered(reallocate(doc)))

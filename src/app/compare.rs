@@ -231,16 +231,27 @@ const ROWS: &[Row] = &[
         only_some: false,
     },
     Row {
-        label: "Seam length (mm)",
-        help: "length of the seams through marked area: where stitching errors can show",
-        value: |p| Some(p.seams.length_mm()),
-        decimals: 1,
+        label: "Seam crossings",
+        help: "places where a mark crosses a seam and two fields' marks meet: where \
+               stitching errors can show",
+        value: |p| Some(p.seams.cuts as f64),
+        decimals: 0,
         kind: RowKind::Ranked,
         only_some: false,
     },
     Row {
-        label: "Split strokes",
-        help: "strokes cut at seams into pieces marked from different fields",
+        label: "Marks along seams (mm)",
+        help: "length marked along a seam line (fills and lines that run on it), shown when \
+               some plan has any",
+        value: |p| Some(p.seams.length_mm()).filter(|&mm| mm > 0.0),
+        decimals: 1,
+        kind: RowKind::Ranked,
+        only_some: true,
+    },
+    Row {
+        label: "Strokes split at seams",
+        help: "strokes cut at seams, each into pieces marked from different fields (the \
+               warnings say how many pieces each became)",
         value: |p| Some(p.seams.split_strokes as f64),
         decimals: 0,
         kind: RowKind::Ranked,

@@ -10,7 +10,7 @@ use crate::import::{HiddenLayers, ImportOptions};
 use crate::job::JobCtx;
 use crate::motion::Toolpath;
 use crate::pipeline::{derive_geometries, lower_plan};
-use crate::pipeline::{load_artwork, place_document_fields};
+use crate::pipeline::{load_artwork, place_what_fits};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -71,7 +71,7 @@ pub fn open(
         )
         .map_err(|e| e.to_string())?
         .doc;
-        let problem = match place_document_fields(&mut doc, ctx) {
+        let problem = match place_what_fits(&mut doc, ctx) {
             Ok(_) => None,
             Err(e) if ctx.is_cancelled() => {
                 return Err(format!("{}: cancelled ({e})", path.display()))
@@ -148,7 +148,7 @@ pub fn reimport(
     if work.geometry_rev == before {
         return Ok((work, None));
     }
-    match place_document_fields(&mut work, ctx) {
+    match place_what_fits(&mut work, ctx) {
         Ok(_) => Ok((work, None)),
         Err(e) if ctx.is_cancelled() => Err(format!("cancelled ({e})")),
         Err(e) => {

@@ -721,7 +721,7 @@ fn layer_header(
         let words = if layer.pen.hatch.is_some() {
             format!("{imported} shapes, {marked} strokes with the hatch")
         } else {
-            super::words::count(imported, "geometry", "geometries")
+            super::words::count(imported, "shape", "shapes")
         };
         ui.label(RichText::new(words).weak());
     });

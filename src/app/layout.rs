@@ -487,12 +487,8 @@ impl App {
     fn coverage_ui(&mut self, ui: &mut egui::Ui) {
         let closed = self.session.closed();
         ui.label(format!(
-            "{} ({closed} closed, {} open), {}",
-            super::words::count(
-                self.session.doc().geometries.len(),
-                "geometry",
-                "geometries"
-            ),
+            "{} ({closed} closed, {} open strokes), {}",
+            super::words::shapes_and_strokes(self.session.doc()),
             self.session.doc().geometries.len() - closed,
             super::words::fields_count(&self.session.doc().fields, &self.session.doc().profile)
         ));
@@ -511,21 +507,20 @@ impl App {
             })
             .count();
         let beyond = far - large;
-        let large_advice = oversize_advice(&self.session.doc().settings);
-        let advice = [
-            (large, large_advice.as_str()),
-            (
-                beyond,
-                "beyond the stage's stroke plus half a field: choose \"Placement: \
+        if large > 0 {
+            self.oversize_ui(ui, large);
+        }
+        let advice = [(
+            beyond,
+            "beyond the stage's stroke plus half a field: choose \"Placement: \
                  centred\" in the Layers panel to move the artwork within reach.",
-            ),
-        ];
+        )];
         for (n, what) in advice.into_iter().filter(|(n, _)| *n > 0) {
             ui.add(
                 egui::Label::new(
                     RichText::new(format!(
                         "{} (dashed purple) cannot be held by any scan field, {} {what}",
-                        super::words::count(n, "geometry", "geometries"),
+                        super::words::count(n, "stroke", "strokes"),
                         if n == 1 { "it is" } else { "they are" },
                     ))
                     .color(colour::OUT_OF_REACH),
@@ -539,7 +534,7 @@ impl App {
                     RichText::new(format!(
                         "{} (magenta halo on the canvas) {} not covered by a scan field \
                  yet: add a field (Add field) or press \"Re-place automatically\".",
-                        super::words::count(near, "geometry", "geometries"),
+                        super::words::count(near, "stroke", "strokes"),
                         if near == 1 { "is" } else { "are" }
                     ))
                     .color(colour::UNCOVERED),
@@ -615,7 +610,7 @@ impl App {
                 f.center.y,
                 f.size[0],
                 f.size[1],
-                super::words::count(f.geometries.len(), "geometry", "geometries"),
+                super::words::count(f.geometries.len(), "stroke", "strokes"),
                 if f.locked { ", locked" } else { "" }
             ))
             .wrap(),
@@ -814,24 +809,91 @@ fn workbench_canvas<'a>(
     }
 }
 
-/// What helps geometries larger than a scan field, never proposing what `settings` already
-/// chose: splitting them at field borders, marking them on the fly, or both.
+impl App {
+    /// The strokes larger than a scan field, said once (which they are), with what helps them
+    /// as buttons: *Split at field borders* and *Mark on the fly*, each offered only when not
+    /// already chosen.
+    fn oversize_ui(&mut self, ui: &mut egui::Ui, large: usize) {
+        use crate::document::MotionMode;
+        let doc = self.session.doc();
+        let [fw, fh] = doc.profile.field_mm;
+        let names: Vec<String> = self
+            .session
+            .out_of_reach()
+            .iter()
+            .map(|&g| (g, &doc.geometries[g]))
+            .filter(|(_, g)| crate::fields::is_oversize(g, [fw, fh]))
+            .map(|(k, g)| format!("stroke {} ({})", k + 1, g.shape_words()))
+            .collect();
+        let more = names.len().saturating_sub(5);
+        let mut list = names.into_iter().take(5).collect::<Vec<_>>().join("; ");
+        if more > 0 {
+            list.push_str(&format!(" and {more} more"));
+        }
+        let advice = oversize_advice(&doc.settings);
+        ui.add(
+            egui::Label::new(
+                RichText::new(format!(
+                    "{} (dashed purple) {} larger than the {fw} × {fh} mm scan field: {list}. \
+                     {advice}",
+                    super::words::count(large, "stroke", "strokes"),
+                    if large == 1 { "is" } else { "are" },
+                ))
+                .color(colour::OUT_OF_REACH),
+            )
+            .wrap(),
+        );
+        let settings = doc.settings.clone();
+        let idle = self.runtime.job.is_none();
+        let repaint = ui.ctx().clone();
+        ui.horizontal_wrapped(|ui| {
+            if !settings.split_oversize
+                && ui
+                    .add_enabled(idle, egui::Button::new("Split at field borders"))
+                    .on_hover_text(
+                        "Cut them where fields meet and place fields on the pieces (step-and-scan)",
+                    )
+                    .clicked()
+            {
+                let s = crate::document::SolverSettings {
+                    split_oversize: true,
+                    ..settings.clone()
+                };
+                if self.execute(Command::SetSettings(Box::new(s))).is_ok() {
+                    self.replace_fields(&repaint);
+                }
+            }
+            if settings.motion == MotionMode::Step
+                && ui
+                    .add_enabled(idle, egui::Button::new("Mark on the fly"))
+                    .on_hover_text(
+                        "Mark them whole while the stage moves: the next solve plans on the fly",
+                    )
+                    .clicked()
+            {
+                let s = crate::document::SolverSettings {
+                    motion: MotionMode::OnTheFly,
+                    ..settings.clone()
+                };
+                let _ = self.execute(Command::SetSettings(Box::new(s)));
+            }
+        });
+    }
+}
+
+/// What helps geometries larger than a scan field, in words beside the buttons of
+/// [`App::oversize_ui`], never proposing what `settings` already chose.
 fn oversize_advice(settings: &crate::document::SolverSettings) -> String {
     use crate::document::MotionMode;
-    let split = "tick \"Split oversize geometries\" in Solver settings and press \"Re-place \
-                 automatically\"";
     let flies = settings.motion != MotionMode::Step;
     match (settings.split_oversize, flies) {
-        (false, false) => {
-            format!("larger than a scan field: {split}, or choose \"On the fly\" as the motion.")
-        }
-        (false, true) => format!(
-            "larger than a scan field: the next solve marks them on the fly (a region carries \
-             them); to mark them step-and-scan, {split}."
-        ),
-        (true, _) => "larger than a scan field: press \"Re-place automatically\" to cut them at \
-                      field borders (splitting is ticked)."
-            .to_string(),
+        (false, false) => "Split them at field borders, or mark them on the fly:".into(),
+        (false, true) => "The next solve marks them on the fly (a region carries them); to \
+                          mark them step-and-scan, split them at field borders:"
+            .into(),
+        (true, _) => "Splitting is chosen: press \"Re-place automatically\" to cut them at \
+                      field borders."
+            .into(),
     }
 }
 
@@ -846,11 +908,11 @@ mod tests {
             ..Default::default()
         };
         let step = oversize_advice(&s);
-        assert!(step.contains("Split oversize") && step.contains("choose \"On the fly\""));
+        assert!(step.contains("Split them") && step.contains("on the fly"));
         s.motion = crate::document::MotionMode::OnTheFly;
         let otf = oversize_advice(&s);
-        assert!(!otf.contains("choose \"On the fly\"") && otf.contains("marks them on the fly"));
+        assert!(otf.contains("The next solve marks them on the fly"));
         s.split_oversize = true;
-        assert!(!oversize_advice(&s).contains("tick \"Split"));
+        assert!(oversize_advice(&s).contains("Splitting is chosen"));
     }
 }

@@ -47,7 +47,7 @@ use crate::document::{
     Algo, DerivedKey, Document, Layer, MachineProfile, Motion, MotionMode, Plan, SolverSettings,
 };
 use crate::job::JobCtx;
-use crate::pipeline::{derive_geometries, move_seam, place_document_fields};
+use crate::pipeline::{derive_geometries, move_seam, place_what_fits};
 use commands::{Command, Outcome};
 use compare::CompareState;
 use files::{ExportKind, Recent};
@@ -424,11 +424,7 @@ impl App {
         let msg = format!(
             "{}: {} on {}, {}, {}{hidden}",
             path.display(),
-            count(
-                self.session.doc().geometries.len(),
-                "geometry",
-                "geometries"
-            ),
+            words::shapes_and_strokes(self.session.doc()),
             count(self.session.doc().layers.len(), "layer", "layers"),
             count(self.session.doc().fields.len(), "scan field", "scan fields"),
             // the Warnings panel's word
@@ -476,7 +472,7 @@ impl App {
             "place",
             repaint,
             move |ctx| {
-                place_document_fields(&mut work, ctx).map_err(|e| gui_error(&e))?;
+                place_what_fits(&mut work, ctx).map_err(|e| gui_error(&e))?;
                 Ok(JobResult::Placed {
                     doc: Box::new(work),
                     what: "re-place fields automatically".into(),
@@ -532,10 +528,10 @@ impl App {
             let before = work.geometries.len();
             derive_geometries(&mut work, ctx).map_err(|e| e.to_string())?;
             if work.fields.is_empty() && !work.geometries.is_empty() {
-                place_document_fields(&mut work, ctx).map_err(|e| gui_error(&e))?;
+                place_what_fits(&mut work, ctx).map_err(|e| gui_error(&e))?;
             }
             let what = format!(
-                "change layers: {before} to {} geometries",
+                "change layers: {before} to {} strokes to mark",
                 work.geometries.len()
             );
             Ok(JobResult::Placed {
@@ -657,11 +653,8 @@ impl App {
             Ok(o) => {
                 if group.is_none() {
                     let cover = match o.uncovered.len() {
-                        0 => "every geometry lies in a scan field".to_string(),
-                        n => format!(
-                            "{} outside every scan field",
-                            count(n, "geometry", "geometries")
-                        ),
+                        0 => "every stroke lies in a scan field".to_string(),
+                        n => format!("{} outside every scan field", count(n, "stroke", "strokes")),
                     };
                     self.set_status(format!("{what}: {cover}"), false);
                 }
@@ -861,8 +854,8 @@ impl App {
             Some("no document open".into())
         } else if !self.session.uncovered().is_empty() {
             Some(match self.session.uncovered().len() {
-                1 => "1 geometry is not covered by a scan field".to_string(),
-                n => format!("{n} geometries are not covered by a scan field"),
+                1 => "1 stroke is not covered by a scan field".to_string(),
+                n => format!("{n} strokes are not covered by a scan field"),
             })
         } else {
             None
@@ -1053,7 +1046,7 @@ impl App {
                             self.field_name(f.id),
                             f.center.x,
                             f.center.y,
-                            count(f.geometries.len(), "geometry", "geometries"),
+                            count(f.geometries.len(), "stroke", "strokes"),
                             self.session.uncovered().len()
                         );
                         self.set_status(msg, false);
@@ -1098,12 +1091,12 @@ impl App {
         self.start_job("moving a seam".into(), "seam", repaint, move |ctx| {
             derive_geometries(&mut work, ctx).map_err(|e| e.to_string())?;
             if work.fields.is_empty() && !work.geometries.is_empty() {
-                place_document_fields(&mut work, ctx).map_err(|e| gui_error(&e))?;
+                place_what_fits(&mut work, ctx).map_err(|e| gui_error(&e))?;
             }
             let what = format!(
                 "move seam {which} = {from_mm:.1} mm to {at:.1} mm{limited}: {}, {}",
                 count(work.fields.len(), "field", "fields"),
-                count(work.seams.split_strokes, "split stroke", "split strokes")
+                count(work.seams.split_strokes, "stroke split", "strokes split")
             );
             Ok(JobResult::Placed {
                 doc: Box::new(work),

@@ -612,7 +612,7 @@ fn caption(c: &Canvas<'_>, playback_room: bool) -> Vec<(String, Color32)> {
         lines.push((
             format!(
                 "{} not covered by a field (magenta halo)",
-                super::words::count(near, "geometry", "geometries")
+                super::words::count(near, "stroke", "strokes")
             ),
             colour::UNCOVERED,
         ));
@@ -621,7 +621,7 @@ fn caption(c: &Canvas<'_>, playback_room: bool) -> Vec<(String, Color32)> {
         lines.push((
             format!(
                 "{} no scan field can hold (dashed purple)",
-                super::words::count(c.out_of_reach.len(), "geometry", "geometries")
+                super::words::count(c.out_of_reach.len(), "stroke", "strokes")
             ),
             colour::OUT_OF_REACH,
         ));

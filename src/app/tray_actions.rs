@@ -74,10 +74,10 @@ impl super::App {
         change(&mut p);
         work.production = Some(p);
         self.start_job(what.clone(), "tray", repaint, move |ctx| {
-            use crate::pipeline::{derive_geometries, expand_production, place_document_fields};
+            use crate::pipeline::{derive_geometries, expand_production, place_what_fits};
             expand_production(&mut work).map_err(|e| super::words::gui_error(&e))?;
             derive_geometries(&mut work, ctx).map_err(|e| super::words::gui_error(&e))?;
-            let problem = match place_document_fields(&mut work, ctx) {
+            let problem = match place_what_fits(&mut work, ctx) {
                 Ok(_) => None,
                 Err(e) if ctx.is_cancelled() => return Err(format!("cancelled ({e})")),
                 Err(e) => {

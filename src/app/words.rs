@@ -91,3 +91,18 @@ pub fn field_numbers(
 pub fn stale_text(why: &[String]) -> String {
     format!("Changed since this plan was made:\n{}", why.join("\n"))
 }
+
+/// What a document holds, in an operator's two words: the drawing's shapes and, where hatch,
+/// cuts or passes make them differ, the strokes to mark ("11 shapes, 200 strokes to mark").
+pub fn shapes_and_strokes(doc: &crate::document::Document) -> String {
+    let (shapes, strokes) = (doc.artwork.len(), doc.geometries.len());
+    if shapes == strokes {
+        count(shapes, "shape", "shapes")
+    } else {
+        format!(
+            "{}, {} to mark",
+            count(shapes, "shape", "shapes"),
+            count(strokes, "stroke", "strokes")
+        )
+    }
+}

@@ -175,6 +175,58 @@ impl Geometry {
             b.min_y
         )
     }
+    /// What the stroke is, in an operator's words: "circle ⌀6.00 mm", "rectangle 20.00 × 10.00
+    /// mm", "line 12.50 mm", "dot", "closed outline 30.00 × 12.00 mm", "open path 48.20 mm long".
+    /// A circle is a closed stroke of 8 or more vertices all within 1 % of their mean distance
+    /// r from their centroid, no edge longer than 0.8 r and a perimeter within 2 % of 2πr; a
+    /// rectangle, 4 vertices with square corners (cosine below 1e-6).
+    pub fn shape_words(&self) -> String {
+        let b = self.bbox();
+        let n = self.points.len();
+        if crate::geom::is_dot(&self.points) {
+            return "dot".into();
+        }
+        if !self.closed {
+            return match n {
+                2 => format!("line {:.2} mm", self.length_mm()),
+                _ => format!("open path {:.2} mm long", self.length_mm()),
+            };
+        }
+        let c = self
+            .points
+            .iter()
+            .fold(Pt::default(), |a, p| a.plus(*p))
+            .scale(1.0 / n as f64);
+        let r: Vec<f64> = self.points.iter().map(|p| p.dist(c)).collect();
+        let mean = r.iter().sum::<f64>() / n as f64;
+        let round = r.iter().all(|d| (d - mean).abs() <= 0.01 * mean);
+        // no long edge (a rounded rectangle's vertices are all at its corners) and the
+        // perimeter of a circle
+        let short_edges =
+            (0..n).all(|k| self.points[k].dist(self.points[(k + 1) % n]) <= 0.8 * mean);
+        let perimeter = self.length_mm();
+        let circular = (perimeter - std::f64::consts::TAU * mean).abs() <= 0.02 * perimeter;
+        if n >= 8 && mean > 0.0 && round && short_edges && circular {
+            return format!("circle ⌀{:.2} mm", 2.0 * mean);
+        }
+        let square = |k: usize| {
+            let (a, o, z) = (
+                self.points[(k + 3) % 4],
+                self.points[k],
+                self.points[(k + 1) % 4],
+            );
+            let (u, v) = (a.minus(o), z.minus(o));
+            u.dot(v).abs() <= 1e-6 * u.norm() * v.norm()
+        };
+        if n == 4 && (0..4).all(square) {
+            let s = [
+                self.points[0].dist(self.points[1]),
+                self.points[1].dist(self.points[2]),
+            ];
+            return format!("rectangle {:.2} × {:.2} mm", s[0], s[1]);
+        }
+        format!("closed outline {:.2} × {:.2} mm", b.width(), b.height())
+    }
     /// The points in marking order for a start vertex and direction.
     ///
     /// Closed: `start_vertex` onwards (or backwards when `reversed`) and back to it.
@@ -218,6 +270,27 @@ mod tests {
             Pt::new(0.0, 0.0),
         ];
         Geometry::new(pts, true, Source::default())
+    }
+
+    #[test]
+    fn a_stroke_says_what_shape_it_is() {
+        assert_eq!(sq().shape_words(), "rectangle 1.00 × 1.00 mm");
+        let circle: Vec<Pt> = (0..64)
+            .map(|k| {
+                let a = k as f64 * std::f64::consts::TAU / 64.0;
+                Pt::new(10.0 + 3.0 * a.cos(), 5.0 + 3.0 * a.sin())
+            })
+            .collect();
+        let g = Geometry::new(circle, true, Source::default());
+        assert_eq!(g.shape_words(), "circle ⌀6.00 mm");
+        let line = vec![Pt::new(0.0, 0.0), Pt::new(3.0, 4.0)];
+        let g = Geometry::new(line.clone(), false, Source::default());
+        assert_eq!(g.shape_words(), "line 5.00 mm");
+        let g = Geometry::new(vec![Pt::new(1.0, 1.0)], false, Source::default());
+        assert_eq!(g.shape_words(), "dot");
+        let tri = vec![Pt::new(0.0, 0.0), Pt::new(4.0, 0.0), Pt::new(0.0, 2.0)];
+        let g = Geometry::new(tri, true, Source::default());
+        assert_eq!(g.shape_words(), "closed outline 4.00 × 2.00 mm");
     }
 
     #[test]

@@ -20,7 +20,7 @@ use crate::geom::BBox;
 pub const FIT_MARGIN_MM: f64 = 1e-3;
 
 /// The words of a cut's warning ("geometry 3 (… mm) is larger than the scan field: split into
-/// 4 strokes at field borders"), by which the cut's warnings are found again.
+/// 4 pieces at field borders"), by which the cut's warnings are found again.
 pub const SPLIT_WORDS: &str = "is larger than the scan field: split into";
 
 /// True when the geometry does not fit a field of `field_mm`.
@@ -400,7 +400,7 @@ pub fn split_oversize(
             element: element.clone(),
             line: None,
             message: format!(
-                "geometry {} ({w:.2} × {h:.2} mm) {SPLIT_WORDS} {pieces} strokes at field borders",
+                "geometry {} ({w:.2} × {h:.2} mm) {SPLIT_WORDS} {pieces} pieces at field borders",
                 i + 1
             ),
             note: false,
