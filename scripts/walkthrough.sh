@@ -2,7 +2,7 @@
 # An operator's walkthrough of the GUI, replayed headless: starts the release build on its own
 # Xvfb display, drives it with xdotool and saves a PNG screenshot after each step, with
 # steps.txt listing "NN-name.png: what the step did / what to look at". Run it after a GUI
-# change and look at every picture. About 2 minutes.
+# change and look at every picture. About 80 s.
 #
 #   scripts/walkthrough.sh [BINARY]
 #
@@ -65,6 +65,7 @@ BTN_REPLACE="617 37"         # toolbar: "Re-place automatically"
 BTN_RUN_HHA="745 37"         # toolbar: "Run HHA" (it has no keyboard shortcut)
 BTN_WORKBENCH="1090 37"      # toolbar: the "Workbench" tab
 BTN_COMPARE="1174 37"        # toolbar: the "Compare" tab
+BTN_FIT_VIEW="889 68"        # Compare tab, its top row: "Fit view" (with two plans A and B)
 PROMPT_PATH="790 519"        # the path field of the in-window "Load a machine profile" prompt
 BTN_CANCEL="186 987"         # status bar while a job runs: "Cancel" (right of the progress bar)
 CANVAS="820 520"             # the middle of the work-area canvas
@@ -269,7 +270,7 @@ texture() {
   shot texture-cancel "Cancel pressed (~6.5 s): the status bar right after"
   wait_quiet 60
   away
-  shot texture-cancelled "after the cancel: what was kept (a plan or none) and the status bar's words"
+  shot texture-cancelled "after the cancel: what was kept (a '(stopped)' plan or none; it depends on when the cancel lands) and the status bar's words"
 }
 
 isw() {
@@ -300,6 +301,9 @@ isw() {
     resize "$1" "$2"
     away
     shot "isw-compare-$1x$2" "Compare tab in a $1 x $2 window (not refitted): what is cut off, what wraps"
+    click "$BTN_FIT_VIEW"
+    away
+    shot "isw-compare-$1x$2-fit" "the same after Compare's Fit view button"
     click "$BTN_WORKBENCH"
     move "$CANVAS"; key f
     away

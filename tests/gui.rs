@@ -2149,3 +2149,103 @@ fn hovering_a_shape_says_what_it_is_not_its_internal_path() {
     h.get_by_label_contains("circle ⌀12.00 mm, layer");
     h.get_by_label_contains("from 'dot'");
 }
+
+/// Drags with the primary button from `from` to `to` (screen points), in six steps.
+fn drag_from_to(h: &mut Harness<'_, App>, from: egui::Pos2, to: egui::Pos2) {
+    h.hover_at(from);
+    h.step();
+    h.drag_at(from);
+    h.step();
+    for i in 1..=6 {
+        h.hover_at(from + (to - from) * (i as f32 / 6.0));
+        h.step();
+    }
+    h.drop_at(to);
+    settle(h);
+}
+
+/// oversize.svg split at field borders: its seams' x positions.
+fn oversize_split() -> (Harness<'static, App>, Vec<f64>) {
+    let (mut h, _) = opened_oversize();
+    h.get_by_label("Split at field borders").click();
+    h.step();
+    wait_idle(&mut h, Duration::from_secs(60));
+    let xs = h.state().session.doc().tiling.as_ref().unwrap().xs.clone();
+    (h, xs)
+}
+
+#[test]
+fn a_dragged_seam_goes_as_far_as_its_neighbours_allow_and_says_why() {
+    use galvoplan::geom::Pt;
+    let (mut h, xs) = oversize_split();
+    // the seam near 110 mm: both its cells are as wide as a field already, it cannot move
+    let k = (1..xs.len() - 1)
+        .min_by(|&a, &b| (xs[a] - 110.0).abs().total_cmp(&(xs[b] - 110.0).abs()))
+        .unwrap();
+    let at = |h: &Harness<'_, App>, x: f64| h.state().mm_screen_pos(Pt::new(x, 150.0)).unwrap();
+    let (from, to) = (at(&h, xs[k]), at(&h, xs[k] + 25.0));
+    drag_from_to(&mut h, from, to);
+    let status = h.state().status().to_string();
+    assert!(
+        status.contains(&format!(
+            "seam x = {:.1} mm stays where it is: the cell from",
+            xs[k]
+        )),
+        "{status}"
+    );
+    assert!(status.contains("the widest a scan field holds"), "{status}");
+    assert_eq!(h.state().session.doc().tiling.as_ref().unwrap().xs, xs);
+    // the next seam moves left as far as the cell on its right allows, and says so
+    let (from, to) = (at(&h, xs[k + 1]), at(&h, xs[k + 1] - 25.0));
+    drag_from_to(&mut h, from, to);
+    wait_idle(&mut h, Duration::from_secs(60));
+    let status = h.state().status().to_string();
+    let moved = h.state().session.doc().tiling.as_ref().unwrap().xs[k + 1];
+    assert!(
+        moved < xs[k + 1] - 0.5 && moved > xs[k + 1] - 25.0,
+        "{moved} {status}"
+    );
+    assert!(
+        status.contains(&format!(
+            "move seam x = {:.1} mm to {moved:.1} mm (it stops there: the cell up to {:.1} mm",
+            xs[k + 1],
+            xs[k + 2]
+        )),
+        "{status}"
+    );
+}
+
+#[test]
+fn a_drag_on_the_artwork_pans_and_only_a_fields_free_area_moves_it() {
+    use galvoplan::geom::Pt;
+    let (mut h, _) = opened_oversize();
+    let fields = h.state().session.doc().fields.clone();
+    // the small square's left edge (140, 150) lies in a field: a drag there pans
+    let on_edge = h.state().mm_screen_pos(Pt::new(140.0, 150.0)).unwrap();
+    h.hover_at(on_edge);
+    h.step();
+    assert_eq!(
+        h.output().platform_output.cursor_icon,
+        egui::CursorIcon::Default
+    );
+    drag_from_to(&mut h, on_edge, on_edge + Vec2::new(60.0, 40.0));
+    assert_eq!(h.state().session.doc().fields, fields);
+    let after = h.state().mm_screen_pos(Pt::new(140.0, 150.0)).unwrap();
+    assert!(
+        (after - on_edge - Vec2::new(60.0, 40.0)).length() < 2.0,
+        "{after:?}"
+    );
+    // the square's centre is a field's free area: hovered, the field is offered (grab), and a
+    // drag there moves it
+    let centre = h.state().mm_screen_pos(Pt::new(150.0, 150.0)).unwrap();
+    h.hover_at(centre);
+    h.step();
+    assert_eq!(
+        h.output().platform_output.cursor_icon,
+        egui::CursorIcon::Grab
+    );
+    drag_from_to(&mut h, centre, centre + Vec2::new(-30.0, 0.0));
+    assert_ne!(h.state().session.doc().fields, fields);
+    // the controls are named on the canvas
+    h.get_by_label_contains("middle-drag: pan · wheel: zoom");
+}

@@ -27,10 +27,12 @@ enum Drag {
         from: Pt,
         to: Pt,
     },
-    /// Moving a seam of `axis` (0: vertical) from `from_mm`; `at_mm` follows the pointer.
+    /// Moving a seam of `axis` (0: vertical) from `from_mm`: the pointer is at `wanted_mm`,
+    /// the seam at `at_mm`, as far towards it as its neighbours allow.
     Seam {
         axis: usize,
         from_mm: f64,
+        wanted_mm: f64,
         at_mm: f64,
     },
 }
@@ -43,18 +45,66 @@ fn drag_end(drag: Drag) -> Option<CanvasAction> {
             code,
             by: to.minus(from),
         }),
+        // a seam that could not move stays, and says why
         Drag::Seam {
             axis,
             from_mm,
+            wanted_mm,
             at_mm,
-        } if (at_mm - from_mm).abs() > 1e-6 => Some(CanvasAction::MoveSeam {
+        } if (at_mm - from_mm).abs() < SEAM_STILL_MM
+            && (wanted_mm - from_mm).abs() > SEAM_STILL_MM =>
+        {
+            Some(CanvasAction::SeamStays {
+                axis,
+                from_mm,
+                to_mm: wanted_mm,
+            })
+        }
+        Drag::Seam {
             axis,
             from_mm,
-            to_mm: at_mm,
+            wanted_mm,
+            at_mm,
+        } if (at_mm - from_mm).abs() >= SEAM_STILL_MM => Some(CanvasAction::MoveSeam {
+            axis,
+            from_mm,
+            to_mm: wanted_mm,
         }),
         _ => None,
     }
 }
+
+/// The canvas's controls in words, bottom left: what the left button, the middle button, the
+/// wheel and F do (a label, so that it can be read out).
+fn show_hint(ui: &mut egui::Ui, rect: Rect, editable: bool) {
+    let words = if editable {
+        "drag: pan · drag a field's free area, a seam or a code: move it · middle-drag: pan · \
+         wheel: zoom · F: fit"
+    } else {
+        "drag or middle-drag: pan · wheel: zoom"
+    };
+    let font = egui::FontId::proportional(11.0);
+    let ink = Color32::from_gray(70);
+    let size = ui
+        .painter()
+        .layout_no_wrap(words.into(), font.clone(), ink)
+        .size();
+    let at = rect.left_bottom() + Vec2::new(6.0, -6.0 - size.y);
+    let r = Rect::from_min_size(at, size + Vec2::new(2.0, 0.0));
+    if !rect.contains_rect(r) {
+        return;
+    }
+    ui.painter()
+        .rect_filled(r.expand(3.0), 3.0, Color32::from_white_alpha(210));
+    ui.put(
+        r,
+        egui::Label::new(egui::RichText::new(words).font(font).color(ink)).selectable(false),
+    );
+}
+
+/// A seam drag that moves it less than this does not move it, mm (a tenth of what the
+/// status says, 0.1 mm).
+const SEAM_STILL_MM: f64 = 0.05;
 
 /// The wheel (or a pinch) zooms `view` about the cursor.
 fn zoom_about_cursor(ui: &egui::Ui, response: &egui::Response, rect: Rect, view: &mut View) {
@@ -129,6 +179,15 @@ pub enum CanvasAction {
         /// 0: a vertical seam (x), 1: a horizontal one (y).
         axis: usize,
         /// Where it was, mm.
+        from_mm: f64,
+        /// Where it was dropped, mm (it goes as far towards it as its neighbours allow).
+        to_mm: f64,
+    },
+    /// Dragged a seam that its neighbours keep where it is.
+    SeamStays {
+        /// 0: a vertical seam (x), 1: a horizontal one (y).
+        axis: usize,
+        /// Where it is, mm.
         from_mm: f64,
         /// Where it was dropped, mm.
         to_mm: f64,
@@ -218,7 +277,35 @@ impl Canvas<'_> {
         self.paint_parts(&painter, &state.view, rect);
         self.paint_codes(&painter, &state.view, rect, state.drag);
         self.part_menu(&response, rect, state, &mut actions);
-        if let Drag::Seam { axis, at_mm, .. } = state.drag {
+        self.paint_seam_drag(ui, &painter, rect, state);
+        if state.drag == Drag::None {
+            self.paint_grab(ui, &painter, &response, rect, &state.view);
+        }
+        show_hint(ui, rect, self.editable);
+        let response = if state.drag == Drag::None {
+            self.hover_info(response, rect, &state.view)
+        } else {
+            response
+        };
+        (response, actions)
+    }
+
+    /// The seam being dragged, across the work area, with where it is and, when its neighbours
+    /// stop it short of the pointer, why.
+    fn paint_seam_drag(
+        &self,
+        ui: &egui::Ui,
+        painter: &egui::Painter,
+        rect: Rect,
+        state: &CanvasState,
+    ) {
+        if let Drag::Seam {
+            axis,
+            from_mm,
+            wanted_mm,
+            at_mm,
+        } = state.drag
+        {
             // the seam being moved, across the work area
             let (lo, hi) = Canvas::reach(self.profile);
             let (a, b) = if axis == 0 {
@@ -230,8 +317,22 @@ impl Canvas<'_> {
             painter.line_segment([s(a), s(b)], egui::Stroke::new(2.0, colour::SEAM));
             if let Some(p) = ui.input(|i| i.pointer.hover_pos()) {
                 // white on the seam's colour: readable over dark hatch
+                let which = if axis == 0 { "x" } else { "y" };
+                let stops = self
+                    .tiling
+                    .and_then(|t| {
+                        crate::fields::seam_stop_reason(
+                            t,
+                            axis,
+                            from_mm,
+                            wanted_mm,
+                            self.cell_max_mm,
+                        )
+                    })
+                    .map(|why| format!("\nstops here: {why}"))
+                    .unwrap_or_default();
                 let galley = painter.layout_no_wrap(
-                    format!("seam {} = {at_mm:.1} mm", if axis == 0 { "x" } else { "y" }),
+                    format!("seam {which} = {at_mm:.1} mm{stops}"),
                     egui::FontId::proportional(13.0),
                     egui::Color32::WHITE,
                 );
@@ -241,12 +342,46 @@ impl Canvas<'_> {
                 painter.galley(at + Vec2::new(3.0, 1.0), galley, egui::Color32::WHITE);
             }
         }
-        let response = if state.drag == Drag::None {
-            self.hover_info(response, rect, &state.view)
-        } else {
-            response
+    }
+
+    /// The field a press under the pointer would move, outlined before the press (a press on
+    /// the artwork, a seam or a code moves something else).
+    fn paint_grab(
+        &self,
+        ui: &egui::Ui,
+        painter: &egui::Painter,
+        response: &egui::Response,
+        rect: Rect,
+        view: &View,
+    ) {
+        if !self.editable || self.add_tool {
+            return;
+        }
+        let Some(p) = response.hover_pos() else {
+            return;
         };
-        (response, actions)
+        let at = view.to_mm(rect, p);
+        let tol = f64::from(HOVER_PX / view.scale.max(1e-6));
+        let elsewhere = self
+            .seam_at(at, f64::from(SEAM_GRAB_PX / view.scale))
+            .is_some()
+            || self.code_at(at, f64::from(4.0 / view.scale)).is_some()
+            || self.geometry_at(ui.ctx(), response.id, at, tol).is_some();
+        let Some(f) = self.field_at(at).filter(|f| !f.locked && !elsewhere) else {
+            return;
+        };
+        let b = f.bbox();
+        let r = Rect::from_two_pos(
+            view.to_screen(rect, Pt::new(b.min_x, b.min_y)),
+            view.to_screen(rect, Pt::new(b.max_x, b.max_y)),
+        );
+        painter.rect_stroke(
+            r,
+            0.0,
+            egui::Stroke::new(3.0, colour::SELECTED),
+            egui::StrokeKind::Middle,
+        );
+        ui.ctx().set_cursor_icon(egui::CursorIcon::Grab);
     }
 
     fn interact(
@@ -262,7 +397,12 @@ impl Canvas<'_> {
             let primary =
                 self.editable && response.drag_started_by(PointerButton::Primary) && !self.add_tool;
             state.drag = match origin.filter(|_| primary) {
-                Some(o) => self.drag_from(state.view.to_mm(rect, o), &state.view, actions),
+                Some(o) => {
+                    let at = state.view.to_mm(rect, o);
+                    let tol = f64::from(HOVER_PX / state.view.scale.max(1e-6));
+                    let on_artwork = self.geometry_at(ui.ctx(), response.id, at, tol).is_some();
+                    self.drag_from(at, &state.view, on_artwork, actions)
+                }
                 None => Drag::Pan,
             };
         }
@@ -308,8 +448,14 @@ impl Canvas<'_> {
     }
 
     /// What a primary drag from `at` (mm) moves: a code, a seam, an unlocked field (selected
-    /// too), or the view.
-    fn drag_from(&self, at: Pt, view: &View, actions: &mut Vec<CanvasAction>) -> Drag {
+    /// too) when the press is not `on_artwork`, or the view.
+    fn drag_from(
+        &self,
+        at: Pt,
+        view: &View,
+        on_artwork: bool,
+        actions: &mut Vec<CanvasAction>,
+    ) -> Drag {
         if let Some(c) = self.code_at(at, f64::from(4.0 / view.scale)) {
             return Drag::Code {
                 code: c.code,
@@ -321,8 +467,13 @@ impl Canvas<'_> {
             return Drag::Seam {
                 axis,
                 from_mm,
+                wanted_mm: from_mm,
                 at_mm: from_mm,
             };
+        }
+        // a press on the artwork pans; only one on a field's free area moves the field
+        if on_artwork {
+            return Drag::Pan;
         }
         match self.field_at(at) {
             Some(f) => {
@@ -363,6 +514,7 @@ impl Canvas<'_> {
                 Drag::Seam {
                     axis,
                     from_mm,
+                    wanted_mm: to_mm,
                     at_mm,
                 }
             }

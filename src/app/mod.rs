@@ -1062,10 +1062,34 @@ impl App {
                     from_mm,
                     to_mm,
                 } => self.move_seam(axis, from_mm, to_mm, repaint),
+                CanvasAction::SeamStays {
+                    axis,
+                    from_mm,
+                    to_mm,
+                } => self.seam_stays(axis, from_mm, to_mm),
                 CanvasAction::SkipCell { cell, skip } => self.skip_cell(cell, skip, repaint),
                 CanvasAction::MoveCode { code, by } => self.move_code(code, by, repaint),
             }
         }
+    }
+
+    /// Why the document's seam of `axis` at `from_mm` dragged to `to_mm` stops short of it.
+    fn seam_stop_reason(&self, axis: usize, from_mm: f64, to_mm: f64) -> Option<String> {
+        let doc = self.session.doc();
+        let cell_max = crate::fields::cell_max_mm(&doc.layers, doc.profile.field_mm);
+        crate::fields::seam_stop_reason(doc.tiling.as_ref()?, axis, from_mm, to_mm, cell_max)
+    }
+
+    /// Says why a dragged seam stays where it is.
+    fn seam_stays(&mut self, axis: usize, from_mm: f64, to_mm: f64) {
+        let which = if axis == 0 { "x" } else { "y" };
+        let why = self
+            .seam_stop_reason(axis, from_mm, to_mm)
+            .unwrap_or_else(|| "its neighbours keep it there".into());
+        self.set_status(
+            format!("seam {which} = {from_mm:.1} mm stays where it is: {why}"),
+            true,
+        );
     }
 
     /// Moves a seam: the geometries are cut again on the moved tiling and the fields placed
@@ -1082,12 +1106,10 @@ impl App {
         };
         let which = if axis == 0 { "x" } else { "y" };
         // a drag past what the neighbours allow stops there, and says why
-        let limited = if (at - to_mm).abs() > 0.05 {
-            let cell = crate::fields::cell_max_mm(&work.layers, work.profile.field_mm)[axis.min(1)];
-            format!(" (as far as the next seams allow: no cell wider than {cell:.1} mm)")
-        } else {
-            String::new()
-        };
+        let limited = self
+            .seam_stop_reason(axis, from_mm, to_mm)
+            .map(|why| format!(" (it stops there: {why})"))
+            .unwrap_or_default();
         self.start_job("moving a seam".into(), "seam", repaint, move |ctx| {
             derive_geometries(&mut work, ctx).map_err(|e| e.to_string())?;
             if work.fields.is_empty() && !work.geometries.is_empty() {

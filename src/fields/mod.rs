@@ -22,7 +22,7 @@ pub use greedy::greedy_fields;
 pub use reach::{center_range, check_artwork, check_reach, Span};
 pub use split::{
     cell_max_mm, choose_document_tiling, cut_at_tiling, cut_hatch_at_tiling, is_oversize,
-    move_seam, split_oversize, Cut, FIT_MARGIN_MM, SPLIT_WORDS,
+    move_seam, seam_stop_reason, split_oversize, Cut, FIT_MARGIN_MM, SPLIT_WORDS,
 };
 
 use crate::document::runs::Contraction;

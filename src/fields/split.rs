@@ -320,6 +320,43 @@ fn fits_tiling(t: &Tiling, extent: &BBox, cell_max: [f64; 2]) -> bool {
         && cells_fit(&t.ys, cell_max[1])
 }
 
+/// Narrowest cell a moved seam leaves, mm.
+const MIN_CELL_MM: f64 = 1.0;
+
+/// Where the seam of `axis` nearest to `from_mm` may go: its index among the borders, its
+/// neighbours and the range `[lo, hi]` (no cell wider than `max`, none narrower than 1 mm).
+struct SeamRange {
+    k: usize,
+    prev: f64,
+    next: f64,
+    lo: f64,
+    hi: f64,
+    max: f64,
+}
+
+impl SeamRange {
+    fn of(tiling: &Tiling, axis: usize, from_mm: f64, cell_max_mm: [f64; 2]) -> Option<Self> {
+        let borders = tiling.borders(axis);
+        let k = (1..borders.len().saturating_sub(1)).min_by(|&a, &b| {
+            (borders[a] - from_mm)
+                .abs()
+                .total_cmp(&(borders[b] - from_mm).abs())
+        })?;
+        let (prev, next) = (borders[k - 1], borders[k + 1]);
+        let max = cell_max_mm[axis.min(1)];
+        let lo = (prev + MIN_CELL_MM).max(next - max);
+        let hi = (next - MIN_CELL_MM).min(prev + max);
+        (lo <= hi).then_some(Self {
+            k,
+            prev,
+            next,
+            lo,
+            hi,
+            max,
+        })
+    }
+}
+
 /// `tiling` with the seam of `axis` (0: vertical, x; 1: horizontal, y) nearest to `from_mm`
 /// moved towards `to_mm`, as far as its neighbours allow (no cell wider than `cell_max_mm`, no
 /// cell narrower than 1 mm), and where the seam went, mm. None when the axis has no seam.
@@ -330,29 +367,53 @@ pub fn move_seam(
     to_mm: f64,
     cell_max_mm: [f64; 2],
 ) -> Option<(Tiling, f64)> {
-    const MIN_CELL_MM: f64 = 1.0;
-    let borders = tiling.borders(axis);
-    let k = (1..borders.len().saturating_sub(1)).min_by(|&a, &b| {
-        (borders[a] - from_mm)
-            .abs()
-            .total_cmp(&(borders[b] - from_mm).abs())
-    })?;
-    let (prev, next) = (borders[k - 1], borders[k + 1]);
-    let max = cell_max_mm[axis.min(1)];
-    let lo = (prev + MIN_CELL_MM).max(next - max);
-    let hi = (next - MIN_CELL_MM).min(prev + max);
-    if lo > hi {
-        return None;
-    }
+    let r = SeamRange::of(tiling, axis, from_mm, cell_max_mm)?;
     let mut moved = tiling.clone();
     let v = if axis == 0 {
         &mut moved.xs
     } else {
         &mut moved.ys
     };
-    let at = to_mm.clamp(lo, hi);
-    v[k] = at;
+    let at = to_mm.clamp(r.lo, r.hi);
+    v[r.k] = at;
     Some((moved, at))
+}
+
+/// Why the seam [`move_seam`] moves towards `to_mm` stops short of it, in words ("the cell
+/// from 39.99 mm would be wider than 69.99 mm, the widest a scan field holds"); None when it
+/// gets there (or there is no seam).
+pub fn seam_stop_reason(
+    tiling: &Tiling,
+    axis: usize,
+    from_mm: f64,
+    to_mm: f64,
+    cell_max_mm: [f64; 2],
+) -> Option<String> {
+    let r = SeamRange::of(tiling, axis, from_mm, cell_max_mm)?;
+    let too_wide = |from: f64| {
+        format!(
+            "the cell from {from:.1} mm would be wider than {:.1} mm, the widest a scan field holds",
+            r.max
+        )
+    };
+    if to_mm > r.hi + 1e-9 {
+        Some(if r.hi >= r.next - MIN_CELL_MM - 1e-9 {
+            format!("the next seam is at {:.1} mm", r.next)
+        } else {
+            too_wide(r.prev)
+        })
+    } else if to_mm < r.lo - 1e-9 {
+        Some(if r.lo <= r.prev + MIN_CELL_MM + 1e-9 {
+            format!("the previous seam is at {:.1} mm", r.prev)
+        } else {
+            format!(
+                "the cell up to {:.1} mm would be wider than {:.1} mm, the widest a scan field holds",
+                r.next, r.max
+            )
+        })
+    } else {
+        None
+    }
 }
 
 /// Replaces every oversize geometry by its pieces, cut at the seams of `tiling` (the document's,
