@@ -2249,3 +2249,17 @@ fn a_drag_on_the_artwork_pans_and_only_a_fields_free_area_moves_it() {
     // the controls are named on the canvas
     h.get_by_label_contains("middle-drag: pan · wheel: zoom");
 }
+
+#[test]
+fn equal_plans_show_no_winner() {
+    let mut h = opened(&demo());
+    for _ in 0..2 {
+        solve(&mut h, "Run HHA");
+    }
+    h.get_by_label("Compare").click();
+    settle(&mut h);
+    h.get_by_label("B vs A");
+    // the same solve twice: the same job time, not coloured as a win, a 0 % difference
+    assert!(h.query_by_label("faster").is_none());
+    h.get_by_label("0.00 %");
+}

@@ -349,16 +349,27 @@ fn metrics_row(ui: &mut egui::Ui, row: &Row, a: &Plan, b: Option<&Plan>) {
     .on_hover_text(row.help);
     let va = (row.value)(a);
     let vb = b.and_then(|b| (row.value)(b));
-    value_cell(ui, row, va, vb);
+    // values that differ are shown with the decimals that tell them apart
+    let decimals = match (va, vb) {
+        (Some(x), Some(y)) => decimals_to_differ(x, y, row.decimals),
+        _ => row.decimals,
+    };
+    value_cell(ui, row, (va, vb), decimals);
     if b.is_none() {
         return;
     }
-    value_cell(ui, row, vb, va);
+    value_cell(ui, row, (vb, va), decimals);
     match (va, vb) {
         (Some(x), Some(y)) if x.abs() > 1e-12 && row.kind != RowKind::Effort => {
             let pct = (y - x) / x * 100.0;
-            // the deciding figure to 0.01 %: plans of a race (HHA, HGA) differ by tenths
-            let decimals = if row.kind == RowKind::Decides { 2 } else { 1 };
+            // the deciding figure to 0.01 %: plans of a race (HHA, HGA) differ by tenths; a
+            // difference the values show is never said as 0 %
+            let least = if row.kind == RowKind::Decides { 2 } else { 1 };
+            let decimals = if with_decimals(x, decimals) == with_decimals(y, decimals) {
+                least
+            } else {
+                decimals_to_differ(pct, 0.0, least as usize) as i32
+            };
             let zero = 0.5 * 10f64.powi(-decimals);
             let text = if pct.abs() < zero {
                 format!("{:.*} %", decimals as usize, 0.0)
@@ -382,9 +393,34 @@ fn metrics_row(ui: &mut egui::Ui, row: &Row, a: &Plan, b: Option<&Plan>) {
     }
 }
 
-fn value_cell(ui: &mut egui::Ui, row: &Row, mine: Option<f64>, other: Option<f64>) {
-    let text = mine.map_or("–".to_string(), |v| format!("{v:.*}", row.decimals));
-    let better = matches!((mine, other), (Some(x), Some(y)) if x < y);
+/// The decimals to show `x` and `y` with: `least`, or up to three more where they differ but
+/// would read the same.
+fn decimals_to_differ(x: f64, y: f64, least: usize) -> usize {
+    (least..=least + 3)
+        .find(|&d| with_decimals(x, d) != with_decimals(y, d))
+        .unwrap_or(least)
+}
+
+/// `v` with `d` decimals, never a negative zero ("-0.0" reads as "0.0").
+fn with_decimals(v: f64, d: usize) -> String {
+    let text = format!("{v:.d$}");
+    match text.strip_prefix('-') {
+        Some(rest) if rest.chars().all(|c| c == '0' || c == '.') => rest.to_string(),
+        _ => text,
+    }
+}
+
+/// One plan's value of `row` with `decimals`; the better of the two (lower, and reading
+/// lower) highlighted: equal values are no win.
+fn value_cell(
+    ui: &mut egui::Ui,
+    row: &Row,
+    (mine, other): (Option<f64>, Option<f64>),
+    decimals: usize,
+) {
+    let show = |v: f64| with_decimals(v, decimals);
+    let text = mine.map_or("–".to_string(), show);
+    let better = matches!((mine, other), (Some(x), Some(y)) if x < y && show(x) != show(y));
     let t = RichText::new(text).monospace();
     match row.kind {
         RowKind::Decides => {
@@ -517,6 +553,15 @@ pub fn convergence_plot(ui: &mut egui::Ui, plans: &[(&Plan, Color32, &str)], hha
         .y_axis_min_width(Y_AXIS_WIDTH_PX)
         .allow_scroll(false)
         .show(ui, |pui| {
+            // first, dashed and thin: the GA's lines are drawn over it where they meet it
+            if let Some(v) = hha_figure {
+                pui.hline(
+                    HLine::new(format!("HHA plan: {} {}", kind.show(v), kind.unit()), v)
+                        .color(Color32::from_rgb(22, 163, 74))
+                        .width(1.0)
+                        .style(LineStyle::dashed_dense()),
+                );
+            }
             for (p, col, letter) in &with_history {
                 let best: PlotPoints = p
                     .history
@@ -549,13 +594,6 @@ pub fn convergence_plot(ui: &mut egui::Ui, plans: &[(&Plan, Color32, &str)], hha
                             .radius(5.0),
                     );
                 }
-            }
-            if let Some(v) = hha_figure {
-                pui.hline(
-                    HLine::new(format!("HHA plan: {} {}", kind.show(v), kind.unit()), v)
-                        .color(Color32::from_rgb(22, 163, 74))
-                        .width(1.5),
-                );
             }
         });
 }
@@ -799,3 +837,18 @@ fn plan_canvas<'a>(
 
 /// Width the compare view's metrics table would like beside the convergence plot, px.
 const METRICS_MIN_PX: f32 = 400.0;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn values_that_differ_get_the_decimals_that_tell_them_apart() {
+        assert_eq!(decimals_to_differ(9.108, 9.105, 3), 3);
+        assert_eq!(decimals_to_differ(9.1081, 9.1079, 3), 4);
+        assert_eq!(decimals_to_differ(791.61, 791.64, 1), 2);
+        assert_eq!(decimals_to_differ(12.0, 12.0, 1), 1);
+        // a −0.03 % difference is not said as 0.0 %
+        assert_eq!(decimals_to_differ(-0.033, 0.0, 1), 2);
+    }
+}
