@@ -2263,3 +2263,41 @@ fn equal_plans_show_no_winner() {
     assert!(h.query_by_label("faster").is_none());
     h.get_by_label("0.00 %");
 }
+
+/// A harness of `size` px with `path` open.
+fn sized(path: &Path, size: Vec2) -> Harness<'static, App> {
+    let mut app = App::default();
+    assert!(app.open(path), "{}", app.status());
+    let mut h = Harness::builder()
+        .with_max_steps(MAX_STEPS)
+        .with_size(size)
+        .build_ui_state(|ui, app: &mut App| app.ui(ui), app);
+    settle(&mut h);
+    h
+}
+
+#[test]
+fn the_motion_plots_titles_are_never_cut() {
+    for width in [1000.0, 1500.0] {
+        let mut h = sized(
+            &common::root().join("assets/examples/oversize.svg"),
+            Vec2::new(width, 1000.0),
+        );
+        set_motion(&mut h, "On the fly (stage moves while marking)");
+        wait_idle(&mut h, Duration::from_secs(60));
+        solve(&mut h, "Run HHA");
+        // the limits read in full: what the peak is measured against
+        // the limits read in full (what the peak is measured against): no title row is cut
+        for title in ["Stage speed", "Scanner offset"] {
+            let rows: Vec<String> = h
+                .query_all_by_label_contains(title)
+                .map(|n| format!("{n:?}"))
+                .collect();
+            assert!(!rows.is_empty(), "{width} px: {title}");
+            for row in rows {
+                assert!(!row.contains("…"), "{width} px: {row}");
+            }
+        }
+        h.get_by_label_contains("707 both");
+    }
+}

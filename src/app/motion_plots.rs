@@ -121,18 +121,30 @@ pub fn show(
     height_px: f32,
 ) {
     let width = ((ui.available_width() - ui.spacing().item_spacing.x) / 2.0).max(120.0);
-    let plot_px = (height_px - 2.0 * ui.text_style_height(&egui::TextStyle::Body)).max(60.0);
     ui.horizontal_top(|ui| {
         ui.vertical(|ui| {
             ui.set_width(width);
-            offset_plot(ui, s, profile, t_s, plot_px);
+            offset_plot(ui, s, profile, t_s, height_px);
         });
         ui.vertical(|ui| {
             ui.set_width(width);
-            speed_plot(ui, s, profile, t_s, plot_px);
+            speed_plot(ui, s, profile, t_s, height_px);
         });
     });
 }
+
+/// A plot's title, wrapped (never cut), with its explanation on hover; returns the height
+/// left for the plot of a column `height_px` tall (its axis labels counted), at least 60 px.
+fn title(ui: &mut egui::Ui, text: String, hover: String, height_px: f32) -> f32 {
+    let top = ui.cursor().min.y;
+    ui.add(egui::Label::new(text).wrap()).on_hover_text(hover);
+    let used = ui.cursor().min.y - top;
+    (height_px - used - ui.text_style_height(&egui::TextStyle::Body)).max(60.0)
+}
+
+/// How far above the highest curve or limit a plot reaches, as a share of it: the legend
+/// (top right) sits in that band, not over the curves.
+const LEGEND_HEADROOM: f64 = 1.45;
 
 fn offset_plot(
     ui: &mut egui::Ui,
@@ -142,23 +154,25 @@ fn offset_plot(
     height_px: f32,
 ) {
     let [rx, ry] = reach_mm(profile);
-    // one line (the plot's height counts on it): cut with "…" when narrow, in full on hover
-    ui.add(
-        egui::Label::new(format!(
+    let height_px = title(
+        ui,
+        format!(
             "Scanner offset (tool - stage), mm: peak {:.1} of ±{:.1}",
             s.peak_offset_mm(),
             rx.min(ry)
-        ))
-        .truncate(),
-    )
-    .on_hover_text(format!(
-        "Where the laser point is inside the scan field while the stage moves. The scanner \
-         can reach up to the red dashed lines: half the field less the profile's on-the-fly \
-         margin ({:.1} mm); the planner keeps the offset inside them.",
-        profile.otf_margin_mm
-    ));
+        ),
+        format!(
+            "Where the laser point is inside the scan field while the stage moves. The scanner \
+             can reach up to the red dashed lines: half the field less the profile's on-the-fly \
+             margin ({:.1} mm); the planner keeps the offset inside them.",
+            profile.otf_margin_mm
+        ),
+        height_px,
+    );
     Plot::new("otf-offset")
         .height(height_px)
+        .include_y(rx.max(ry) * (2.0 * LEGEND_HEADROOM - 1.0))
+        .include_y(-rx.max(ry))
         .legend(Legend::default())
         .custom_x_axes(vec![time_axis()])
         .x_grid_spacer(time_grid_spacer)
@@ -194,22 +208,23 @@ fn speed_plot(
         profile.axis_x.max_velocity_mm_s,
         profile.axis_y.max_velocity_mm_s,
     );
-    ui.add(
-        egui::Label::new(format!(
+    let height_px = title(
+        ui,
+        format!(
             "Stage speed, mm/s: peak {:.0}, limit {:.0} per axis, {:.0} both",
             s.peak_speed_mm_s(),
             vx.max(vy),
             vx.hypot(vy)
-        ))
-        .truncate(),
-    )
-    .on_hover_text(
+        ),
         "How fast the stage travels along its route (both axes together). Each axis stays \
          within its own limit (dashed), so on a diagonal the combined speed may reach the dotted \
-         line.",
+         line."
+            .into(),
+        height_px,
     );
     Plot::new("otf-speed")
         .height(height_px)
+        .include_y(vx.hypot(vy).max(s.peak_speed_mm_s()) * LEGEND_HEADROOM)
         .legend(Legend::default())
         .custom_x_axes(vec![time_axis()])
         .x_grid_spacer(time_grid_spacer)
