@@ -118,7 +118,7 @@ fn open_demo_run_hha_shows_metrics() {
     wait_idle(&mut h, Duration::from_secs(120));
     let plan = h.state().active_plan().expect("a plan").clone();
     assert_eq!(plan.algo, Algo::Hha);
-    assert_eq!(plan.name, "HHA · job time · step-and-scan · seed 1");
+    assert_eq!(plan.name, "HHA · job time · step-and-scan");
     common::check_plan(h.state().session.doc(), &plan);
     // the metrics table: worded rows with units, the job time first with the plan's value
     h.get_by_label("Idle travel (mm)");
@@ -693,10 +693,7 @@ fn the_cost_switch_decides_what_the_solve_minimises() {
         CostModel::Distance
     );
     let by_distance = solve(&mut h, "Run HHA");
-    assert_eq!(
-        by_distance.name,
-        "HHA · idle distance · step-and-scan · seed 1"
-    );
+    assert_eq!(by_distance.name, "HHA · idle distance · step-and-scan");
     assert_ne!(by_time.order, by_distance.order);
     // each plan is best at what it minimised (demo: 9.116 s / 1848 mm against 9.142 s / 1704 mm)
     let (t_time, t_dist) = (
@@ -1193,7 +1190,7 @@ fn a_pen_edit_makes_the_plan_stale_and_re_solve_and_export_writes_the_new_feed()
     assert_eq!(h.state().plan_staleness(0), [why.as_str()]);
     h.get_by_label("stale");
     h.get_by_label_contains(&format!(
-        "HHA · job time · step-and-scan · seed 1 is stale: {why} since it was made"
+        "HHA · job time · step-and-scan is stale: {why} since it was made"
     ));
     // export asks; re-solving is the default answer and writes the new feed
     h.key_press_modifiers(ctrl(), Key::E);
@@ -1229,9 +1226,7 @@ fn a_profile_edit_makes_the_headline_stale() {
     let why = h.state().plan_staleness(0).to_vec();
     assert_eq!(why.len(), 1, "{why:?}");
     assert!(why[0].starts_with("base x max velocity ") && why[0].ends_with("→ 100 mm/s"));
-    h.get_by_label_contains(
-        "HHA · job time · step-and-scan · seed 1 is stale: base x max velocity",
-    );
+    h.get_by_label_contains("HHA · job time · step-and-scan is stale: base x max velocity");
     h.get_by_label("stale");
     // the plan keeps the figures and the toolpath of its own profile
     let plan = h.state().session.doc().plans[0].clone();
@@ -1715,8 +1710,8 @@ fn convergence_plot_speaks_the_tables_figures_and_names_say_what_a_plan_is() {
     }
     let plans = h.state().session.doc().plans.clone();
     let (hha, hga) = (&plans[0], &plans[1]);
-    assert_eq!(hha.name, "HHA · job time · step-and-scan · seed 1");
-    assert_eq!(hga.name, "HGA · job time · step-and-scan · seed 1");
+    assert_eq!(hha.name, "HHA · job time · step-and-scan");
+    assert_eq!(hga.name, "HGA · job time · step-and-scan");
     let (th, ta) = (
         hha.metrics.job_time_s.unwrap(),
         hga.metrics.job_time_s.unwrap(),
@@ -2300,4 +2295,22 @@ fn the_motion_plots_titles_are_never_cut() {
         }
         h.get_by_label_contains("707 both");
     }
+}
+
+#[test]
+fn a_plans_name_carries_its_seed_only_when_two_plans_differ_by_seed_alone() {
+    let mut h = opened(&demo());
+    let first = solve(&mut h, "Run HHA");
+    assert_eq!(first.name, "HHA · job time · step-and-scan");
+    // the same settings again: numbered
+    let again = solve(&mut h, "Run HHA");
+    assert_eq!(again.name, "HHA · job time · step-and-scan #2");
+    // another seed alone: named by its seed
+    section(&mut h, "Solver settings");
+    set_text(&mut h, "Seed", "7");
+    settle(&mut h);
+    let seeded = solve(&mut h, "Run HHA");
+    assert_eq!(seeded.name, "HHA · job time · step-and-scan · seed 7");
+    // the seed is in every plan's details
+    assert!(h.query_by_label_contains("· seed 1").is_none());
 }

@@ -639,11 +639,16 @@ impl App {
         for k in 0..self.session.doc().plans.len() {
             let p = &self.session.doc().plans[k];
             let stale = self.plan_staleness(k).to_vec();
-            // the name (what the plan is: algorithm, cost, motion, seed) wraps on its own line
+            // the name (what the plan is: algorithm, cost, motion) wraps on its own line; its
+            // random seed is in its details
             let selected = self.session.active() == Some(k);
             ui.set_max_width(ui.available_width());
             if ui
                 .add(egui::Button::selectable(selected, p.name.as_str()).wrap())
+                .on_hover_text(format!(
+                    "{}\nrandom seed {} (a solve is the same for the same seed), solved in {:.2} s",
+                    p.name, p.settings.seed, p.metrics.solve_s.total
+                ))
                 .clicked()
             {
                 show = Some(k);

@@ -890,20 +890,33 @@ impl App {
     fn next_plan_name(&self, algo: Algo) -> String {
         let mut settings = self.session.doc().settings.clone();
         settings.algo = algo;
-        self.unique_plan_name(settings.plan_title())
+        self.unique_plan_name(settings.plan_title(), &settings)
     }
 
-    /// `title`, with " #2", " #3"… when a plan of that name exists.
-    fn unique_plan_name(&self, title: String) -> String {
+    /// `title` for a plan solved with `settings`; when a plan of that name exists: with
+    /// " · seed N" where the two differ by their random seed alone, else with " #2", " #3"….
+    fn unique_plan_name(&self, title: String, settings: &SolverSettings) -> String {
+        let plans = &self.session.doc().plans;
         let taken = |name: &str| {
-            self.session
-                .doc()
-                .plans
+            plans
                 .iter()
                 .any(|p| p.name == name || p.name.strip_suffix(" (stopped)") == Some(name))
         };
         if !taken(&title) {
             return title;
+        }
+        let unseeded = |s: &SolverSettings| SolverSettings {
+            seed: 0,
+            ..s.clone()
+        };
+        let by_seed_alone = plans.iter().any(|p| {
+            p.name.starts_with(&title)
+                && p.settings.seed != settings.seed
+                && unseeded(&p.settings) == unseeded(settings)
+        });
+        let seeded = format!("{title} · seed {}", settings.seed);
+        if by_seed_alone && !taken(&seeded) {
+            return seeded;
         }
         (2..)
             .map(|n| format!("{title} #{n}"))
@@ -965,7 +978,7 @@ impl App {
     ) {
         // an automatic motion is named for the motion the solve chose
         let name = if plan.settings.motion == MotionMode::Auto {
-            self.unique_plan_name(plan.name.clone())
+            self.unique_plan_name(plan.name.clone(), &plan.settings)
         } else {
             name
         };

@@ -48,14 +48,14 @@ impl Algo {
 impl SolverSettings {
     /// What a plan made with these settings is, in words: algorithm, cost, motion (with the
     /// stage route on the fly) and, for the searches that draw random numbers, the seed, e.g.
-    /// `HGA · job time · on the fly (lsa) · seed 3`. Plans are named after it.
+    /// `HGA · job time · on the fly (lsa)`. Plans are named after it.
     pub fn plan_title(&self) -> String {
         self.title_with(None)
     }
 
     /// [`plan_title`](Self::plan_title) of a plan made in `motion`: under
     /// [`MotionMode::Auto`] it says which motion the solve chose, e.g.
-    /// `HHA · job time · auto: on the fly · seed 1`.
+    /// `HHA · job time · auto: on the fly`.
     pub fn plan_title_as(&self, motion: Motion) -> String {
         self.title_with(Some(self.motion_words(motion)))
     }
@@ -90,10 +90,9 @@ impl SolverSettings {
             (MotionMode::Step, _) => self.motion_words(Motion::Step),
             (MotionMode::OnTheFly, _) => self.motion_words(Motion::OnTheFly),
         };
-        match self.algo {
-            Algo::Hha | Algo::Hga => format!("{algo} · {cost} · {motion} · seed {}", self.seed),
-            Algo::AsIs | Algo::Baseline => format!("{algo} · {cost} · {motion}"),
-        }
+        // the random seed is in a plan's details; the GUI adds it to a name only where two
+        // plans differ by seed alone
+        format!("{algo} · {cost} · {motion}")
     }
 
     /// A motion in words, on the fly with seed 001's stage route as the command line spells it
