@@ -269,8 +269,10 @@ pub fn plan_document_lowered(
     plan.metrics.solve_s.fields = fields_s;
     plan.metrics.fields_lower_bound = Some(lower_bound);
     // why auto planned one motion only, said like the whole-or-cut choice (the last solve's)
-    doc.warnings
-        .retain(|w| !w.message.starts_with(crate::order::FLY_NOT_PLANNED));
+    doc.warnings.retain(|w| {
+        !w.message.starts_with(crate::order::FLY_NOT_PLANNED)
+            && !w.message.starts_with(crate::order::LINUXCNC_OTF_NOTE)
+    });
     if let Some(note) = &plan.metrics.motion_note {
         doc.warnings.push(choice_warning(note.clone()));
     }

@@ -740,3 +740,34 @@ fn the_report_holds_the_plans_profile_pens_and_settings_and_fields_are_numbered_
         "{summary}"
     );
 }
+
+#[test]
+fn linuxcnc_on_the_fly_says_why_its_job_time_is_what_it_is() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("job.gcode").display().to_string();
+    let svg = common::root().join("assets/examples/oversize.svg");
+    let svg = svg.display().to_string();
+    let run = galvoplan(&[
+        "plan",
+        &svg,
+        "--profile",
+        "linuxcnc",
+        "--motion",
+        "on-the-fly",
+        "-o",
+        &out,
+    ]);
+    let job_s = reported_job_time(&run);
+    let err = String::from_utf8_lossy(&run.stderr);
+    let note = err
+        .lines()
+        .find(|l| l.contains("LinuxCNC runs on-the-fly G-code without look-ahead: "))
+        .unwrap_or_else(|| panic!("{err}"));
+    let job_s: f64 = job_s.parse().unwrap();
+    assert!(note.contains(&format!("{job_s:.2} s on the fly")), "{note}");
+    assert!(note.contains("step-and-scan would take"), "{note}");
+    // a scan-head profile has no such note
+    let run = galvoplan(&["plan", &svg, "--motion", "on-the-fly", "-o", &out]);
+    reported_job_time(&run);
+    assert!(!String::from_utf8_lossy(&run.stderr).contains("without look-ahead"));
+}

@@ -165,6 +165,9 @@ pub fn order_plan(
             best = m;
         }
     }
+    if motion_note.is_none() {
+        motion_note = linuxcnc_note(&nodes, inputs, &best, ctx);
+    }
     let order_s = t0.elapsed().as_secs_f64();
     let lower = Candidates::new(&nodes, inputs, best.motion, ctx);
     let mut plan = lower.plan(&best.ordering);
@@ -184,6 +187,28 @@ pub fn order_plan(
     plan.metrics = m;
     plan.history = best.history;
     Ok((plan, best.toolpath))
+}
+
+/// How the plan's motion note begins when LinuxCNC runs an on-the-fly plan.
+pub const LINUXCNC_OTF_NOTE: &str = "LinuxCNC runs on-the-fly G-code without look-ahead";
+
+/// On a LinuxCNC controller, an on-the-fly plan's note: why its job time is what it is, beside
+/// what step-and-scan would take on the same order ("LinuxCNC runs on-the-fly G-code without
+/// look-ahead: 18.36 s; step-and-scan would take 8.16 s"). None elsewhere, after a cancel, or
+/// where step-and-scan cannot mark the order (geometries larger than a field).
+fn linuxcnc_note(nodes: &Nodes, inputs: &PlanInputs, best: &Made, ctx: &JobCtx) -> Option<String> {
+    let lcnc = inputs.profile.controller.kind == crate::document::ControllerKind::Linuxcnc;
+    if best.motion != Motion::OnTheFly || !lcnc || ctx.is_cancelled() {
+        return None;
+    }
+    let step = Candidates::new(nodes, inputs, Motion::Step, ctx)
+        .toolpath(&best.ordering)
+        .ok()?;
+    Some(format!(
+        "{LINUXCNC_OTF_NOTE}: {:.2} s on the fly; step-and-scan would take {:.2} s",
+        best.toolpath.duration_s(),
+        step.duration_s()
+    ))
 }
 
 /// Under auto, on the fly is not planned for a job of more than this many strokes (passes
