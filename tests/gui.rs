@@ -2314,3 +2314,38 @@ fn a_plans_name_carries_its_seed_only_when_two_plans_differ_by_seed_alone() {
     // the seed is in every plan's details
     assert!(h.query_by_label_contains("· seed 1").is_none());
 }
+
+#[test]
+fn the_compare_table_and_its_heading_stay_in_view_on_a_1000_pixel_screen() {
+    for size in [Vec2::new(1600.0, 1000.0), Vec2::new(1280.0, 1000.0)] {
+        let mut h = sized(&demo(), size);
+        solve(&mut h, "Run HHA");
+        set_motion(&mut h, "On the fly (stage moves while marking)");
+        wait_idle(&mut h, Duration::from_secs(60));
+        solve(&mut h, "Run HHA");
+        h.get_by_label("Compare").click();
+        settle(&mut h);
+        // the compare view's table (the side panel, on the right, has its own)
+        let side_px = size.x * 0.6;
+        for label in [
+            "B vs A",
+            "Job time (s)",
+            "Stage route (mm)",
+            "Solve time (s)",
+        ] {
+            let nodes: Vec<_> = h
+                .get_all_by_label(label)
+                .map(|n| n.rect())
+                .filter(|r| r.left() < side_px)
+                .collect();
+            assert!(!nodes.is_empty(), "{size:?} {label}");
+            for r in nodes {
+                assert!(r.bottom() <= size.y, "{size:?} {label}: {r:?}");
+            }
+        }
+        for heading in ["A: HHA", "B: HHA"] {
+            let r = h.get_by_label_contains(heading).rect();
+            assert!(r.top() >= 0.0 && r.bottom() <= size.y, "{heading}: {r:?}");
+        }
+    }
+}

@@ -79,7 +79,7 @@ struct Row {
     value: fn(&Plan) -> Option<f64>,
     decimals: usize,
     kind: RowKind,
-    /// Shown only when a plan has the figure.
+    /// Shown only when a plan has the figure, and it is not zero (seams where nothing is cut).
     only_some: bool,
 }
 
@@ -228,7 +228,7 @@ const ROWS: &[Row] = &[
         value: |p| Some(p.seams.seams() as f64),
         decimals: 0,
         kind: RowKind::Ranked,
-        only_some: false,
+        only_some: true,
     },
     Row {
         label: "Seam crossings",
@@ -237,13 +237,13 @@ const ROWS: &[Row] = &[
         value: |p| Some(p.seams.cuts as f64),
         decimals: 0,
         kind: RowKind::Ranked,
-        only_some: false,
+        only_some: true,
     },
     Row {
         label: "Marks along seams (mm)",
         help: "length marked along a seam line (fills and lines that run on it), shown when \
                some plan has any",
-        value: |p| Some(p.seams.length_mm()).filter(|&mm| mm > 0.0),
+        value: |p| Some(p.seams.length_mm()),
         decimals: 1,
         kind: RowKind::Ranked,
         only_some: true,
@@ -255,7 +255,7 @@ const ROWS: &[Row] = &[
         value: |p| Some(p.seams.split_strokes as f64),
         decimals: 0,
         kind: RowKind::Ranked,
-        only_some: false,
+        only_some: true,
     },
     Row {
         label: "Direction changes",
@@ -296,18 +296,6 @@ const DECIDES_PT: f32 = 16.0;
 /// Plan names say what a plan is and run long, so the columns are headed "A" and "B" under the
 /// names written out (wrapped) above the table; a table of one plan heads its column "Value".
 pub fn metrics_table(ui: &mut egui::Ui, id: &str, a: &Plan, b: Option<&Plan>) {
-    if let Some(b) = b {
-        for (letter, p, col) in [("A", a, colour::PATH_A), ("B", b, colour::PATH_B)] {
-            ui.add(
-                egui::Label::new(
-                    RichText::new(format!("{letter}: {}", p.name))
-                        .strong()
-                        .color(col),
-                )
-                .wrap(),
-            );
-        }
-    }
     egui::Grid::new(id)
         .num_columns(4)
         .striped(true)
@@ -322,15 +310,23 @@ pub fn metrics_table(ui: &mut egui::Ui, id: &str, a: &Plan, b: Option<&Plan>) {
                 ui.label(RichText::new("Value").strong().color(colour::PATH_A));
             }
             ui.end_row();
-            // a figure no plan shown has (a mixed job's) is left out, not shown as dashes
-            let shown = |row: &&Row| {
-                !row.only_some || (row.value)(a).is_some() || b.and_then(row.value).is_some()
-            };
-            for row in ROWS.iter().filter(shown) {
+            for row in ROWS.iter().filter(|row| row_shown(row, a, b)) {
                 metrics_row(ui, row, a, b);
                 ui.end_row();
             }
         });
+}
+
+/// Whether `row` is shown for plans `a` and `b`: a figure no plan shown has (a mixed job's),
+/// or has as zero (seams of a job that cuts nothing), is left out, not shown as dashes.
+fn row_shown(row: &Row, a: &Plan, b: Option<&Plan>) -> bool {
+    let has = |p: &Plan| (row.value)(p).is_some_and(|v| v != 0.0);
+    !row.only_some || has(a) || b.is_some_and(has)
+}
+
+/// The rows of the metrics table of `a` and `b`.
+fn rows_shown(a: &Plan, b: Option<&Plan>) -> usize {
+    ROWS.iter().filter(|row| row_shown(row, a, b)).count()
 }
 
 fn metrics_row(ui: &mut egui::Ui, row: &Row, a: &Plan, b: Option<&Plan>) {
@@ -440,6 +436,21 @@ fn value_cell(
         RowKind::Ranked | RowKind::Part | RowKind::Info | RowKind::Effort => {
             ui.label(t);
         }
+    }
+}
+
+/// Which plan is A and which is B, in their colours (the compare table's columns): above the
+/// table, so that they stay in view when it scrolls.
+fn plan_names(ui: &mut egui::Ui, a: &Plan, b: &Plan) {
+    for (letter, p, col) in [("A", a, colour::PATH_A), ("B", b, colour::PATH_B)] {
+        ui.add(
+            egui::Label::new(
+                RichText::new(format!("{letter}: {}", p.name))
+                    .strong()
+                    .color(col),
+            )
+            .wrap(),
+        );
     }
 }
 
@@ -702,8 +713,18 @@ pub fn show(
             (layers, stale_of(k), playback_t_s, revision),
         )
     };
-    // the metrics table's height (20 rows), or less on a small window (it scrolls then)
-    let bottom = 460.0_f32.min(ui.available_height() * 0.45);
+    // the metrics table's height (its rows, the plans' names and a stale note), or less on a
+    // small window (it scrolls then)
+    let row_px = ui.text_style_height(&egui::TextStyle::Body) + 4.0;
+    let rows = rows_shown(&doc.plans[ka], kb.map(|k| &doc.plans[k])) as f32;
+    // a stale note takes about three lines, its "and N more" one
+    let notes = [Some(ka), kb]
+        .into_iter()
+        .flatten()
+        .filter(|&k| !stale_of(k).is_empty())
+        .count() as f32;
+    let needed = (rows + 5.0 + 4.0 * notes) * row_px + 16.0;
+    let bottom = needed.min(ui.available_height() * 0.7);
     let top = (ui.available_height() - bottom - 8.0).max(100.0);
     let width = ui.available_width();
     match kb {
@@ -749,11 +770,16 @@ fn figures<'s>(
         plans.push((b, colour::PATH_B, "B"));
     }
     let history = plans.iter().any(|(p, _, _)| !p.history.is_empty());
+    // the lines above the table (a note, the plans' names) come out of its height
+    let end_y = ui.cursor().min.y + bottom;
     let metrics = |ui: &mut egui::Ui| {
+        if let Some(b) = b {
+            plan_names(ui, a, b);
+        }
         // both ways: on a narrow view the table scrolls sideways rather than losing columns
         egui::ScrollArea::both()
             .id_salt("compare-metrics-scroll")
-            .max_height(bottom)
+            .max_height((end_y - ui.cursor().min.y).max(80.0))
             .show(ui, |ui| {
                 // stale figures are said to be so before they are shown
                 let mut notes = vec![(a, stale_of(ka))];
