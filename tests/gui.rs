@@ -323,9 +323,10 @@ fn invalid_profile_and_settings_input_is_rejected() {
     settle(&mut h);
     assert_eq!(h.state().session.doc().profile.field_mm, [70.0, 70.0]);
     // a built-in profile is selectable
-    h.get_by_label("Built-in").click();
+    h.get_by_label("Machine").click();
     settle(&mut h);
-    h.get_by_label("small-field").click();
+    h.get_by_label("Small machine: 200 mm stage, 40 mm field (Y up)")
+        .click();
     settle(&mut h);
     assert_ne!(h.state().session.doc().profile.field_mm, [70.0, 70.0]);
     assert!(h
@@ -1456,18 +1457,28 @@ fn a_rejected_profile_or_settings_value_clears_after_a_valid_edit_of_another() {
 fn the_built_in_picker_names_the_profile_shown() {
     let mut h = opened(&demo());
     section(&mut h, "Machine profile");
-    let picked = |h: &Harness<'_, App>| h.get_by_label("Built-in").value();
-    assert_eq!(picked(&h).as_deref(), Some("seed000"));
+    let picked = |h: &Harness<'_, App>| h.get_by_label("Machine").value();
+    let reference = "Reference machine: 300 mm stage, 70 mm field";
+    assert_eq!(picked(&h).as_deref(), Some(reference));
     set_text(&mut h, "Stroke X (mm)", "290");
-    // seed000's name, other values: an edited seed000
-    assert_eq!(picked(&h).as_deref(), Some("seed000, edited"));
+    // the reference machine's name, other values: an edited reference machine
+    assert_eq!(
+        picked(&h).as_deref(),
+        Some(format!("{reference}, edited").as_str())
+    );
     set_text(&mut h, "Name", "bench machine");
-    assert_eq!(picked(&h).as_deref(), Some("custom (edited or loaded)"));
-    h.get_by_label("Built-in").click();
+    assert_eq!(
+        picked(&h).as_deref(),
+        Some("bench machine (loaded or edited)")
+    );
+    h.get_by_label("Machine").click();
     settle(&mut h);
-    h.get_by_label("small-field").click();
+    let small = galvoplan::document::MachineProfile::builtin("small-field").unwrap();
+    h.get_by_label(&small.name).click();
     settle(&mut h);
-    assert_eq!(picked(&h).as_deref(), Some("small-field"));
+    assert_eq!(picked(&h).as_deref(), Some(small.name.as_str()));
+    // no internal key is shown
+    assert!(h.query_by_label_contains("seed000").is_none());
 }
 
 #[test]
@@ -2348,4 +2359,22 @@ fn the_compare_table_and_its_heading_stay_in_view_on_a_1000_pixel_screen() {
             assert!(r.top() >= 0.0 && r.bottom() <= size.y, "{heading}: {r:?}");
         }
     }
+}
+
+#[test]
+fn the_view_follows_a_resized_window_until_the_operator_moves_it() {
+    let mut h = sized(&demo(), Vec2::new(1000.0, 700.0));
+    let small_px = h.state().workbench_px_per_mm();
+    // the window grows (a window manager's first resize): the drawing is fitted again
+    h.set_size(Vec2::new(1600.0, 1000.0));
+    settle(&mut h);
+    let large_px = h.state().workbench_px_per_mm();
+    assert!(large_px > small_px * 1.2, "{small_px} -> {large_px}");
+    // once the operator has panned, a resize keeps the view's scale
+    let canvas = h.get_by_label("Work area").rect();
+    let at = canvas.left_bottom() + Vec2::new(20.0, -60.0);
+    drag_from_to(&mut h, at, at + Vec2::new(40.0, -30.0));
+    h.set_size(Vec2::new(1200.0, 800.0));
+    settle(&mut h);
+    assert_eq!(h.state().workbench_px_per_mm(), large_px);
 }

@@ -106,8 +106,13 @@ fn show_hint(ui: &mut egui::Ui, rect: Rect, editable: bool) {
 /// status says, 0.1 mm).
 const SEAM_STILL_MM: f64 = 0.05;
 
-/// The wheel (or a pinch) zooms `view` about the cursor.
-fn zoom_about_cursor(ui: &egui::Ui, response: &egui::Response, rect: Rect, view: &mut View) {
+/// The wheel (or a pinch) zooms `view` about the cursor; true when it did.
+fn zoom_about_cursor(
+    ui: &egui::Ui,
+    response: &egui::Response,
+    rect: Rect,
+    view: &mut View,
+) -> bool {
     let (scroll, zoom) = ui.input(|i| (i.smooth_scroll_delta.y, i.zoom_delta()));
     let factor = zoom * (scroll / 200.0).exp();
     if (factor - 1.0).abs() > 1e-4 {
@@ -116,8 +121,10 @@ fn zoom_about_cursor(ui: &egui::Ui, response: &egui::Response, rect: Rect, view:
             view.scale = (view.scale * factor).clamp(0.01, 1000.0);
             let after = view.to_screen(rect, before);
             view.offset += cursor - after;
+            return true;
         }
     }
+    false
 }
 
 /// How near a seam the pointer grabs it, px.
@@ -135,6 +142,11 @@ pub struct CanvasState {
     /// With `fit_requested`: fit the machine's whole reach with the content (F, *Fit to
     /// view*), so that where the artwork lies on the stage can be seen.
     pub fit_whole: bool,
+    /// The operator panned or zoomed since the view was last fitted: a resized canvas then
+    /// keeps the view (anchored to its centre) instead of fitting again.
+    moved: bool,
+    /// The last fit showed the machine's whole reach (a resize fits the same way).
+    fitted_whole: bool,
     drag: Drag,
     /// The tray cell the context menu is open for: (cell, it is skipped).
     context_cell: Option<(u32, bool)>,
@@ -244,9 +256,15 @@ impl Canvas<'_> {
         };
         response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Canvas, true, &label));
         let mut actions = Vec::new();
-        if let Some(old) = state.rect {
-            // keep the content anchored to the centre when the canvas is resized
-            state.view.offset += (rect.size() - old.size()) / 2.0;
+        if let Some(old) = state.rect.filter(|old| old.size() != rect.size()) {
+            if state.moved {
+                // keep the content anchored to the centre when the canvas is resized
+                state.view.offset += (rect.size() - old.size()) / 2.0;
+            } else {
+                // a view the operator has not moved follows the canvas: fitted again
+                state.fit_requested = true;
+                state.fit_whole |= state.fitted_whole;
+            }
         }
         if state.view.scale == 0.0 || state.fit_requested {
             // the caption (top left) keeps its own band above the content
@@ -266,7 +284,9 @@ impl Canvas<'_> {
                 (lo, hi)
             };
             state.view.fit(below_caption, lo, hi);
+            state.fitted_whole = state.fit_whole;
             state.fit_whole = false;
+            state.moved = false;
             state.view.offset += below_caption.min - rect.min;
             state.fit_requested = false;
         }
@@ -411,7 +431,10 @@ impl Canvas<'_> {
                 .interact_pointer_pos()
                 .map(|p| state.view.to_mm(rect, p));
             match (state.drag, at) {
-                (Drag::Pan | Drag::None, _) => state.view.offset += response.drag_delta(),
+                (Drag::Pan | Drag::None, _) => {
+                    state.view.offset += response.drag_delta();
+                    state.moved |= response.drag_delta() != Vec2::ZERO;
+                }
                 (drag, Some(at)) => state.drag = self.drag_to(drag, at, actions),
                 (_, None) => {}
             }
@@ -442,8 +465,8 @@ impl Canvas<'_> {
                 }
             }
         }
-        if response.hovered() {
-            zoom_about_cursor(ui, response, rect, view);
+        if response.hovered() && zoom_about_cursor(ui, response, rect, &mut state.view) {
+            state.moved = true;
         }
     }
 

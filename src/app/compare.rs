@@ -670,8 +670,14 @@ fn toolbar(ui: &mut egui::Ui, st: &mut CompareState, plans: &[Plan]) {
             std::mem::swap(&mut st.a, &mut st.b);
         }
         ui.separator();
-        ui.selectable_value(&mut st.overlay, false, "Side by side");
-        ui.selectable_value(&mut st.overlay, true, "Overlay");
+        // how two plans are shown: nothing to choose with one
+        let two = plans.len() > 1;
+        ui.add_enabled_ui(two, |ui| {
+            ui.selectable_value(&mut st.overlay, false, "Side by side");
+            ui.selectable_value(&mut st.overlay, true, "Overlay");
+        })
+        .response
+        .on_disabled_hover_text("one plan: solve another to compare two");
         ui.separator();
         if ui.button("Fit view").clicked() {
             st.canvas.fit_requested = true;
@@ -741,7 +747,11 @@ pub fn show(
         }
         _ => {
             let mut c = canvas(ka, colour::PATH_A);
-            c.label = "Compare (overlay)";
+            // one plan is shown alone, whichever way two would be
+            c.label = match kb {
+                Some(_) => "Compare (overlay)",
+                None => "Plan A alone: solve another plan to compare",
+            };
             if let Some(kb) = kb {
                 let mut other = canvas(kb, colour::PATH_B).paths;
                 c.paths.append(&mut other);

@@ -653,10 +653,14 @@ impl App {
             Ok(o) => {
                 if group.is_none() {
                     let cover = match o.uncovered.len() {
-                        0 => "every stroke lies in a scan field".to_string(),
-                        n => format!("{} outside every scan field", count(n, "stroke", "strokes")),
+                        0 => "every stroke is in a scan field".to_string(),
+                        n => format!(
+                            "{} outside every scan field: \"Re-place automatically\" places \
+                             fields for them",
+                            count(n, "stroke", "strokes")
+                        ),
                     };
-                    self.set_status(format!("{what}: {cover}"), false);
+                    self.set_status(format!("{what}: done; {cover}"), false);
                 }
                 if o.uncovered.is_empty() && self.session.problem().is_some() {
                     self.session.set_problem(None);
@@ -927,7 +931,7 @@ impl App {
     fn poll_job(&mut self, ui_ctx: &egui::Context) {
         let Some(job) = &self.runtime.job else { return };
         let Some(outcome) = job.poll() else { return };
-        let (name, cancelled, elapsed) = (job.name.clone(), job.is_cancelled(), job.elapsed());
+        let (name, cancelled) = (job.name.clone(), job.is_cancelled());
         self.runtime.job = None;
         match outcome {
             JobOutcome::Done(JobResult::Opened { path, opened }) => self.opened(&path, *opened),
@@ -954,11 +958,16 @@ impl App {
                 self.set_status(format!("wrote the {what} to {}", path.display()), false);
             }
             JobOutcome::Done(JobResult::Plan { plan, lowered }) => {
-                self.solved(*plan, *lowered, (name, cancelled, elapsed), ui_ctx)
+                self.solved(*plan, *lowered, (name, cancelled), ui_ctx)
             }
-            JobOutcome::Failed(e) if cancelled => {
+            JobOutcome::Failed(_) if cancelled => {
                 self.runtime.export_after_solve = None;
-                self.set_status(format!("{name}: cancelled ({e})"), false)
+                // a cancelled job leaves the document as it was (a solve cancelled after a
+                // plan was made keeps it, named stopped: that is a result)
+                self.set_status(
+                    format!("{name}: cancelled before it made anything; nothing was changed"),
+                    false,
+                )
             }
             JobOutcome::Failed(e) => {
                 self.runtime.export_after_solve = None;
@@ -973,7 +982,7 @@ impl App {
         &mut self,
         mut plan: Plan,
         lowered: toolpaths::Prelowered,
-        (name, cancelled, elapsed): (String, bool, Duration),
+        (name, cancelled): (String, bool),
         ui_ctx: &egui::Context,
     ) {
         // an automatic motion is named for the motion the solve chose
@@ -1000,11 +1009,10 @@ impl App {
             ),
             _ => format!("stage travel {:.1} mm, {} scan fields", m.base_mm, m.fields),
         };
+        // the solve time of the metrics table: one figure for one fact
         let msg = format!(
             "{}: {job}, idle travel {:.1} mm, {stage} (solved in {:.2} s)",
-            plan.name,
-            m.idle_mm,
-            elapsed.as_secs_f64()
+            plan.name, m.idle_mm, m.solve_s.total
         );
         let k = self.session.add_plan(plan, lowered);
         // a new plan is shown from its start

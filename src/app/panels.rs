@@ -253,18 +253,23 @@ impl Editors {
     pub fn profile_ui(&mut self, ui: &mut egui::Ui, profile: &MachineProfile) -> Option<Command> {
         let mut out = None;
         ui.horizontal(|ui| {
-            let label = ui.label("Built-in");
+            let label = ui.label("Machine");
             let current = builtin_words(profile);
             egui::ComboBox::from_id_salt("builtin-profile")
                 .selected_text(current)
                 .wrap()
                 .show_ui(ui, |ui| {
-                    for (name, _) in BUILTIN {
-                        if ui.button(*name).clicked() {
-                            match MachineProfile::builtin(name) {
-                                Ok(p) => out = Some(p),
-                                Err(e) => self.file_error = Some(e.to_string()),
-                            }
+                    for (key, _) in BUILTIN {
+                        // the machine by its name; the command line's key on hover
+                        let Ok(p) = MachineProfile::builtin(key) else {
+                            continue;
+                        };
+                        if ui
+                            .button(p.name.as_str())
+                            .on_hover_text(format!("built in: --profile {key}"))
+                            .clicked()
+                        {
+                            out = Some(p);
                         }
                     }
                 })
@@ -414,19 +419,21 @@ pub(super) fn combo<T: PartialEq + Copy>(
     .inner
 }
 
-/// What the built-in profile picker shows for `profile`: the built-in it equals; a built-in's
-/// name with "edited" when it carries that built-in's name but other values; else "custom".
+/// What the machine picker shows for `profile`: the built-in machine it equals, by its name;
+/// that name with "edited" when it carries a built-in's name but other values; else the
+/// profile's own name, said to be the operator's.
 pub fn builtin_words(profile: &MachineProfile) -> String {
-    let builtins: Vec<(&str, MachineProfile)> = BUILTIN
+    let builtins: Vec<MachineProfile> = BUILTIN
         .iter()
-        .filter_map(|(name, _)| Some((*name, MachineProfile::builtin(name).ok()?)))
+        .filter_map(|(key, _)| MachineProfile::builtin(key).ok())
         .collect();
-    if let Some((name, _)) = builtins.iter().find(|(_, b)| b == profile) {
-        return (*name).to_string();
+    if builtins.iter().any(|b| b == profile) {
+        return profile.name.clone();
     }
-    match builtins.iter().find(|(_, b)| b.name == profile.name) {
-        Some((name, _)) => format!("{name}, edited"),
-        None => "custom (edited or loaded)".to_string(),
+    if builtins.iter().any(|b| b.name == profile.name) {
+        format!("{}, edited", profile.name)
+    } else {
+        format!("{} (loaded or edited)", profile.name)
     }
 }
 
