@@ -15,6 +15,15 @@
 # it with no error, every move ends on the toolpath (1 um), the machine runs it to the end with no
 # error, and the ratio lies within 0.95-1.05 (step-and-scan; laser-on time too) or 0.90-1.10
 # (on the fly). Exits 1 when a job is not ok.
+#
+# Streamed on-the-fly jobs (mode "on-the-fly-streamed": the `linuxcnc` profile streams on the
+# fly, docs/GCODE.md): plans with --stream, runs the program while galvoplan-run.py feeds the
+# stream, and compares halsampler's record of the joints and the laser with the stream
+# (scripts/linuxcnc_stream_check.py): positions within 1 um, the same laser edges, no underrun,
+# laser span ratio 0.99-1.01. Then three checks of the wiring: a starved stream (fed too
+# slowly) stops with the laser off in the period it runs dry and says so; a stream with a
+# sample beyond the INI's limits is refused before it runs; `--motion auto` picks streamed on
+# the fly for oversize.svg at no more than half the step-and-scan job time.
 # Installs linuxcnc-uspace (without recommends) when it is missing.
 set -uo pipefail
 cd "$(dirname "$0")/.."
@@ -44,6 +53,7 @@ fi
 export RUNTESTS=1
 
 sim() { # program result -> runs it; one retry when LinuxCNC did not come up
+  # (a streamed job: GALVOPLAN_STREAM and GALVOPLAN_TRACE in the environment)
   local try
   for try in 1 2; do
     rm -f "$2"
@@ -57,8 +67,11 @@ sim() { # program result -> runs it; one retry when LinuxCNC did not come up
 status=0
 job() { # name svg mode [plan options...]
   local name=$1 svg=$2 mode=$3; shift 3
-  local o="$OUT/$name"
-  if ! "$B" plan "$svg" --profile linuxcnc --motion "$mode" -o "$o.ngc" --report "$o.json" \
+  local o="$OUT/$name" profile=linuxcnc
+  # on the fly as an inverse-time program: the profile without its stream (a LinuxCNC machine
+  # without the streamer wiring; the program runs on this one too)
+  [ "$mode" = on-the-fly ] && profile="$G93_PROFILE"
+  if ! "$B" plan "$svg" --profile "$profile" --motion "$mode" -o "$o.ngc" --report "$o.json" \
       --waypoints "$o.waypoints.csv" "$@" 2>"$o.plan.log"; then
     echo "{\"job\": \"$name\", \"mode\": \"$mode\", \"ok\": false, \"error\": \"plan failed\"}"
     status=1; return
@@ -99,6 +112,102 @@ sys.exit(0 if ok else 1)
 PY
 }
 
+PERIOD_S=$(sed -n 's/^stream_period_s = //p' assets/profiles/linuxcnc.toml)
+G93_PROFILE="$OUT/linuxcnc-g93.toml"
+sed '/^stream_period_s/d' assets/profiles/linuxcnc.toml >"$G93_PROFILE"
+
+stream_job() { # name svg
+  local name=$1 svg=$2
+  local o="$OUT/$name-streamed"
+  if ! "$B" plan "$svg" --profile linuxcnc --motion on-the-fly -o "$o.ngc" --report "$o.json" \
+      --stream "$o.stream" 2>"$o.plan.log"; then
+    echo "{\"job\": \"$name\", \"mode\": \"on-the-fly-streamed\", \"ok\": false, \"error\": \"plan failed: $(tail -1 "$o.plan.log" | tr -d '"')\"}"
+    status=1; return
+  fi
+  GALVOPLAN_STREAM="$o.stream" GALVOPLAN_TRACE="$o.trace" sim "$(realpath "$o.ngc")" "$o.sim.json"
+  python3 "$ROOT/scripts/linuxcnc_stream_check.py" "$o.stream" "$o.trace" --period-s "$PERIOD_S" \
+    >"$o.check.json" 2>"$o.check.log"
+  python3 - "$name" "$o" <<'PY' || status=1
+import json, sys
+name, o = sys.argv[1:]
+rep = json.load(open(o + ".json"))["metrics"]
+def load(path, what):
+    try:
+        return json.load(open(path))
+    except (OSError, ValueError):
+        return {"ok": False, "errors": [what]}
+sim = load(o + ".sim.json", "LinuxCNC did not run (see %s.sim.json.log)" % o)
+chk = load(o + ".check.json", "the trace check did not run (see %s.check.log)" % o)
+ok = bool(sim.get("ok") and chk.get("ok"))
+row = {"job": name, "mode": "on-the-fly-streamed", "linuxcnc_s": chk.get("linuxcnc_laser_s"),
+       "galvoplan_s": chk.get("planned_laser_s"), "ratio": chk.get("ratio"),
+       "job_time_s": round(rep.get("job_time_s") or 0.0, 4), "samples": chk.get("samples"),
+       "max_position_error_um": chk.get("max_position_error_um"),
+       "laser_edges_ok": chk.get("laser_edges_ok"), "underruns": chk.get("underruns"), "ok": ok,
+       "errors": sim.get("errors", []) + chk.get("errors", [])}
+print(json.dumps(row))
+sys.exit(0 if ok else 1)
+PY
+}
+
+starved_job() { # a stream fed at a third of its pace: it must stop, laser off, and say so
+  local o="$OUT/oversize-streamed" s="$OUT/starved"
+  GALVOPLAN_STREAM="$o.stream" GALVOPLAN_TRACE="$s.trace" GALVOPLAN_STREAM_RATE=3000 \
+    sim "$(realpath "$o.ngc")" "$s.sim.json"
+  python3 - "$s" <<'PY' || status=1
+import json, sys
+s = sys.argv[1]
+sim = json.load(open(s + ".sim.json"))
+rows = [l.split() for l in open(s + ".trace") if l.strip()]
+# the first period the FIFO ran dry before the last sample: the laser must be off in it
+dry = next((r for r in rows if r[6] == "1" and r[5] == "0"), None)
+said = any("ran dry" in e for e in sim.get("errors", []))
+ok = (not sim.get("ok")) and said and dry is not None and dry[4] == "0" and int(rows[-1][7]) > 0
+print(json.dumps({"job": "oversize-starved", "mode": "on-the-fly-streamed",
+                  "stopped": not sim.get("ok"), "laser_off_when_dry": dry is not None and dry[4] == "0",
+                  "underruns": int(rows[-1][7]) if rows else None, "said": said, "ok": ok,
+                  "errors": sim.get("errors", [])}))
+sys.exit(0 if ok else 1)
+PY
+}
+
+beyond_job() { # a sample past U's limit: refused before anything runs
+  local o="$OUT/oversize-streamed" s="$OUT/beyond"
+  awk 'NR == 100 { $3 = "40.0" } { print }' "$o.stream" >"$s.stream"
+  GALVOPLAN_STREAM="$s.stream" sim "$(realpath "$o.ngc")" "$s.sim.json"
+  python3 - "$s" <<'PY' || status=1
+import json, sys
+sim = json.load(open(sys.argv[1] + ".sim.json"))
+ok = bool(sim.get("stream_refused")) and any("beyond" in e for e in sim.get("errors", []))
+print(json.dumps({"job": "oversize-beyond-limits", "mode": "on-the-fly-streamed",
+                  "refused": bool(sim.get("stream_refused")), "ok": ok,
+                  "errors": sim.get("errors", [])}))
+sys.exit(0 if ok else 1)
+PY
+}
+
+auto_job() { # --motion auto picks the stream for oversize.svg, at most half step-and-scan's time
+  local o="$OUT/auto"
+  "$B" plan assets/examples/oversize.svg --profile linuxcnc --motion auto -o "$o.ngc" \
+    --report "$o.json" --stream "$o.stream" 2>"$o.log" &&
+  "$B" plan assets/examples/oversize.svg --profile linuxcnc --motion step --split-oversize \
+    -o "$o.step.ngc" --report "$o.step.json" 2>"$o.step.log"
+  python3 - "$o" <<'PY' || status=1
+import json, sys
+o = sys.argv[1]
+try:
+    auto = json.load(open(o + ".json"))["metrics"]["job_time_s"]
+    step = json.load(open(o + ".step.json"))["metrics"]["job_time_s"]
+    streamed = "streamed on the fly" in open(o + ".log").read()
+except (OSError, ValueError, KeyError) as e:
+    print(json.dumps({"job": "oversize-auto", "ok": False, "errors": [str(e)]})); sys.exit(1)
+ok = streamed and auto <= 0.5 * step
+print(json.dumps({"job": "oversize-auto", "mode": "auto", "streamed": streamed, "auto_s": auto,
+                  "step_s": step, "ratio": round(auto / step, 4), "ok": ok}))
+sys.exit(0 if ok else 1)
+PY
+}
+
 job demo assets/examples/demo.svg step
 job ISW-1017 tests/data/linuxcnc/ISW-1017.svg step
 job two-layers assets/examples/two-layers.svg step --pens assets/examples/two-layers.pens.toml
@@ -108,6 +217,13 @@ job lissajous tests/data/linuxcnc/lissajous.svg on-the-fly
 job tray-2x2 assets/examples/part.svg step --array 2x2@40,32 --serial 1001 --date 2026-12-07
 # a dotted DataMatrix on each part (one spot per module, fired for the dwell) on the fly
 job tray-dots assets/examples/part.svg on-the-fly --array 2x2@40,32 --serial 1001 --code "datamatrix:GP{serial:05}@3,3:6:dots"
+for n in oversize lissajous spiral tree; do
+  f=tests/data/linuxcnc/$n.svg; [ "$n" = oversize ] && f=assets/examples/oversize.svg
+  stream_job "$n" "$f"
+done
+starved_job
+beyond_job
+auto_job
 if [ -n "$SHARED" ]; then
   for f in "$SHARED"/instances/*.svg; do
     n=$(basename "$f" .svg)

@@ -979,7 +979,11 @@ fn complete_plan(
 /// motion and controller clock ([`crate::motion::lower_motion`]), whatever the document's
 /// current ones.
 pub fn lower_plan(doc: &Document, plan: &Plan) -> Result<Toolpath, PipelineError> {
-    lower_plan_on(doc, plan, plan.profile.controller.marks_clock_s())
+    lower_plan_on(
+        doc,
+        plan,
+        plan.profile.controller.marks_clock_s(plan.motion),
+    )
 }
 
 /// [`lower_plan`] on a clock of `clock_s` instead of its profile's (None: continuous).

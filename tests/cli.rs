@@ -164,7 +164,7 @@ fn oversize_geometry_is_listed() {
     );
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
-        err.contains("#huge") && err.contains("split into 2 strokes"),
+        err.contains("#huge") && err.contains("split into 2 pieces"),
         "{err}"
     );
     let report: serde_json::Value =
@@ -282,10 +282,12 @@ fn a_trajectory_never_changes_the_plans_job_time() {
     for svg in ["assets/examples/demo.svg", "assets/examples/oversize.svg"] {
         let svg = root.join(svg).display().to_string();
         for profile in ["seed000", "linuxcnc", clocked.as_str()] {
-            let out = d("job.gcode");
+            let (out, stream) = (d("job.gcode"), d("job.stream"));
             let plan = |extra: &[&str]| {
                 let mut args = vec!["plan", &svg, "--profile", profile, "--motion", "auto"];
                 args.extend(["-o", out.as_str()]);
+                // a plan the linuxcnc profile streams needs its stream
+                args.extend(["--stream", stream.as_str()]);
                 args.extend(extra);
                 galvoplan(&args)
             };
@@ -309,6 +311,8 @@ fn a_trajectory_never_changes_the_plans_job_time() {
             &svg,
             "--profile",
             profile,
+            "--motion",
+            "step",
             "-o",
             &out,
             "--trajectory",
@@ -747,11 +751,17 @@ fn linuxcnc_on_the_fly_says_why_its_job_time_is_what_it_is() {
     let out = dir.path().join("job.gcode").display().to_string();
     let svg = common::root().join("assets/examples/oversize.svg");
     let svg = svg.display().to_string();
+    // a LinuxCNC machine without the streamer wiring: on the fly is a G93 program
+    let text = std::fs::read_to_string(common::root().join("assets/profiles/linuxcnc.toml"));
+    let g93 = dir.path().join("linuxcnc-g93.toml");
+    let text = text.unwrap().replace("stream_period_s = 0.0001\n", "");
+    std::fs::write(&g93, text).unwrap();
+    let g93 = g93.display().to_string();
     let run = galvoplan(&[
         "plan",
         &svg,
         "--profile",
-        "linuxcnc",
+        &g93,
         "--motion",
         "on-the-fly",
         "-o",

@@ -83,7 +83,9 @@ fn step_and_scan_marks_between_m62_and_m63_in_exact_path_mode() {
 
 #[test]
 fn on_the_fly_lines_last_the_planned_time_and_stay_within_the_tolerance() {
-    let profile = MachineProfile::builtin("linuxcnc").unwrap();
+    // a LinuxCNC machine without the streamer wiring: on the fly is an inverse-time program
+    let mut profile = MachineProfile::builtin("linuxcnc").unwrap();
+    profile.controller.stream_period_s = None;
     let tol = profile.gcode.path_tol_mm;
     let (doc, plan, toolpath) = planned("oversize.svg", MotionMode::OnTheFly, profile.clone());
     assert!(toolpath.route.is_some());
@@ -167,13 +169,109 @@ fn the_configuration_is_the_profiles_machine() {
     assert!(ini.contains("[JOINT_0]") && ini.contains("[JOINT_3]"));
     assert!(ini.contains("MAX_ACCELERATION = 1000000"));
     let hal = text("galvoplan.hal");
-    assert!(hal.contains("net laser-gate motion.digital-out-00"));
-    assert!(hal.contains("motion.analog-out-02") && hal.contains("num_aio=4"));
+    assert!(hal.contains("num_aio=4") && hal.contains("base_period_nsec=[EMCMOT]BASE_PERIOD"));
     assert!(hal.contains("joint.3.motor-pos-cmd => joint.3.motor-pos-fb"));
     assert!(files
         .iter()
         .any(|f| f.name == "galvoplan-run.py" && f.executable));
     assert!(text("README.txt").contains("xy2mod"));
+    // the stream: in the base thread, its period the profile's; the joints, the laser (gated
+    // by the stream's state) and the power through it; an underrun is an E-stop
+    assert!(ini.contains("BASE_PERIOD = 100000") && ini.contains("HALFILE = galvoplan-stream.hal"));
+    let stream = text("galvoplan-stream.hal");
+    for line in [
+        "loadrt streamer depth=20000 cfg=ffffbbf",
+        "addf streamer.0 base-thread",
+        "net st-select motion.digital-out-01 => streamer.0.enable mux2.0.sel",
+        "net laser-gate st-laser-or.out",
+        "net estop-loop st-enable.out => iocontrol.0.emc-enable-in",
+        "net st-end streamer.0.pin.5 => motion.digital-in-00",
+        "net st-p3 streamer.0.pin.3 => mux2.3.in1",
+        "net st-power streamer.0.pin.6 => mux2.4.in1",
+    ] {
+        assert!(stream.contains(line), "{line}");
+    }
+    let timers = text("galvoplan-timers.hal");
+    assert!(timers.contains("loadrt and2 names=tm-laser-move,tm-job,st-active"));
+    // without a stream: the laser is motion's output alone
+    profile.controller.stream_period_s = None;
+    let files = linuxcnc_config(&profile);
+    let hal = &files
+        .iter()
+        .find(|f| f.name == "galvoplan.hal")
+        .unwrap()
+        .text;
+    assert!(hal.contains("net laser-gate motion.digital-out-00"));
+    assert!(hal.contains("net laser-power motion.analog-out-02"));
+    assert!(!files.iter().any(|f| f.name == "galvoplan-stream.hal"));
+}
+
+#[test]
+fn a_streamed_plan_is_its_own_states_on_the_streams_clock() {
+    use galvoplan::export::{stream_text, StreamError};
+    let profile = MachineProfile::builtin("linuxcnc").unwrap();
+    let period_s = profile.controller.stream_period_s.unwrap();
+    let (doc, plan, toolpath) = planned("oversize.svg", MotionMode::OnTheFly, profile.clone());
+    let (text, f) = stream_text(&toolpath, &plan).unwrap();
+    let lines: Vec<Vec<&str>> = text.lines().map(|l| l.split(' ').collect()).collect();
+    assert_eq!(lines.len(), f.samples);
+    assert_eq!(f.period_s, period_s);
+    // the plan's own states, sample by sample, and its end marked on the last line only
+    for (k, cols) in lines.iter().enumerate() {
+        assert_eq!(cols.len(), 6);
+        let m = toolpath.state_at(k as f64 * period_s);
+        let v: Vec<f64> = cols[..4].iter().map(|c| c.parse().unwrap()).collect();
+        let want = [m.stage.x, m.stage.y, m.scan.x, m.scan.y];
+        assert!(v.iter().zip(want).all(|(a, b)| (a - b).abs() < 1e-6), "{k}");
+        assert_eq!(cols[4], if m.laser { "1" } else { "0" });
+        assert_eq!(cols[5] == "1", k + 1 == lines.len());
+    }
+    // the laser switches on a sample (the plan is made on the stream's clock): where a mark
+    // begins after something else, and ends before something else
+    let mark = |i: usize| {
+        toolpath
+            .segments
+            .get(i)
+            .is_some_and(|s| s.kind == galvoplan::motion::SegmentKind::Mark)
+    };
+    let on_tick = |t: f64| ((t / period_s) - (t / period_s).round()).abs() < 1e-6;
+    for (i, seg) in toolpath
+        .segments
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| mark(*i))
+    {
+        assert!(
+            i == 0 || mark(i - 1) || on_tick(seg.start_s),
+            "{}",
+            seg.start_s
+        );
+        assert!(mark(i + 1) || on_tick(seg.end_s()), "{}", seg.end_s());
+    }
+    // between samples the joints stay within the path tolerance of the planned path
+    assert!(
+        f.max_deviation_mm <= profile.gcode.path_tol_mm,
+        "{}",
+        f.max_deviation_mm
+    );
+    // the program hands the joints over and waits for the stream's last sample
+    let g = write_gcode(&toolpath, &plan, doc.page_mm[1], "oversize").unwrap();
+    assert!(g.contains("\nM64 P1\nM66 P0 L3 Q") && g.contains("\nM65 P1\n"));
+    assert!(!g.contains("G93") && !g.contains("\nG1 "));
+    // a sample beyond the machine's limits is refused
+    let mut small = plan.clone();
+    small.profile.stroke_mm = [100.0, 100.0];
+    let e = stream_text(&toolpath, &small).unwrap_err();
+    assert!(
+        matches!(e, StreamError::Beyond { ref axis, .. } if axis == "X" || axis == "Y"),
+        "{e}"
+    );
+    // a step-and-scan plan is not streamed
+    let (_, step, step_path) = planned("demo.svg", MotionMode::Step, profile);
+    assert!(matches!(
+        stream_text(&step_path, &step),
+        Err(StreamError::NotStreamed { .. })
+    ));
 }
 
 #[test]

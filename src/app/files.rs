@@ -252,7 +252,11 @@ pub fn export_text(
         ExportKind::Preview => preview_svg(toolpath, plan, doc.page_mm),
         ExportKind::Trajectory => {
             // sampled on the controller's clock when the profile has one, else every 1 ms
-            let clock_ms = plan.profile.controller.clock_s().map_or(1.0, |s| s * 1e3);
+            let clock_ms = plan
+                .profile
+                .controller
+                .clock_s(plan.motion)
+                .map_or(1.0, |s| s * 1e3);
             let period_s = trajectory_period_s(clock_ms).map_err(|e| e.to_string())?;
             trajectory_csv(toolpath, period_s)
         }

@@ -359,6 +359,7 @@ impl PlanArgs {
             ("trajectory", &self.trajectory),
             ("waypoints", &self.waypoints),
             ("parts log", &self.parts_log),
+            ("stream", &self.stream),
         ];
         v.extend(
             optional
@@ -524,6 +525,11 @@ struct PlanArgs {
     /// changes it.
     #[arg(long, value_name = "MS", requires = "trajectory")]
     trajectory_period_ms: Option<f64>,
+    /// Write the stream of a streamed on-the-fly plan (a LinuxCNC profile with
+    /// `[controller] stream_period_s`): one line per stream period, `X Y U V laser end`, which
+    /// the machine's `streamer` feeds to the joints while the program waits (docs/GCODE.md).
+    #[arg(long, value_name = "JOB.stream")]
+    stream: Option<PathBuf>,
     /// Write the toolpath's exact states at every segment end and mark vertex (on the fly: and
     /// every millisecond of planned time, the on-the-fly program's samples) as CSV, in the
     /// trajectory's columns: what a controller's canonical moves are checked against.

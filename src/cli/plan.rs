@@ -21,11 +21,11 @@ pub fn run(a: &PlanArgs) -> Result<()> {
     let profile = a.job.profile()?;
     let settings = a.job.settings()?;
     let opts = a.job.import()?;
-    let period_s = a
-        .trajectory
-        .as_ref()
-        .map(|_| sampling_period_s(&profile, a.trajectory_period_ms))
-        .transpose()?;
+    // an impossible period is refused before any work; one the plan's clock differs from, once
+    // the plan (and so its motion) is made
+    if let (Some(_), Some(ms)) = (&a.trajectory, a.trajectory_period_ms) {
+        trajectory_period_s(ms)?;
+    }
     let pens = a.job.pens()?;
     let progress = Arc::new(BarProgress::new());
     let import_progress = |done| {
@@ -92,8 +92,14 @@ pub fn run(a: &PlanArgs) -> Result<()> {
     let source = a.input.display().to_string();
     // the trajectory samples the toolpath the plan was ordered and measured on (on the
     // profile's clock when it has one): an export never changes the plan's figures
+    let period_s = a
+        .trajectory
+        .as_ref()
+        .map(|_| sampling_period_s(&plan.profile, plan.motion, a.trajectory_period_ms))
+        .transpose()?;
     let trajectory = period_s.map(|p| trajectory_csv(&toolpath, p));
     let waypoints = a.waypoints.as_ref().map(|_| waypoints_csv(&toolpath));
+    let stream = stream_of(a, &plan, &toolpath)?;
     // streamed into the output file (atomically: written whole or not at all)
     let mut gcode_error = None;
     write_atomic_with(&a.output, |f| {
@@ -141,6 +147,9 @@ pub fn run(a: &PlanArgs) -> Result<()> {
     if let (Some(p), Some(s)) = (&a.waypoints, &waypoints) {
         write(p, s)?;
     }
+    if let (Some(p), Some(s)) = (&a.stream, &stream) {
+        write(p, s)?;
+    }
     if let Some(log) = &a.parts_log {
         let program = a.output.display().to_string();
         galvoplan::export::append_parts_log(log, &program, &plan.parts, chrono_now())
@@ -162,13 +171,53 @@ pub fn run(a: &PlanArgs) -> Result<()> {
     Ok(())
 }
 
-/// The trajectory's sampling period, s: the profile's clock (a `--trajectory-period-ms` that
-/// differs from it is refused), else the period asked for, else 1 ms.
+/// The stream of a streamed plan (checked against the machine's limits, written only with
+/// `--stream`, which such a plan needs: its program runs nothing without it); says what it
+/// holds. A plan that is not streamed has none.
+fn stream_of(
+    a: &PlanArgs,
+    plan: &galvoplan::document::Plan,
+    toolpath: &galvoplan::motion::Toolpath,
+) -> Result<Option<String>> {
+    let source = a.input.display();
+    let streamed = toolpath.route.is_some() && plan.profile.controller.streamed(plan.motion);
+    if !streamed {
+        if let Some(p) = &a.stream {
+            eprintln!(
+                "galvoplan: {source}: the plan is {}, not streamed: {} is not written",
+                plan.motion_words(),
+                p.display()
+            );
+        }
+        return Ok(None);
+    }
+    let Some(path) = &a.stream else {
+        anyhow::bail!(
+            "{source}: the plan is streamed on the fly (profile '{}'): give --stream JOB.stream for its stream, which the program waits for",
+            plan.profile.name
+        );
+    };
+    let (text, f) = galvoplan::export::stream_text(toolpath, plan)
+        .with_context(|| format!("{}: cannot stream the plan", path.display()))?;
+    eprintln!(
+        "galvoplan: {source}: streamed on the fly: {} samples every {} ms ({:.3} s); between samples the joints stay within {:.4} mm of the planned path",
+        f.samples,
+        f.period_s * 1e3,
+        (f.samples.saturating_sub(1)) as f64 * f.period_s,
+        f.max_deviation_mm
+    );
+    Ok(Some(text))
+}
+
+/// The trajectory's sampling period, s: the clock of the profile's controller for a plan in
+/// `motion` (a `--trajectory-period-ms` that differs from it is refused), else the period asked
+/// for, else 1 ms.
 fn sampling_period_s(
     profile: &galvoplan::document::MachineProfile,
+    motion: galvoplan::document::Motion,
     asked_ms: Option<f64>,
 ) -> Result<f64> {
-    let Some(clock_s) = profile.controller.clock_s() else {
+    let Some(clock_s) = profile.controller.clock_s(motion) else {
         return Ok(trajectory_period_s(asked_ms.unwrap_or(1.0))?);
     };
     match asked_ms {

@@ -14,8 +14,9 @@ use thiserror::Error;
 /// * 3: `[gcode] mode = "linuxcnc"` with `laser_output`, `power_output`, `path_tol_mm`; a
 ///   `[controller]` table (the controller's time law). Every version-2 file is a valid
 ///   version-3 file.
-/// * 4: `[controller] clock_period_s`, a scan head's clock (plans made on it). Every version-3
-///   file is a valid version-4 file.
+/// * 4: `[controller] clock_period_s`, a scan head's clock (plans made on it), and
+///   `stream_period_s`, a LinuxCNC machine that streams on-the-fly plans. Every version-3 file
+///   is a valid version-4 file.
 pub const PROFILE_VERSION: u32 = 4;
 
 /// Limits of one base-stage axis (seed 002, Table 2 style).
@@ -254,23 +255,43 @@ pub struct Controller {
     /// continuous. A LinuxCNC controller's clock is its servo period.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub clock_period_s: Option<f64>,
+    /// A LinuxCNC controller that streams on-the-fly plans: the period of the thread that takes
+    /// one sample of X, Y, U, V and the laser from a realtime FIFO (LinuxCNC's `streamer` in
+    /// motmod's base thread; docs/GCODE.md, *Streamed on the fly*), s. On-the-fly plans are made
+    /// on it. None: on the fly is an inverse-time (`G93`) program, run at LinuxCNC's pace.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stream_period_s: Option<f64>,
 }
 
 impl Controller {
-    /// The controller's clock period, s, if it has one: the servo period of LinuxCNC, the
-    /// scan head's clock when the profile gives one.
-    pub fn clock_s(&self) -> Option<f64> {
+    /// The controller's clock period for a plan in `motion`, s, if it has one: the stream's
+    /// period for a streamed on-the-fly plan, else LinuxCNC's servo period, or the scan head's
+    /// clock when the profile gives one.
+    pub fn clock_s(&self, motion: super::Motion) -> Option<f64> {
         match self.kind {
-            ControllerKind::Linuxcnc => Some(self.servo_period_s),
+            ControllerKind::Linuxcnc => Some(
+                self.streamed(motion)
+                    .then_some(self.stream_period_s)
+                    .flatten()
+                    .unwrap_or(self.servo_period_s),
+            ),
             ControllerKind::Ideal => self.clock_period_s,
         }
     }
 
-    /// The clock the lowering puts marks on ([`crate::motion::Toolpath::on_clock`]): the scan
-    /// head's. LinuxCNC's time law already counts every move in whole servo periods.
-    pub fn marks_clock_s(&self) -> Option<f64> {
+    /// A plan in `motion` is streamed to a LinuxCNC machine's joints, not run as G-code.
+    pub fn streamed(&self, motion: super::Motion) -> bool {
+        self.kind == ControllerKind::Linuxcnc
+            && motion == super::Motion::OnTheFly
+            && self.stream_period_s.is_some()
+    }
+
+    /// The clock the lowering puts marks on for a plan in `motion`
+    /// ([`crate::motion::Toolpath::on_clock`]): the scan head's, or a LinuxCNC stream's.
+    /// LinuxCNC's time law already counts every move of its programs in whole servo periods.
+    pub fn marks_clock_s(&self, motion: super::Motion) -> Option<f64> {
         match self.kind {
-            ControllerKind::Linuxcnc => None,
+            ControllerKind::Linuxcnc => self.stream_period_s.filter(|_| self.streamed(motion)),
             ControllerKind::Ideal => self.clock_period_s,
         }
     }
@@ -283,6 +304,7 @@ impl Default for Controller {
             servo_period_s: 1e-3,
             scanner_accel_mm_s2: 1e6,
             clock_period_s: None,
+            stream_period_s: None,
         }
     }
 }
@@ -460,6 +482,21 @@ impl MachineProfile {
                 self.otf_margin_mm,
                 format!("less than half the field ({half_field_mm} mm)"),
             ));
+        }
+        if let Some(stream_s) = self.controller.stream_period_s {
+            // the stream runs in motmod's base thread, whose period divides the servo period
+            let ratio = self.controller.servo_period_s / stream_s;
+            if (ratio - ratio.round()).abs() > 1e-6 || ratio < 0.5 {
+                return Err(InvalidValue::new(
+                    "Stream period",
+                    "controller.stream_period_s",
+                    stream_s,
+                    format!(
+                        "a whole fraction of the servo period ({} s)",
+                        self.controller.servo_period_s
+                    ),
+                ));
+            }
         }
         if self.controller.kind == ControllerKind::Linuxcnc
             && self.gcode.mode != GcodeMode::Linuxcnc

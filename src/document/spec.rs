@@ -638,6 +638,15 @@ fn controller_specs() -> Vec<FieldSpec<MachineProfile>> {
             |p| p.controller.servo_period_s
         ),
         optional!(
+            "Stream period",
+            "s",
+            "controller.stream_period_s",
+            "LinuxCNC: on-the-fly plans streamed to the joints, one sample a period (its base \
+             thread); empty: an inverse-time (G93) program",
+            Range(1e-5, 0.01),
+            |p| p.controller.stream_period_s
+        ),
+        optional!(
             "Scan-head clock",
             "s",
             "controller.clock_period_s",
@@ -1135,6 +1144,8 @@ pub mod rows {
     /// LinuxCNC's servo period.
     pub const SERVO_PERIOD: Row<MachineProfile> =
         Row::new("controller.servo_period_s", profile_specs);
+    /// A LinuxCNC stream's period.
+    pub const STREAM: Row<MachineProfile> = Row::new("controller.stream_period_s", profile_specs);
     /// A scan head's clock.
     pub const CLOCK: Row<MachineProfile> = Row::new("controller.clock_period_s", profile_specs);
     /// LinuxCNC's scanner acceleration.
@@ -1185,7 +1196,7 @@ pub const PROFILE_APPLIES: &[AppliesWhen] = &[
     (&[rows::POWER_WORD], |p| {
         !(p.gcode.mode == GcodeMode::Linuxcnc && p.gcode.power_output.is_some())
     }),
-    (&[rows::SERVO_PERIOD], |p| {
+    (&[rows::SERVO_PERIOD, rows::STREAM], |p| {
         p.controller.kind == ControllerKind::Linuxcnc
     }),
     (&[rows::CLOCK], |p| {

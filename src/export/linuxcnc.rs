@@ -42,6 +42,12 @@ pub(super) fn write_program(
     let profile = &plan.profile;
     let mut p = Program::new(profile, w, sink);
     p.out.push_str(header);
+    if toolpath.route.is_some() && profile.controller.streamed(plan.motion) {
+        p.start(false);
+        p.hand_over(toolpath);
+        p.end();
+        return p.spill(0);
+    }
     p.start(toolpath.route.is_some());
     if toolpath.route.is_some() {
         p.on_the_fly(toolpath, plan)?;
@@ -116,6 +122,48 @@ impl<'a, 'w> Program<'a, 'w> {
             let _ = writeln!(self.out, "M68 E{e} Q0");
         }
         self.out.push_str("G94\n(end)\nM2\n");
+    }
+
+    /// A streamed on-the-fly job: the machine to the stream's first sample, the joints handed
+    /// to the stream (`M64` on the stream's output), a wait for its last sample (`M66` on its
+    /// end input; the program is aborted when it does not come), motion taken to the last
+    /// sample while the stream still holds the joints (so that nothing jumps), and the joints
+    /// handed back (`M65`).
+    fn hand_over(&mut self, toolpath: &Toolpath) {
+        let d = &self.profile.gcode;
+        let [u, v] = [d.scanner_axes[0].trim(), d.scanner_axes[1].trim()];
+        let sel = super::linuxcnc_config::stream_output(self.profile);
+        let end = super::linuxcnc_config::STREAM_END_INPUT;
+        let first = toolpath.state_at(0.0);
+        let last = toolpath.state_at(toolpath.duration_s());
+        let at = |m: &crate::motion::MachineState| {
+            format!(
+                "X{} Y{} {u}{} {v}{}",
+                self.w.num(m.stage.x),
+                self.w.num(m.stage.y),
+                self.w.num(m.scan.x),
+                self.w.num(m.scan.y)
+            )
+        };
+        let (from, to) = (at(&first), at(&last));
+        // the wait is bounded: the job's time and 10 s for the stream to start
+        let wait_s = toolpath.duration_s() + 10.0;
+        let _ = write!(
+            self.out,
+            "(streamed on the fly: the stream moves X Y {u} {v} and the laser, one sample a period)
+G0 {from}
+M66 P{end} L0
+M64 P{sel}
+M66 P{end} L3 Q{wait}
+o100 if [#5399 LT 0]
+(abort, the stream did not reach its last sample: it ran dry or its feeder stopped)
+o100 endif
+G0 {to}
+M66 P{end} L0
+M65 P{sel}
+",
+            wait = fmt_s(wait_s)
+        );
     }
 
     /// Writes the lines held to the sink once they are `at_least` bytes (0: whatever is held).

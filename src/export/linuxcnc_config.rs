@@ -22,6 +22,16 @@ use std::fmt::Write;
 /// round past a limit by half a unit of the last place.
 pub const LIMIT_MARGIN_MM: f64 = 0.001;
 
+/// The digital input that tells a streamed job's program the stream reached its last sample
+/// (`M66 P0`; the stream's `end` column, [`super::stream_text`]).
+pub const STREAM_END_INPUT: u32 = 0;
+
+/// The digital output that hands the joints and the laser to the stream (`M64`/`M65`): the one
+/// after the laser's.
+pub fn stream_output(profile: &MachineProfile) -> u32 {
+    profile.gcode.laser_output + 1
+}
+
 /// One file of a configuration: its name in the output folder and its text.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct ConfigFile {
@@ -48,7 +58,12 @@ struct Axis {
 /// The configuration files for `profile` (see the module documentation).
 pub fn linuxcnc_config(profile: &MachineProfile) -> Vec<ConfigFile> {
     let axes = axes(profile);
-    vec![
+    let stream = profile.controller.stream_period_s.map(|_| ConfigFile {
+        name: "galvoplan-stream.hal",
+        text: stream_hal(profile),
+        executable: false,
+    });
+    let mut files = vec![
         ConfigFile {
             name: "galvoplan.ini",
             text: ini(profile, &axes),
@@ -61,7 +76,7 @@ pub fn linuxcnc_config(profile: &MachineProfile) -> Vec<ConfigFile> {
         },
         ConfigFile {
             name: "galvoplan-timers.hal",
-            text: TIMERS_HAL.to_string(),
+            text: timers_hal(profile),
             executable: false,
         },
         ConfigFile {
@@ -79,7 +94,9 @@ pub fn linuxcnc_config(profile: &MachineProfile) -> Vec<ConfigFile> {
             text: readme(profile, &axes),
             executable: false,
         },
-    ]
+    ];
+    files.extend(stream);
+    files
 }
 
 fn axes(profile: &MachineProfile) -> Vec<Axis> {
@@ -148,7 +165,7 @@ PARAMETER_FILE = galvoplan.var
 EMCMOT = motmod
 COMM_TIMEOUT = 1.0
 SERVO_PERIOD = {servo_ns}
-
+{base}
 [EMCIO]
 EMCIO = io
 CYCLE_TIME = 0.100
@@ -158,7 +175,7 @@ TOOL_TABLE = galvoplan.tbl
 HALUI = halui
 HALFILE = galvoplan.hal
 HALFILE = galvoplan-timers.hal
-
+{stream_hal}
 [KINS]
 KINEMATICS = trivkins coordinates={coords}
 JOINTS = 4
@@ -177,6 +194,18 @@ MAX_LINEAR_VELOCITY = {fastest}
         v = axes[3].letter,
         default_v = num(profile.axis_x.max_velocity_mm_s),
         fastest = num(fastest),
+        stream_hal = if profile.controller.stream_period_s.is_some() {
+            "HALFILE = galvoplan-stream.hal\n"
+        } else {
+            ""
+        },
+        base = profile
+            .controller
+            .stream_period_s
+            .map_or(String::new(), |p| format!(
+                "# the thread the stream of a streamed on-the-fly job runs in\nBASE_PERIOD = {}\n",
+                (p * 1e9).round() as u64
+            )),
     );
     for (j, a) in axes.iter().enumerate() {
         let limits = format!(
@@ -198,12 +227,18 @@ MAX_LINEAR_VELOCITY = {fastest}
 
 fn hal(profile: &MachineProfile) -> String {
     let d = &profile.gcode;
-    let dio = (d.laser_output + 1).max(4);
+    let streams = profile.controller.stream_period_s.is_some();
+    let dio = (stream_output(profile) + 1).max(4);
     let aio = d.power_output.map_or(4, |e| (e + 1).max(4));
+    let base = if streams {
+        "base_period_nsec=[EMCMOT]BASE_PERIOD base_thread_fp=1 "
+    } else {
+        ""
+    };
     let mut s = format!(
         "# Motion and the simulated machine (galvoplan linuxcnc-config).
 loadrt [KINS]KINEMATICS
-loadrt [EMCMOT]EMCMOT servo_period_nsec=[EMCMOT]SERVO_PERIOD num_joints=[KINS]JOINTS num_dio={dio} num_aio={aio}
+loadrt [EMCMOT]EMCMOT {base}servo_period_nsec=[EMCMOT]SERVO_PERIOD num_joints=[KINS]JOINTS num_dio={dio} num_aio={aio}
 addf motion-command-handler servo-thread
 addf motion-controller servo-thread
 
@@ -221,9 +256,18 @@ addf motion-controller servo-thread
     let _ = write!(
         s,
         "
-net estop-loop iocontrol.0.user-enable-out => iocontrol.0.emc-enable-in
 net tool-prep-loop iocontrol.0.tool-prepare => iocontrol.0.tool-prepared
 net tool-change-loop iocontrol.0.tool-change => iocontrol.0.tool-changed
+"
+    );
+    if streams {
+        // the joints, the laser and the E-stop loop: galvoplan-stream.hal, loaded after the
+        // timers (whose and2/not instances it uses)
+        return s;
+    }
+    let _ = write!(
+        s,
+        "net estop-loop iocontrol.0.user-enable-out => iocontrol.0.emc-enable-in
 
 # The laser gate: digital output {n} (M62/M63 P{n} in the program).
 net laser-gate motion.digital-out-{n:02}
@@ -237,6 +281,120 @@ net laser-gate motion.digital-out-{n:02}
         );
     }
     s
+}
+
+/// Samples a stream's FIFO holds: two seconds of the stream, at least 4,096.
+fn stream_depth(period_s: f64) -> u64 {
+    ((2.0 / period_s).ceil() as u64).max(4096)
+}
+
+/// The logic of a streamed job's HAL, loaded with the timers' (a HAL component is loaded once):
+/// `and2` and `not` instances.
+const STREAM_AND2: &str = ",st-active,st-laser,st-starved,st-starved2,st-enable";
+const STREAM_NOT: &str = ",st-full,st-not-end,st-ok";
+
+/// The stream of a streamed on-the-fly job into the joints and the laser (docs/GCODE.md,
+/// *Streamed on the fly*): `streamer` in the base thread, `mux2` per joint between motion and
+/// the stream, the laser gated by the stream's state in the same period, and an E-stop when the
+/// stream runs dry before its last sample.
+fn stream_hal(profile: &MachineProfile) -> String {
+    let d = &profile.gcode;
+    let period_s = profile.controller.stream_period_s.unwrap_or(1e-4);
+    let depth = stream_depth(period_s);
+    let (sel, n) = (stream_output(profile), d.laser_output);
+    let power = d.power_output;
+    let cfg = if power.is_some() { "ffffbbf" } else { "ffffbb" };
+    let muxes = if power.is_some() { 5 } else { 4 };
+    let mut s = format!(
+        "# Streamed on the fly (docs/GCODE.md): the program hands the joints to the stream with
+# M64 P{sel} and waits for its last sample with M66 P{end} L3. The stream's FIFO is fed by
+# halstreamer (galvoplan-run.py): one line per base-thread period, X Y U V laser end{pw}.
+# While motion.digital-out-{sel:02} is on, each joint follows the stream (mux2), not motion;
+# the laser is the stream's bit while the FIFO has samples, so an underrun turns it off in the
+# same period, and an underrun before the last sample (end = 0) is an E-stop. The stream
+# bypasses LinuxCNC's soft limits: galvoplan and galvoplan-run.py check every sample against
+# the axes' limits before it runs. sampler.0 records what the joints and the laser get.
+loadrt streamer depth={depth} cfg={cfg}
+loadrt sampler depth={depth} cfg=ffffbbbs
+loadrt mux2 count={muxes}
+loadrt or2 names=st-laser-or
+addf streamer.0 base-thread
+",
+        end = STREAM_END_INPUT,
+        pw = if power.is_some() { " power" } else { "" },
+    );
+    for m in 0..muxes {
+        let _ = writeln!(s, "addf mux2.{m} base-thread");
+    }
+    for f in [
+        "st-full",
+        "st-not-end",
+        "st-active",
+        "st-laser",
+        "st-laser-or",
+        "st-starved",
+        "st-starved2",
+        "st-ok",
+        "sampler.0",
+    ] {
+        let _ = writeln!(s, "addf {f} base-thread");
+    }
+    let sels: String = (0..muxes).map(|m| format!(" mux2.{m}.sel")).collect();
+    let _ = write!(
+        s,
+        "addf st-enable servo-thread
+net st-select motion.digital-out-{sel:02} => streamer.0.enable{sels} st-active.in0 st-starved2.in1 sampler.0.enable
+net st-empty streamer.0.empty => st-full.in st-starved.in0
+net st-has st-full.out => st-active.in1
+net st-on st-active.out => st-laser.in0
+net st-laser-bit streamer.0.pin.4 => st-laser.in1
+net st-lit st-laser.out => st-laser-or.in1
+net st-end streamer.0.pin.5 => motion.digital-in-{end:02} st-not-end.in sampler.0.pin.5
+net st-not-ended st-not-end.out => st-starved.in1
+net st-starving st-starved.out => st-starved2.in0
+net st-starved-b st-starved2.out => st-ok.in
+net st-fine st-ok.out => st-enable.in1
+net estop-user iocontrol.0.user-enable-out => st-enable.in0
+net estop-loop st-enable.out => iocontrol.0.emc-enable-in
+# The laser gate: digital output {n} (M62/M63 P{n}) or the stream's bit.
+net g-laser motion.digital-out-{n:02} => st-laser-or.in0
+net laser-gate st-laser-or.out => sampler.0.pin.4
+net st-empty => sampler.0.pin.6
+net st-underruns streamer.0.underruns => sampler.0.pin.7
+",
+        end = STREAM_END_INPUT,
+    );
+    for j in 0..4 {
+        let _ = writeln!(
+            s,
+            "net j{j}-pos => mux2.{j}.in0\nnet st-p{j} streamer.0.pin.{j} => mux2.{j}.in1\nnet m{j}-pos mux2.{j}.out => sampler.0.pin.{j}"
+        );
+    }
+    if let Some(e) = power {
+        let _ = writeln!(
+            s,
+            "# The laser power: analog output {e} (M67 E{e}) or the stream's.\nnet g-power motion.analog-out-{e:02} => mux2.4.in0\nnet st-power streamer.0.pin.6 => mux2.4.in1\nnet laser-power mux2.4.out"
+        );
+    }
+    s
+}
+
+/// The timers' HAL file, with a streamed job's logic instances when the profile streams.
+fn timers_hal(profile: &MachineProfile) -> String {
+    let (and2, not) = if profile.controller.stream_period_s.is_some() {
+        (STREAM_AND2, STREAM_NOT)
+    } else {
+        ("", "")
+    };
+    TIMERS_HAL
+        .replace(
+            "loadrt not names=tm-still",
+            &format!("loadrt not names=tm-still{not}"),
+        )
+        .replace(
+            "loadrt and2 names=tm-laser-move,tm-job",
+            &format!("loadrt and2 names=tm-laser-move,tm-job{and2}"),
+        )
 }
 
 /// The timers' HAL file (the same for every profile).

@@ -73,8 +73,10 @@ pub fn lower_motion(
         }
         Motion::OnTheFly => {
             let path = lower_on_the_fly(geometries, plan, profile, clock_s, ctx)?;
-            match controller::LinuxcncClock::of(profile) {
+            let streamed = profile.controller.streamed(Motion::OnTheFly);
+            match controller::LinuxcncClock::of(profile).filter(|_| !streamed) {
                 // the controller's planner cannot keep the planned pace: the job at its pace
+                // (a streamed plan runs at its own, sample by sample)
                 Some(clock) => {
                     let (start, lines) = controller::otf_lines(&path, profile.gcode.path_tol_mm);
                     let controller_s = clock.otf_program_s(&start, &lines);

@@ -197,7 +197,9 @@ pub const LINUXCNC_OTF_NOTE: &str = "LinuxCNC runs on-the-fly G-code without loo
 /// look-ahead: 18.36 s; step-and-scan would take 8.16 s"). None elsewhere, after a cancel, or
 /// where step-and-scan cannot mark the order (geometries larger than a field).
 fn linuxcnc_note(nodes: &Nodes, inputs: &PlanInputs, best: &Made, ctx: &JobCtx) -> Option<String> {
-    let lcnc = inputs.profile.controller.kind == crate::document::ControllerKind::Linuxcnc;
+    // a streamed plan runs at its own pace: nothing to explain
+    let lcnc = inputs.profile.controller.kind == crate::document::ControllerKind::Linuxcnc
+        && !inputs.profile.controller.streamed(Motion::OnTheFly);
     if best.motion != Motion::OnTheFly || !lcnc || ctx.is_cancelled() {
         return None;
     }
@@ -528,7 +530,7 @@ impl<'a> Candidates<'a> {
     ) -> Result<Toolpath, OrderError> {
         let mut plan = self.plan(ordering);
         plan.step_fields = step_fields.to_vec();
-        let clock_s = plan.profile.controller.marks_clock_s();
+        let clock_s = plan.profile.controller.marks_clock_s(plan.motion);
         match lower_motion(self.real, &plan, clock_s, ctx) {
             Err(MotionError::OnTheFly(OtfError::Cancelled(c))) => Err(OrderError::Cancelled(c)),
             other => Ok(other?),
