@@ -2358,6 +2358,19 @@ fn the_compare_table_and_its_heading_stay_in_view_on_a_1000_pixel_screen() {
             let r = h.get_by_label_contains(heading).rect();
             assert!(r.top() >= 0.0 && r.bottom() <= size.y, "{heading}: {r:?}");
         }
+        // side by side: two canvases of the same size, next to each other
+        let canvas = |label: &str| {
+            h.get_all_by_label(label)
+                .find(|n| format!("{n:?}").contains("role: Canvas"))
+                .map(|n| n.rect())
+                .unwrap()
+        };
+        let (a, b) = (canvas("Plan A"), canvas("Plan B"));
+        assert!((a.width() - b.width()).abs() < 2.0, "{a:?} {b:?}");
+        assert!(
+            a.right() <= b.left() + 1.0 && a.width() > 200.0,
+            "{a:?} {b:?}"
+        );
     }
 }
 
@@ -2377,4 +2390,21 @@ fn the_view_follows_a_resized_window_until_the_operator_moves_it() {
     h.set_size(Vec2::new(1200.0, 800.0));
     settle(&mut h);
     assert_eq!(h.state().workbench_px_per_mm(), large_px);
+}
+
+#[test]
+fn a_linuxcnc_machine_without_the_stream_says_why_on_the_fly_takes_longer() {
+    use galvoplan::app::commands::Command;
+    let (mut h, _) = opened_oversize();
+    let mut p = galvoplan::document::MachineProfile::builtin("linuxcnc").unwrap();
+    p.controller.stream_period_s = None;
+    h.state_mut()
+        .execute(Command::SetProfile(Box::new(p)))
+        .unwrap();
+    settle(&mut h);
+    set_motion(&mut h, "On the fly (stage moves while marking)");
+    wait_idle(&mut h, Duration::from_secs(60));
+    solve(&mut h, "Run HHA");
+    h.get_by_label_contains("LinuxCNC runs on-the-fly G-code without look-ahead: ");
+    h.get_by_label_contains("step-and-scan would take");
 }

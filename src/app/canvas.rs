@@ -89,17 +89,18 @@ fn show_hint(ui: &mut egui::Ui, rect: Rect, editable: bool) {
         .painter()
         .layout_no_wrap(words.into(), font.clone(), ink)
         .size();
-    let at = rect.left_bottom() + Vec2::new(6.0, -6.0 - size.y);
+    // bottom right (the scale bar is bottom left)
+    let at = rect.right_bottom() + Vec2::new(-8.0 - size.x, -6.0 - size.y);
     let r = Rect::from_min_size(at, size + Vec2::new(2.0, 0.0));
     if !rect.contains_rect(r) {
         return;
     }
     ui.painter()
         .rect_filled(r.expand(3.0), 3.0, Color32::from_white_alpha(210));
-    ui.put(
-        r,
-        egui::Label::new(egui::RichText::new(words).font(font).color(ink)).selectable(false),
-    );
+    // a child ui of its own: the label takes no room in the canvas's layout (beside a second
+    // canvas, the compare view's, it would push that one away)
+    let mut child = ui.new_child(egui::UiBuilder::new().max_rect(r));
+    child.add(egui::Label::new(egui::RichText::new(words).font(font).color(ink)).selectable(false));
 }
 
 /// A seam drag that moves it less than this does not move it, mm (a tenth of what the
@@ -356,8 +357,12 @@ impl Canvas<'_> {
                     egui::FontId::proportional(13.0),
                     egui::Color32::WHITE,
                 );
-                let at = p + Vec2::new(12.0, -12.0 - galley.size().y);
-                let bg = Rect::from_min_size(at, galley.size() + Vec2::new(6.0, 2.0));
+                // beside the pointer, kept inside the canvas
+                let size = galley.size() + Vec2::new(6.0, 2.0);
+                let mut at = p + Vec2::new(12.0, -12.0 - galley.size().y);
+                at.x = at.x.min(rect.right() - size.x).max(rect.left());
+                at.y = at.y.max(rect.top()).min(rect.bottom() - size.y);
+                let bg = Rect::from_min_size(at, size);
                 painter.rect_filled(bg, 3.0, colour::SEAM);
                 painter.galley(at + Vec2::new(3.0, 1.0), galley, egui::Color32::WHITE);
             }

@@ -123,7 +123,8 @@ const ROWS: &[Row] = &[
     },
     Row {
         label: "Marking (s)",
-        help: "part of the job time: marking at mark speed (the same for every plan)",
+        help: "part of the job time: marking, at the pens' mark speeds (on the fly slower where \
+               the stage cannot follow, and on a controller clock in whole ticks)",
         value: |p| part(&p.metrics, |b| b.mark),
         decimals: 2,
         kind: RowKind::Part,
@@ -184,24 +185,25 @@ const ROWS: &[Row] = &[
     },
     Row {
         label: "Peak stage speed (mm/s)",
-        help: "the stage's largest speed (both axes together), sampled every millisecond",
+        help: "the stage's largest speed (both axes together), sampled every millisecond (not \
+               ranked: a faster job may well move faster)",
         value: |p| p.metrics.motion.map(|f| f.stage_peak_speed_mm_s),
         decimals: 0,
-        kind: RowKind::Ranked,
+        kind: RowKind::Info,
         only_some: false,
     },
     Row {
         label: "Stage acceleration (mm/s²)",
         help: "mean: the stage's speed changes averaged over the job (their sum, sampled every \
                millisecond, divided by the job time): lower is a smoother ride; the report \
-               keeps the sum as stage_speed_variation_mm_s",
+               keeps the sum as stage_speed_variation_mm_s (not ranked: the job time decides)",
         value: |p| {
             let f = p.metrics.motion?;
             let t = p.metrics.job_time_s.filter(|t| *t > 0.0)?;
             Some(f.stage_speed_variation_mm_s / t)
         },
         decimals: 0,
-        kind: RowKind::Ranked,
+        kind: RowKind::Info,
         only_some: false,
     },
     Row {
@@ -750,7 +752,7 @@ pub fn show(
             // one plan is shown alone, whichever way two would be
             c.label = match kb {
                 Some(_) => "Compare (overlay)",
-                None => "Plan A alone: solve another plan to compare",
+                None => "One plan: solve another to compare two",
             };
             if let Some(kb) = kb {
                 let mut other = canvas(kb, colour::PATH_B).paths;

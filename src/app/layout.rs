@@ -477,6 +477,10 @@ impl App {
                 .active()
                 .map_or(&[][..], |k| self.plan_staleness(k));
             compare::stale_notes(ui, &[(plan, stale)]);
+            // why the plan's motion and time are what they are (auto's choice, LinuxCNC's pace)
+            if let Some(note) = &plan.metrics.motion_note {
+                ui.add(egui::Label::new(RichText::new(note).italics()).wrap());
+            }
             compare::metrics_table(ui, "active-metrics", plan, None);
         }
         ui.separator();

@@ -428,7 +428,12 @@ impl App {
             count(self.session.doc().layers.len(), "layer", "layers"),
             count(self.session.doc().fields.len(), "scan field", "scan fields"),
             // the Warnings panel's word
-            count(self.session.doc().warnings.len(), "warning", "warnings")
+            // one line for the same warning on many elements, as the panel lists them
+            count(
+                crate::document::grouped(&self.session.doc().warnings).len(),
+                "warning",
+                "warnings"
+            )
         );
         match o.problem {
             Some(p) => {

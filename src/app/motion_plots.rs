@@ -62,6 +62,9 @@ pub struct MotionSamples {
     pub scan_y_mm: Vec<f64>,
     /// Stage speed (norm of the velocity, by a finite difference) at each sample, mm/s.
     pub stage_speed_mm_s: Vec<f64>,
+    /// The job's figures as the metrics give them (sampled every millisecond): the titles'
+    /// peaks, so that a plot and the table say the same.
+    pub figures: crate::document::MotionFigures,
 }
 
 impl MotionSamples {
@@ -69,7 +72,10 @@ impl MotionSamples {
     /// `None` for step-and-scan toolpaths.
     pub fn of(tp: &Toolpath) -> Option<Self> {
         let route = tp.route.as_ref()?;
-        let mut out = Self::default();
+        let mut out = Self {
+            figures: tp.motion_figures(crate::order::metrics::MOTION_SAMPLE_PERIOD_S),
+            ..Self::default()
+        };
         for t in sample_times_s(tp.duration_s(), PLOT_STEP_S, MAX_SAMPLES) {
             let scan = tp.state_at(t).scan;
             let (t0, t1) = (t - SPEED_DT_S / 2.0, t + SPEED_DT_S / 2.0);
@@ -84,15 +90,12 @@ impl MotionSamples {
 
     /// The largest |scanner offset| over both axes, mm.
     pub fn peak_offset_mm(&self) -> f64 {
-        self.scan_x_mm
-            .iter()
-            .chain(&self.scan_y_mm)
-            .fold(0.0, |m, v| m.max(v.abs()))
+        self.figures.scan_peak_offset_mm
     }
 
     /// The largest stage speed, mm/s.
     pub fn peak_speed_mm_s(&self) -> f64 {
-        self.stage_speed_mm_s.iter().fold(0.0, |m, &v| m.max(v))
+        self.figures.stage_peak_speed_mm_s
     }
 
     fn curve(&self, values: &[f64]) -> PlotPoints<'static> {
@@ -143,7 +146,8 @@ fn title(ui: &mut egui::Ui, text: String, hover: String, height_px: f32) -> f32 
 }
 
 /// How far above the highest curve or limit a plot reaches, as a share of it: the legend
-/// (top right) sits in that band, not over the curves.
+/// (top right; the curves only: the limit lines are said in the title) sits in that band,
+/// not over the curves.
 const LEGEND_HEADROOM: f64 = 1.45;
 
 fn offset_plot(
@@ -157,7 +161,7 @@ fn offset_plot(
     let height_px = title(
         ui,
         format!(
-            "Scanner offset (tool - stage), mm: peak {:.1} of ±{:.1}",
+            "Scanner offset (tool - stage), mm: peak {:.1} of ±{:.1} (dashed)",
             s.peak_offset_mm(),
             rx.min(ry)
         ),
@@ -185,14 +189,14 @@ fn offset_plot(
             for &r in limits {
                 for v in [r, -r] {
                     pui.hline(
-                        HLine::new("field limit", v)
+                        HLine::new("", v)
                             .color(LIMIT)
                             .style(LineStyle::dashed_loose()),
                     );
                 }
             }
             if let Some(t) = t_s {
-                pui.vline(VLine::new("playback t", t).color(NOW).width(2.0));
+                pui.vline(VLine::new("", t).color(NOW).width(2.0));
             }
         });
 }
@@ -211,7 +215,7 @@ fn speed_plot(
     let height_px = title(
         ui,
         format!(
-            "Stage speed, mm/s: peak {:.0}, limit {:.0} per axis, {:.0} both",
+            "Stage speed, mm/s: peak {:.0}, limit {:.0} per axis (dashed), {:.0} both (dotted)",
             s.peak_speed_mm_s(),
             vx.max(vy),
             vx.hypot(vy)
@@ -234,17 +238,17 @@ fn speed_plot(
         .show(ui, |pui| {
             pui.line(Line::new("stage speed", s.curve(&s.stage_speed_mm_s)).color(ROUTE));
             pui.hline(
-                HLine::new("one axis at its limit", vx.max(vy))
+                HLine::new("", vx.max(vy))
                     .color(LIMIT)
                     .style(LineStyle::dashed_loose()),
             );
             pui.hline(
-                HLine::new("both axes at their limits", vx.hypot(vy))
+                HLine::new("", vx.hypot(vy))
                     .color(LIMIT)
                     .style(LineStyle::dotted_loose()),
             );
             if let Some(t) = t_s {
-                pui.vline(VLine::new("playback t", t).color(NOW).width(2.0));
+                pui.vline(VLine::new("", t).color(NOW).width(2.0));
             }
         });
 }

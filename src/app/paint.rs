@@ -701,7 +701,9 @@ fn plan_caption(p: &PathLayer<'_>) -> String {
             p.plan.name,
             motion("on the fly"),
             m.idle_mm,
-            route_length_mm(&l.route_mm)
+            // the metrics' figure (sampled every millisecond), the drawn route's length else
+            m.motion
+                .map_or_else(|| route_length_mm(&l.route_mm), |f| f.stage_route_mm)
         ),
         lowered => format!(
             "{}: {job}{} · idle travel {:.0} mm · stage travel {:.0} mm · {} scan fields",
