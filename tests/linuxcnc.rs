@@ -361,3 +361,21 @@ fn linuxcnc_config_writes_the_machine_and_refuses_a_file_for_a_folder() {
     ]);
     assert!(String::from_utf8_lossy(&r.stderr).contains("nope"));
 }
+
+/// The workbench's G-code export of a streamed plan writes its stream beside the program.
+#[cfg(feature = "gui")]
+#[test]
+fn the_workbench_exports_a_streamed_plans_stream_beside_its_program() {
+    use galvoplan::app::files::{export, stream_path, ExportKind};
+    let profile = MachineProfile::builtin("linuxcnc").unwrap();
+    let (doc, plan, toolpath) = planned("oversize.svg", MotionMode::OnTheFly, profile);
+    let dir = tempfile::tempdir().unwrap();
+    let program = dir.path().join("job.ngc");
+    export(&doc, &plan, Some(&toolpath), ExportKind::Gcode, &program).unwrap();
+    let stream = std::fs::read_to_string(stream_path(&program)).unwrap();
+    let (want, _) = galvoplan::export::stream_text(&toolpath, &plan).unwrap();
+    assert_eq!(stream, want);
+    assert!(std::fs::read_to_string(&program)
+        .unwrap()
+        .contains("M64 P1"));
+}

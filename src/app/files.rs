@@ -272,8 +272,29 @@ pub fn export(
     kind: ExportKind,
     path: &Path,
 ) -> Result<(), String> {
+    // a streamed plan's program runs nothing without its stream: written beside it, first
+    if kind == ExportKind::Gcode && plan.profile.controller.streamed(plan.motion) {
+        let lowered;
+        let toolpath = match toolpath {
+            Some(t) => t,
+            None => {
+                lowered = lower_plan(doc, plan).map_err(|e| e.to_string())?;
+                &lowered
+            }
+        };
+        let stream = stream_path(path);
+        let (text, _) = crate::export::stream_text(toolpath, plan)
+            .map_err(|e| format!("{}: cannot stream the plan: {e}", stream.display()))?;
+        write_atomic(&stream, text.as_bytes())
+            .map_err(|e| format!("{}: cannot write: {e}", stream.display()))?;
+    }
     write_atomic(path, export_text(doc, plan, toolpath, kind)?.as_bytes())
         .map_err(|e| format!("{}: cannot write: {e}", path.display()))
+}
+
+/// Where a streamed plan's stream goes beside its program: `job.ngc` → `job.stream`.
+pub fn stream_path(program: &Path) -> PathBuf {
+    program.with_extension("stream")
 }
 
 /// The open dialog (SVG, DXF or project).

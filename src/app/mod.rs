@@ -960,7 +960,22 @@ impl App {
             }
             JobOutcome::Done(JobResult::Exported { path, kind }) => {
                 let what = kind.filter().0;
-                self.set_status(format!("wrote the {what} to {}", path.display()), false);
+                let streamed = self
+                    .session
+                    .active_plan()
+                    .is_some_and(|p| p.profile.controller.streamed(p.motion));
+                let beside = if kind == ExportKind::Gcode && streamed {
+                    format!(
+                        " and its stream to {} (the program waits for it)",
+                        files::stream_path(&path).display()
+                    )
+                } else {
+                    String::new()
+                };
+                self.set_status(
+                    format!("wrote the {what} to {}{beside}", path.display()),
+                    false,
+                );
             }
             JobOutcome::Done(JobResult::Plan { plan, lowered }) => {
                 self.solved(*plan, *lowered, (name, cancelled), ui_ctx)
