@@ -480,7 +480,7 @@ the card's pins and add its read/write functions to the servo thread, e.g. for a
            feedback from posx-fb/posy-fb, enable from amp-enable-out.
   laser:   motion.digital-out-{n:02} => the laser's gate input (a GPIO or sserial output){power}.
 Home switches, limits and E-stop wiring are the machine's own; this file homes in place.
-",
+{stream}",
         name = profile.name.replace('\n', " "),
         version = env!("CARGO_PKG_VERSION"),
         x = axes[0].letter,
@@ -500,6 +500,37 @@ Home switches, limits and E-stop wiring are the machine's own; this file homes i
         sa = num(axes[2].accel_mm_s2),
         servo = num(profile.controller.servo_period_s),
         n = d.laser_output,
+        stream = profile.controller.stream_period_s.map_or(String::new(), |p| format!(
+            "
+Streamed on the fly (galvoplan-stream.hal; docs/GCODE.md): a job planned with
+`galvoplan plan ... --stream JOB.stream` runs as JOB.ngc plus its stream, one sample every
+{p} s in motmod's base thread (BASE_PERIOD):
+  GALVOPLAN_PROGRAM=$PWD/JOB.ngc GALVOPLAN_STREAM=$PWD/JOB.stream \
+    GALVOPLAN_RESULT=$PWD/job.json linuxcnc galvoplan.ini
+galvoplan-run.py refuses a stream with a sample beyond the axes' limits (the stream bypasses the
+soft limits), fills the FIFO, then runs the program: M64 P{sel} hands the joints and the laser to
+the stream, M66 P0 waits for its last sample, M65 P{sel} takes them back. An underrun (the FIFO
+empty before the last sample) turns the laser off in the same period and is an E-stop.
+On a real machine the same wiring holds, with the mux outputs going to the hardware:
+  stage X/Y: mux2.0.out / mux2.1.out => the stepgen's position-cmd (hm2_<board>.0.stepgen.00/01)
+           or a pid's command for a servo drive (pwmgen + encoder); the base thread's period
+           must suit the drive (a stepgen interpolates between servo-rate commands; for a
+           stream faster than the servo thread, run the stepgen's update in the base thread or
+           keep the stream on the servo period);
+  scanner U/V: mux2.2.out / mux2.3.out => hm2_<board>.0.xy2mod.00.posx-cmd / posy-cmd (XY2-100
+           takes a position every 10 us: the stream's samples, held between);
+  laser:   st-laser-or.out (signal laser-gate) => the laser's gate input, so that an underrun
+           switches it off in the same period{power_stream};
+  feed the FIFO from user space with halstreamer (as galvoplan-run.py does) or the HAL stream
+  API (Python hal.stream), ahead of the consumer; streamer.0.curr-depth shows how far ahead.
+",
+            sel = stream_output(profile),
+            power_stream = if d.power_output.is_some() {
+                ";\n  power:   mux2.4.out (signal laser-power) => the laser's analog power input"
+            } else {
+                ""
+            },
+        )),
         power = d.power_output.map_or(String::new(), |e| format!(
             "\n  power:   motion.analog-out-{e:02} => the laser's analog power input (a PWM or DAC)"
         )),
