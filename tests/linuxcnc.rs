@@ -248,11 +248,31 @@ fn a_streamed_plan_is_its_own_states_on_the_streams_clock() {
         );
         assert!(mark(i + 1) || on_tick(seg.end_s()), "{}", seg.end_s());
     }
-    // between samples the joints stay within the path tolerance of the planned path
+    // between samples the joints stay within the path tolerance of the planned path, also on
+    // a pattern of sharp turns (the marks slow there)
     assert!(
         f.max_deviation_mm <= profile.gcode.path_tol_mm,
         "{}",
         f.max_deviation_mm
+    );
+    let settings = SolverSettings {
+        motion: MotionMode::OnTheFly,
+        ..SolverSettings::default()
+    };
+    let lissajous = common::root().join("tests/data/linuxcnc/lissajous.svg");
+    let (mut ldoc, _) = load_svg(
+        &lissajous,
+        profile.clone(),
+        settings,
+        &ImportOptions::default(),
+    )
+    .unwrap();
+    let (lplan, lpath) = plan_document_lowered(&mut ldoc, &JobCtx::default()).unwrap();
+    let (_, lf) = stream_text(&lpath, &lplan).unwrap();
+    assert!(
+        lf.max_deviation_mm <= profile.gcode.path_tol_mm,
+        "{}",
+        lf.max_deviation_mm
     );
     // the program hands the joints over and waits for the stream's last sample
     let g = write_gcode(&toolpath, &plan, doc.page_mm[1], "oversize").unwrap();

@@ -119,7 +119,8 @@ pub fn stream_text(
 }
 
 /// The largest distance from the planned tool-centre path between `t0_s` and `t0_s + period_s`
-/// to the straight line from sample `a` to sample `b`.
+/// to the straight move from sample `a` to sample `b` (sampled at [`DEVIATION_SUBSAMPLES`]
+/// instants).
 fn deviation_mm(
     toolpath: &Toolpath,
     t0_s: f64,
@@ -132,9 +133,9 @@ fn deviation_mm(
         .map(|i| {
             let f = i as f64 / DEVIATION_SUBSAMPLES as f64;
             let planned = toolpath.state_at(t0_s + f * period_s).tcp();
-            // where the joints are at that instant: the same fraction along the line
-            let streamed = p.plus(q.minus(p).scale(f));
-            planned.dist(streamed)
+            // the path's distance from the joints' straight move (where along it the tool is
+            // at an instant is the pace, not the path)
+            crate::geom::point_segment_dist(planned, p, q)
         })
         .fold(0.0, f64::max)
 }

@@ -650,14 +650,17 @@ fn tool_pieces(
             piece(SegmentKind::Mark, timing.dot_dwell_s, dot, stage);
         }
         let mark_speed_mm_s = timing.speed_mm_s;
+        let zones = stream_corners(path, stroke, mark_speed_mm_s, profile);
         for (start_frac, end_frac) in stroke_parts(path, stroke) {
-            let part_mm = (end_frac - start_frac) * path.strokes[stroke].length_mm;
-            let tool = Tool::Stroke {
-                stroke,
-                start_frac,
-                end_frac,
-            };
-            piece(SegmentKind::Mark, part_mm / mark_speed_mm_s, tool, stage);
+            for (a, b, speed_mm_s) in at_speeds(start_frac, end_frac, &zones, mark_speed_mm_s) {
+                let part_mm = (b - a) * path.strokes[stroke].length_mm;
+                let tool = Tool::Stroke {
+                    stroke,
+                    start_frac: a,
+                    end_frac: b,
+                };
+                piece(SegmentKind::Mark, part_mm / speed_mm_s, tool, stage);
+            }
         }
         piece(
             SegmentKind::LaserOffDelay,
@@ -789,6 +792,119 @@ fn stroke_parts(path: &Toolpath, stroke: usize) -> Vec<(f64, f64)> {
         parts.push((start_frac, 1.0));
     }
     parts
+}
+
+/// Share of the path tolerance a streamed corner is cut by at most (the rest: the sample
+/// intervals are not centred on the vertex).
+const CORNER_TOL_SHARE: f64 = 0.8;
+
+/// A streamed plan's slow zones on stroke `stroke` marked at `speed_mm_s` (fractions of its
+/// length, with the speed in them; none unless the profile streams on the fly).
+///
+/// Between two samples of a stream (period `T`) the joints move in a straight line, while the
+/// mark follows the stroke: over one sample's travel `s = v·T` centred on a vertex, the path
+/// strays from that chord by [`window_cut_mm`] (at a corner whose edges meet at the inner angle
+/// `ψ`, `(s/2)·cos(ψ/2)`: half the travel at a hairpin; on a curve of radius `r`, `s²/8r`).
+/// Where that exceeds [`CORNER_TOL_SHARE`] of the profile's path tolerance the mark slows
+/// (halving its travel until it does not) over that travel either side of the vertex: the
+/// sample intervals around the vertex then lie inside the zone, their chords within the
+/// tolerance. A corner costs at most a few periods.
+fn stream_corners(
+    path: &Toolpath,
+    stroke: usize,
+    speed_mm_s: f64,
+    profile: &MachineProfile,
+) -> Vec<(f64, f64, f64)> {
+    let Some(period_s) = profile.controller.stream_period_s else {
+        return Vec::new();
+    };
+    if !profile
+        .controller
+        .streamed(crate::document::Motion::OnTheFly)
+    {
+        return Vec::new();
+    }
+    let tol_mm = CORNER_TOL_SHARE * profile.gcode.path_tol_mm;
+    let points = path.stroke_points(stroke);
+    let arc = path.stroke_arc_mm(stroke);
+    let length_mm = path.strokes[stroke].length_mm;
+    if length_mm <= 0.0 || points.len() < 3 || arc.len() != points.len() {
+        return Vec::new();
+    }
+    let mut zones: Vec<(f64, f64, f64)> = Vec::new();
+    for i in 1..points.len() - 1 {
+        let mut travel_mm = speed_mm_s * period_s;
+        if window_cut_mm(points, arc, arc[i], travel_mm) <= tol_mm {
+            continue;
+        }
+        // at most 20 halvings: a millionth of the travel
+        for _ in 0..20 {
+            travel_mm /= 2.0;
+            if window_cut_mm(points, arc, arc[i], travel_mm) <= tol_mm {
+                break;
+            }
+        }
+        let slow = travel_mm / period_s;
+        let reach_mm = travel_mm * 1.05;
+        let (a, b) = (
+            ((arc[i] - reach_mm) / length_mm).max(0.0),
+            ((arc[i] + reach_mm) / length_mm).min(1.0),
+        );
+        match zones.last_mut() {
+            // overlapping zones merge, at the slower speed
+            Some(z) if a <= z.1 => {
+                z.1 = z.1.max(b);
+                z.2 = z.2.min(slow);
+            }
+            _ => zones.push((a, b, slow)),
+        }
+    }
+    zones
+}
+
+/// How far the polyline `points` (arc lengths `arc`) strays from the chord of its stretch
+/// `[at_mm − travel_mm/2, at_mm + travel_mm/2]`, mm: the largest distance of its vertices
+/// inside from the line through the stretch's ends.
+fn window_cut_mm(points: &[Pt], arc: &[f64], at_mm: f64, travel_mm: f64) -> f64 {
+    let point_at = |d: f64| {
+        let d = d.clamp(0.0, arc[arc.len() - 1]);
+        let k = arc.partition_point(|&x| x <= d).clamp(1, arc.len() - 1);
+        let span = arc[k] - arc[k - 1];
+        let f = if span > 0.0 {
+            (d - arc[k - 1]) / span
+        } else {
+            0.0
+        };
+        points[k - 1].plus(points[k].minus(points[k - 1]).scale(f))
+    };
+    let (lo, hi) = (at_mm - travel_mm / 2.0, at_mm + travel_mm / 2.0);
+    let (p, q) = (point_at(lo), point_at(hi));
+    let first = arc.partition_point(|&x| x <= lo);
+    let last = arc.partition_point(|&x| x < hi);
+    (first..last)
+        .map(|k| crate::geom::point_segment_dist(points[k], p, q))
+        .fold(0.0, f64::max)
+}
+
+/// Part `[a, b]` of a stroke cut at the slow `zones` it crosses: each piece with its speed
+/// (`speed_mm_s` outside the zones).
+fn at_speeds(a: f64, b: f64, zones: &[(f64, f64, f64)], speed_mm_s: f64) -> Vec<(f64, f64, f64)> {
+    let mut out = Vec::new();
+    let mut at = a;
+    for &(za, zb, slow) in zones.iter().filter(|z| z.1 > a && z.0 < b) {
+        if za > at {
+            out.push((at, za, speed_mm_s));
+        }
+        let (from, to) = (za.max(at), zb.min(b));
+        if to > from {
+            out.push((from, to, slow));
+            at = to;
+        }
+    }
+    if b > at || out.is_empty() {
+        out.push((at, b, speed_mm_s));
+    }
+    out
 }
 
 /// The knots of part `[start_frac, end_frac]` of stroke `s`: its ends and the vertices between,
@@ -1104,5 +1220,39 @@ fn push_segments(path: &mut Toolpath, pieces: &[Piece], pad_s: f64) {
             scan,
         });
         t_s += piece.duration_s;
+    }
+}
+
+#[cfg(test)]
+mod corner_tests {
+    use super::*;
+
+    #[test]
+    fn a_chord_through_a_hairpin_strays_half_the_travel_and_a_straight_line_none() {
+        let hairpin = [Pt::new(0.0, 0.0), Pt::new(1.0, 0.0), Pt::new(0.0, 1e-9)];
+        let arc = [0.0, 1.0, 2.0];
+        assert!((window_cut_mm(&hairpin, &arc, 1.0, 0.1) - 0.05).abs() < 1e-6);
+        let right = [Pt::new(0.0, 0.0), Pt::new(1.0, 0.0), Pt::new(1.0, 1.0)];
+        // (s/2)·cos(ψ/2), ψ = 90°
+        let want = 0.05 * std::f64::consts::FRAC_1_SQRT_2;
+        assert!((window_cut_mm(&right, &arc, 1.0, 0.1) - want).abs() < 1e-9);
+        let line = [Pt::new(0.0, 0.0), Pt::new(1.0, 0.0), Pt::new(2.0, 0.0)];
+        assert!(window_cut_mm(&line, &arc, 1.0, 0.1) < 1e-12);
+    }
+
+    #[test]
+    fn a_part_is_cut_at_the_slow_zones_it_crosses() {
+        let zones = [(0.2, 0.3, 100.0), (0.5, 0.6, 50.0)];
+        let parts = at_speeds(0.0, 0.55, &zones, 1000.0);
+        assert_eq!(
+            parts,
+            [
+                (0.0, 0.2, 1000.0),
+                (0.2, 0.3, 100.0),
+                (0.3, 0.5, 1000.0),
+                (0.5, 0.55, 50.0)
+            ]
+        );
+        assert_eq!(at_speeds(0.7, 0.9, &zones, 1000.0), [(0.7, 0.9, 1000.0)]);
     }
 }
