@@ -2408,3 +2408,20 @@ fn a_linuxcnc_machine_without_the_stream_says_why_on_the_fly_takes_longer() {
     h.get_by_label_contains("LinuxCNC runs on-the-fly G-code without look-ahead: ");
     h.get_by_label_contains("step-and-scan would take");
 }
+
+#[test]
+fn an_edit_of_passes_moves_no_row() {
+    let mut h = opened(&demo());
+    // the passes' own row is there with one pass, greyed, so that the rows below stay put
+    let rows = |h: &Harness<'_, App>| -> Vec<egui::Rect> {
+        h.get_all_by_label("Shift seams between passes")
+            .map(|n| n.rect())
+            .collect()
+    };
+    let before = rows(&h);
+    assert!(!before.is_empty());
+    enter_nth(&mut h, "Passes", 0, "2");
+    settle(&mut h);
+    assert_eq!(h.state().session.doc().layers[0].pen.passes, 2);
+    assert_eq!(rows(&h), before);
+}

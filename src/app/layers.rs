@@ -326,7 +326,12 @@ impl LayerEditor {
                 let hint = |c: Col| match c {
                     Col::Speed => format!("{}", profile.scanner.mark_speed_mm_s),
                     Col::Power => profile.gcode.power.map_or("none".into(), |p| p.to_string()),
-                    Col::Edge => "spacing".into(),
+                    // empty: inset by the hatch's spacing, shown as its value
+                    Col::Edge => layer
+                        .pen
+                        .hatch
+                        .as_ref()
+                        .map_or(String::new(), |h| format!("{} (the spacing)", h.spacing_mm)),
                     _ => String::new(),
                 };
                 let hatched = layer.pen.hatch.is_some();
@@ -368,22 +373,25 @@ impl LayerEditor {
                     }
                     ui.end_row();
                 }
-                if layer.pen.passes > 1 {
-                    let mut shift = layer.pen.shift_passes;
-                    ui.label("");
-                    if ui
-                        .checkbox(&mut shift, "Shift seams between passes")
-                        .on_hover_text(
-                            "Each pass is cut on a tiling shifted by a fraction of a cell, so no two passes meet at the same seam (more fields)",
-                        )
-                        .changed()
-                    {
-                        let mut l = layer.clone();
-                        l.pen.shift_passes = shift;
-                        out = Some(l);
-                    }
-                    ui.end_row();
+                // always there (greyed with one pass): an edit of Passes moves no row
+                let mut shift = layer.pen.shift_passes;
+                ui.label("");
+                if ui
+                    .add_enabled(
+                        layer.pen.passes > 1,
+                        egui::Checkbox::new(&mut shift, "Shift seams between passes"),
+                    )
+                    .on_hover_text(
+                        "Each pass is cut on a tiling shifted by a fraction of a cell, so no two passes meet at the same seam (more fields)",
+                    )
+                    .on_disabled_hover_text("with two passes or more")
+                    .changed()
+                {
+                    let mut l = layer.clone();
+                    l.pen.shift_passes = shift;
+                    out = Some(l);
                 }
+                ui.end_row();
             });
         out
     }

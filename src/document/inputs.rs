@@ -135,7 +135,7 @@ pub fn staleness(plan: &Plan, doc: &Document) -> Vec<String> {
 
 /// Pen changes between two layer tables (each with the profile its unset values come from),
 /// per layer by name. A value a pen leaves to its profile is compared, and said, as the
-/// profile's value ("mark speed 1000 → 500 mm/s", not "unset → 500"): a pen that now sets what
+/// profile's value ("mark speed 1000 → 500 mm/s", not "none → 500"): a pen that now sets what
 /// the profile gave is no change.
 fn layer_differences(
     (planned, planned_profile): (&[Layer], &super::MachineProfile),

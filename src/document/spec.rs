@@ -196,8 +196,9 @@ pub fn differences<T>(specs: &[FieldSpec<T>], old: &T, new: &T) -> Vec<String> {
         .filter_map(|s| {
             let (a, b) = ((s.show)(old), (s.show)(new));
             (a != b).then(|| {
-                let a = if a.is_empty() { "unset".into() } else { a };
-                let b = if b.is_empty() { "unset".into() } else { b };
+                // an empty value reads as the editors show it
+                let a = if a.is_empty() { "none".into() } else { a };
+                let b = if b.is_empty() { "none".into() } else { b };
                 let unit = if s.unit.is_empty() || s.rule == Rule::Choice {
                     String::new()
                 } else {
@@ -1290,7 +1291,7 @@ mod tests {
         a.mark_speed_mm_s = Some(300.0);
         assert_eq!(
             differences(&pen, &b, &a),
-            vec!["mark speed unset → 300 mm/s"]
+            vec!["mark speed none → 300 mm/s"]
         );
         let passes = pen.iter().find(|s| s.key == "passes").unwrap();
         let mut bad = Pen::default();
