@@ -272,6 +272,7 @@ pub fn plan_document_lowered(
     doc.warnings.retain(|w| {
         !w.message.starts_with(crate::order::FLY_NOT_PLANNED)
             && !w.message.starts_with(crate::order::LINUXCNC_OTF_NOTE)
+            && !w.message.starts_with(crate::order::STREAMED_NOTE)
     });
     if let Some(note) = &plan.metrics.motion_note {
         doc.warnings.push(choice_warning(note.clone()));

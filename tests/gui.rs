@@ -2190,6 +2190,11 @@ fn a_dragged_seam_goes_as_far_as_its_neighbours_allow_and_says_why() {
         .unwrap();
     let at = |h: &Harness<'_, App>, x: f64| h.state().mm_screen_pos(Pt::new(x, 150.0)).unwrap();
     let (from, to) = (at(&h, xs[k]), at(&h, xs[k] + 25.0));
+    // hovered, the seam says it is what a drag moves
+    h.hover_at(from);
+    h.step();
+    settle(&mut h);
+    h.get_by_label_contains(&format!("seam x = {:.1} mm: drag it to move it", xs[k]));
     drag_from_to(&mut h, from, to);
     let status = h.state().status().to_string();
     assert!(
@@ -2424,4 +2429,19 @@ fn an_edit_of_passes_moves_no_row() {
     settle(&mut h);
     assert_eq!(h.state().session.doc().layers[0].pen.passes, 2);
     assert_eq!(rows(&h), before);
+}
+
+#[test]
+fn a_streamed_plan_says_why_its_job_time_is_what_it_is() {
+    use galvoplan::app::commands::Command;
+    let (mut h, _) = opened_oversize();
+    let p = galvoplan::document::MachineProfile::builtin("linuxcnc").unwrap();
+    h.state_mut()
+        .execute(Command::SetProfile(Box::new(p)))
+        .unwrap();
+    settle(&mut h);
+    set_motion(&mut h, "On the fly (stage moves while marking)");
+    wait_idle(&mut h, Duration::from_secs(60));
+    solve(&mut h, "Run HHA");
+    h.get_by_label_contains("Streamed to LinuxCNC's joints every 0.1 ms");
 }

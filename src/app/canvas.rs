@@ -387,9 +387,19 @@ impl Canvas<'_> {
         };
         let at = view.to_mm(rect, p);
         let tol = f64::from(HOVER_PX / view.scale.max(1e-6));
-        let elsewhere = self
-            .seam_at(at, f64::from(SEAM_GRAB_PX / view.scale))
-            .is_some()
+        // a seam a press would move: drawn thick across the tiling before the press
+        let seam = self.seam_at(at, f64::from(SEAM_GRAB_PX / view.scale));
+        if let (Some((axis, at_mm)), Some(t)) = (seam, self.tiling) {
+            let e = t.extent();
+            let (a, b) = if axis == 0 {
+                (Pt::new(at_mm, e.min_y), Pt::new(at_mm, e.max_y))
+            } else {
+                (Pt::new(e.min_x, at_mm), Pt::new(e.max_x, at_mm))
+            };
+            let s = |q: Pt| view.to_screen(rect, q);
+            painter.line_segment([s(a), s(b)], egui::Stroke::new(3.0, colour::SELECTED));
+        }
+        let elsewhere = seam.is_some()
             || self.code_at(at, f64::from(4.0 / view.scale)).is_some()
             || self.geometry_at(ui.ctx(), response.id, at, tol).is_some();
         let Some(f) = self.field_at(at).filter(|f| !f.locked && !elsewhere) else {
@@ -788,6 +798,15 @@ impl Canvas<'_> {
         }
         if let Some(k) = geometry {
             self.stroke_lines(k, &mut lines);
+        }
+        if let Some((axis, at_mm)) = self
+            .seam_at(p, f64::from(SEAM_GRAB_PX / view.scale))
+            .filter(|_| self.editable)
+        {
+            let which = if axis == 0 { "x" } else { "y" };
+            lines.push(format!(
+                "seam {which} = {at_mm:.1} mm: drag it to move it (as far as its neighbours allow)"
+            ));
         }
         if let Some(f) = field {
             let word = super::words::field_word(f, self.profile);

@@ -189,18 +189,35 @@ pub fn order_plan(
     Ok((plan, best.toolpath))
 }
 
+/// How the plan's motion note begins when an on-the-fly plan is streamed to LinuxCNC's joints.
+pub const STREAMED_NOTE: &str = "Streamed to LinuxCNC's joints";
+
 /// How the plan's motion note begins when LinuxCNC runs an on-the-fly plan.
 pub const LINUXCNC_OTF_NOTE: &str = "LinuxCNC runs on-the-fly G-code without look-ahead";
 
-/// On a LinuxCNC controller, an on-the-fly plan's note: why its job time is what it is, beside
-/// what step-and-scan would take on the same order ("LinuxCNC runs on-the-fly G-code without
-/// look-ahead: 18.36 s; step-and-scan would take 8.16 s"). None elsewhere, after a cancel, or
-/// where step-and-scan cannot mark the order (geometries larger than a field).
+/// On a LinuxCNC controller, an on-the-fly plan's note: why its job time is what it is. A
+/// streamed plan: on the stream's clock, slowed at sharp corners ([`STREAMED_NOTE`]). A G93
+/// program: LinuxCNC's pace, beside what step-and-scan would take on the same order ("LinuxCNC
+/// runs on-the-fly G-code without look-ahead: 18.36 s; step-and-scan would take 8.16 s"; none
+/// after a cancel, or where step-and-scan cannot mark the order). None elsewhere.
 fn linuxcnc_note(nodes: &Nodes, inputs: &PlanInputs, best: &Made, ctx: &JobCtx) -> Option<String> {
-    // a streamed plan runs at its own pace: nothing to explain
-    let lcnc = inputs.profile.controller.kind == crate::document::ControllerKind::Linuxcnc
-        && !inputs.profile.controller.streamed(Motion::OnTheFly);
-    if best.motion != Motion::OnTheFly || !lcnc || ctx.is_cancelled() {
+    let controller = &inputs.profile.controller;
+    if best.motion != Motion::OnTheFly
+        || controller.kind != crate::document::ControllerKind::Linuxcnc
+    {
+        return None;
+    }
+    // a streamed plan runs at its own pace, on the stream's clock
+    if let Some(period_s) = controller.stream_period_s {
+        return Some(format!(
+            "{STREAMED_NOTE} every {} ms: each mark starts and ends on a sample, and marks slow at \
+             sharp corners so that the joints' straight moves between samples stay within {} mm \
+             of the path",
+            period_s * 1e3,
+            inputs.profile.gcode.path_tol_mm
+        ));
+    }
+    if ctx.is_cancelled() {
         return None;
     }
     let step = Candidates::new(nodes, inputs, Motion::Step, ctx)
@@ -605,8 +622,8 @@ fn faster_on_the_fly(
     tally.fastest([Ok(Some(best)), by_centred])
 }
 
-/// The on-the-fly candidates of one solve as they are lowered: progress in words ("On the fly:
-/// 2 of 4 candidate plans made, the fastest 12.31 s") and the fastest of those finished.
+/// The on-the-fly candidates of one solve as they are lowered: progress in words ("2 of 4
+/// on-the-fly candidate plans made, the fastest 12.31 s") and the fastest of those finished.
 struct Tally<'a> {
     lower: &'a Candidates<'a>,
     /// Candidates finished, the fastest job time among them, and candidates in all.
@@ -629,13 +646,13 @@ impl<'a> Tally<'a> {
         let (n, best_s, total) = *done;
         drop(done);
         let message = match (self.lower.ctx.is_cancelled(), best_s.is_finite()) {
-            (false, false) => format!("On the fly: {n} of {total} candidate plans made"),
-            (false, true) => {
-                format!("On the fly: {n} of {total} candidate plans made, the fastest {best_s:.2} s")
-            }
-            (true, false) => "On the fly: stopping once the first candidate plan is made".into(),
+            (false, false) => format!("{n} of {total} on-the-fly candidate plans made"),
+            (false, true) => format!(
+                "{n} of {total} on-the-fly candidate plans made, the fastest {best_s:.2} s"
+            ),
+            (true, false) => "Stopping once the first on-the-fly candidate plan is made".into(),
             (true, true) => format!(
-                "On the fly: stopping, keeping the fastest of the {n} candidate plans made ({best_s:.2} s)"
+                "Stopping: keeping the fastest of the {n} on-the-fly candidate plans made ({best_s:.2} s)"
             ),
         };
         self.lower
