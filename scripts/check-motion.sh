@@ -11,17 +11,7 @@ S=../shared
 source "$S/tools/setup.sh" >/dev/null
 OUT="${OUT:-/tmp/galvoplan-motion}"
 mkdir -p "$OUT"
-# A trajectory samples the plan on the profile's clock; a continuous plan's short marks fall between
-# 1 ms samples, so the check plans on a copy of the profile with a 1 ms scan-head clock.
-clocked() { # profile.toml -> a copy with [controller] clock_period_s = 0.001
-  local c="$OUT/$(basename "$1" .toml)-clock-1ms.toml"
-  if grep -q '^\[controller\]' "$1"; then
-    sed 's/^\[controller\]/[controller]\nclock_period_s = 0.001/' "$1" >"$c"
-  else
-    { cat "$1"; printf '\n[controller]\nclock_period_s = 0.001\n'; } >"$c"
-  fi
-  echo "$c"
-}
+source scripts/clocked-profile.sh
 run() { # name svg profile cost
   local name=$1 svg=$2 cost=$4 prof; prof=$(clocked "$3")
   local o="$OUT/$name-$cost"

@@ -238,14 +238,7 @@ pub fn export_text(
         // the report needs no toolpath: never lowered for it
         return Ok(report_json(&source, plan, &doc.warnings));
     }
-    let lowered;
-    let toolpath = match toolpath {
-        Some(t) => t,
-        None => {
-            lowered = lower_plan(doc, plan).map_err(|e| e.to_string())?;
-            &lowered
-        }
-    };
+    let toolpath = &*toolpath_of(doc, plan, toolpath)?;
     Ok(match kind {
         ExportKind::Gcode => write_gcode(toolpath, plan, doc.page_mm[1], &source)
             .map_err(|e| format!("{source}: {e}"))?,
@@ -272,24 +265,37 @@ pub fn export(
     kind: ExportKind,
     path: &Path,
 ) -> Result<(), String> {
-    // a streamed plan's program runs nothing without its stream: written beside it, first
-    if kind == ExportKind::Gcode && plan.profile.controller.streamed(plan.motion) {
-        let lowered;
-        let toolpath = match toolpath {
-            Some(t) => t,
-            None => {
-                lowered = lower_plan(doc, plan).map_err(|e| e.to_string())?;
-                &lowered
-            }
-        };
-        let stream = stream_path(path);
-        let (text, _) = crate::export::stream_text(toolpath, plan)
-            .map_err(|e| format!("{}: cannot stream the plan: {e}", stream.display()))?;
-        write_atomic(&stream, text.as_bytes())
-            .map_err(|e| format!("{}: cannot write: {e}", stream.display()))?;
+    if kind != ExportKind::Gcode || !plan.profile.controller.streamed(plan.motion) {
+        return write_atomic(path, export_text(doc, plan, toolpath, kind)?.as_bytes())
+            .map_err(|e| format!("{}: cannot write: {e}", path.display()));
     }
-    write_atomic(path, export_text(doc, plan, toolpath, kind)?.as_bytes())
-        .map_err(|e| format!("{}: cannot write: {e}", path.display()))
+    // a streamed plan's program runs nothing without its stream: written beside it, first
+    // (from the one lowering both take)
+    let toolpath = toolpath_of(doc, plan, toolpath)?;
+    let stream = stream_path(path);
+    let (text, _) = crate::export::stream_text(&toolpath, plan)
+        .map_err(|e| format!("{}: cannot stream the plan: {e}", stream.display()))?;
+    write_atomic(&stream, text.as_bytes())
+        .map_err(|e| format!("{}: cannot write: {e}", stream.display()))?;
+    write_atomic(
+        path,
+        export_text(doc, plan, Some(&toolpath), kind)?.as_bytes(),
+    )
+    .map_err(|e| format!("{}: cannot write: {e}", path.display()))
+}
+
+/// `toolpath`, or the plan lowered when none is given.
+fn toolpath_of<'a>(
+    doc: &Document,
+    plan: &Plan,
+    toolpath: Option<&'a Toolpath>,
+) -> Result<std::borrow::Cow<'a, Toolpath>, String> {
+    match toolpath {
+        Some(t) => Ok(std::borrow::Cow::Borrowed(t)),
+        None => lower_plan(doc, plan)
+            .map(std::borrow::Cow::Owned)
+            .map_err(|e| e.to_string()),
+    }
 }
 
 /// Where a streamed plan's stream goes beside its program: `job.ngc` → `job.stream`.
