@@ -60,6 +60,25 @@ pub enum PipelineError {
         /// The cause.
         source: crate::export::GcodeError,
     },
+    /// A project could not be read.
+    #[error(transparent)]
+    Project(#[from] crate::document::ProjectError),
+    /// A field's pose the machine cannot take.
+    #[error("{file}: {source}")]
+    Pose {
+        /// The document's source file.
+        file: String,
+        /// The cause.
+        source: crate::document::PoseError,
+    },
+    /// Placements that turn or lift axes beyond X/Y, planned on the fly.
+    #[error("{file}: the fields turn or lift axes beyond X/Y ({axes}), which only step-and-scan moves between fields; plan with step-and-scan")]
+    PosesOnTheFly {
+        /// The document's source file.
+        file: String,
+        /// The profile's axes in words.
+        axes: String,
+    },
     /// Every layer is disabled.
     #[error("{file}: every layer is disabled: nothing to mark")]
     AllDisabled {
@@ -165,6 +184,9 @@ pub fn load_production(
     tray: &TraySettings,
 ) -> Result<Loaded, PipelineError> {
     let t0 = Instant::now();
+    if path.extension().is_some_and(|e| e == "galvoplan") {
+        return load_project_job(path, profile, settings, t0);
+    }
     let mut opts = opts.clone();
     opts.work_area_mm.get_or_insert(profile.stroke_mm);
     opts.field_mm.get_or_insert(profile.field_mm);
@@ -213,6 +235,30 @@ pub fn load_production(
     })
 }
 
+/// A project's artwork and fields as a job for `profile` and `settings` (the command line's):
+/// its fields are kept as placed (locked), with their poses.
+fn load_project_job(
+    path: &Path,
+    profile: MachineProfile,
+    settings: SolverSettings,
+    t0: Instant,
+) -> Result<Loaded, PipelineError> {
+    let mut doc = crate::document::load_project(path)?;
+    doc.profile = profile;
+    doc.settings = settings;
+    doc.plans.clear();
+    for f in &mut doc.fields {
+        f.locked = true;
+    }
+    doc.source = Some(path.display().to_string());
+    Ok(Loaded {
+        doc,
+        import_s: t0.elapsed().as_secs_f64(),
+        skipped_layers: Vec::new(),
+        moved_mm: [0.0, 0.0],
+    })
+}
+
 /// Geometries moved back by a placement's offset: in the file's coordinates again.
 fn unplaced(geometries: &[Geometry], moved_mm: [f64; 2]) -> Vec<Geometry> {
     let back = crate::geom::Pt::new(-moved_mm[0], -moved_mm[1]);
@@ -252,6 +298,20 @@ pub fn plan_document_lowered(
     doc: &mut Document,
     ctx: &JobCtx,
 ) -> Result<(Plan, Toolpath), PipelineError> {
+    check_poses(doc)?;
+    // a job whose fields turn Z, A or B has one motion: auto plans it step-and-scan
+    let posed = doc.fields.iter().any(|f| !f.pose.is_rest());
+    let auto = doc.settings.motion;
+    if posed {
+        doc.settings.motion = MotionMode::Step;
+    }
+    let made = plan_step_or_auto(doc, ctx);
+    doc.settings.motion = auto;
+    made
+}
+
+/// [`plan_document_lowered`] once the poses are checked.
+fn plan_step_or_auto(doc: &mut Document, ctx: &JobCtx) -> Result<(Plan, Toolpath), PipelineError> {
     let hatch_s = derive_geometries(doc, ctx)?;
     let t0 = Instant::now();
     let (lower_bound, made) = place_and_choose(doc, ctx)?;
@@ -283,6 +343,27 @@ pub fn plan_document_lowered(
     plan.metrics.solve_s.total =
         plan.metrics.solve_s.hatch + plan.metrics.solve_s.fields + plan.metrics.solve_s.order;
     Ok((plan, toolpath))
+}
+
+/// The machine can take every field's pose, and a job whose fields turn or lift axes beyond X/Y
+/// is planned step-and-scan (on the fly keeps Z, A and B still).
+fn check_poses(doc: &Document) -> Result<(), PipelineError> {
+    let file = || doc.source.clone().unwrap_or_else(|| "document".into());
+    for f in &doc.fields {
+        doc.profile
+            .check_pose(f.id, &f.pose)
+            .map_err(|source| PipelineError::Pose {
+                file: file(),
+                source,
+            })?;
+    }
+    if doc.settings.motion == MotionMode::OnTheFly && doc.fields.iter().any(|f| !f.pose.is_rest()) {
+        return Err(PipelineError::PosesOnTheFly {
+            file: file(),
+            axes: doc.profile.axes_words(),
+        });
+    }
+    Ok(())
 }
 
 /// Geometries cut on one tiling in the whole-or-cut choice, placed and ordered.
@@ -917,6 +998,7 @@ fn whole_work_region(geometries: &[crate::document::Geometry]) -> Placement {
             size: [b.width(), b.height()],
             locked: false,
             geometries: (0..geometries.len()).collect(),
+            pose: Default::default(),
         }],
         lower_bound: 1,
     }

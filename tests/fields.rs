@@ -80,7 +80,7 @@ proptest! {
     #[test]
     fn locked_fields_stay_and_the_rest_is_covered(gs in geometry_set(), x in 0.0f64..300.0, y in 0.0f64..300.0) {
         let p = MachineProfile::default();
-        let locked = ScanField { id: 7, center: Pt::new(x, y), size: p.field_mm, locked: true, geometries: vec![] };
+        let locked = ScanField { id: 7, center: Pt::new(x, y), size: p.field_mm, locked: true, geometries: vec![], pose: Default::default(),  };
         for mode in [FieldsMode::Greedy, FieldsMode::Auto, FieldsMode::Paper] {
             let placed = place_fields(&gs, &p, &settings(mode, 3), std::slice::from_ref(&locked), &JobCtx::default()).unwrap();
             assert_valid(&gs, &placed.fields, &p);

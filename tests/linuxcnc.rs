@@ -113,7 +113,7 @@ fn on_the_fly_lines_last_the_planned_time_and_stay_within_the_tolerance() {
         toolpath.duration_s()
     );
     // every waypoint lies within the tolerance of the line through it (in planned time)
-    let waypoints: Vec<Vec<f64>> = waypoints_csv(&toolpath)
+    let waypoints: Vec<Vec<f64>> = waypoints_csv(&toolpath, &[])
         .lines()
         .skip(1)
         .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())

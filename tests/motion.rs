@@ -151,7 +151,7 @@ fn trajectory_marks_the_gcode_path() {
     );
     let period_s = 1e-3;
     let clocked = toolpath.on_clock(period_s);
-    let on = laser_on_points(&trajectory_csv(&clocked, period_s), period_s);
+    let on = laser_on_points(&trajectory_csv(&clocked, period_s, &[]), period_s);
     assert!(!on.is_empty());
     let on_gcode_path = |p: Pt| {
         marks.iter().any(|m| {
@@ -786,7 +786,7 @@ fn a_mixed_job_holds_the_stage_still_while_its_step_and_scan_fields_are_marked()
     // ../shared/tools/check_trajectory.py (demo.svg, assets/profiles/seed000.toml, --mode otf)
     let clocked = galvoplan::pipeline::lower_plan_on(&doc, &plan, Some(1e-3)).unwrap();
     assert_on_the_fly_feasible(&doc, &clocked);
-    let csv = trajectory_csv(&clocked, 1e-3);
+    let csv = trajectory_csv(&clocked, 1e-3, &[]);
     assert!(csv.starts_with(TRAJECTORY_HEADER));
     std::fs::write(std::env::temp_dir().join("galvoplan-mixed-demo.csv"), csv).unwrap();
     // the G-code says how each field runs

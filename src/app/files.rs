@@ -251,7 +251,7 @@ pub fn export_text(
                 .clock_s(plan.motion)
                 .map_or(1.0, |s| s * 1e3);
             let period_s = trajectory_period_s(clock_ms).map_err(|e| e.to_string())?;
-            trajectory_csv(toolpath, period_s)
+            trajectory_csv(toolpath, period_s, &plan.profile.extra_axes())
         }
         ExportKind::Report => report_json(&source, plan, &doc.warnings),
     })

@@ -718,14 +718,16 @@ impl App {
             self.canvas_revision(),
         );
         let motion = lowered.and_then(Result::ok).and_then(|l| l.motion.as_ref());
+        let axes = lowered.and_then(Result::ok).and_then(|l| l.axes.as_ref());
+        let plots = motion.is_some() || axes.is_some();
         let header_px = 2.0 * ui.spacing().interact_size.y;
         let plots_px = motion_plots::PLOTS_HEIGHT_PX.min(ui.available_height() * 0.4);
-        let below_px = match motion {
-            Some(_) if self.panels.plots_open => header_px + plots_px,
-            Some(_) => header_px,
-            None => 0.0,
+        let below_px = match plots {
+            true if self.panels.plots_open => header_px + plots_px,
+            true => header_px,
+            false => 0.0,
         };
-        let below = (motion.is_some(), motion.is_some() && self.panels.plots_open);
+        let below = (plots, plots && self.panels.plots_open);
         if below != self.panels.plots_below {
             // the canvas changes height when the plots come or go: fit the content again
             self.panels.plots_below = below;
@@ -733,16 +735,15 @@ impl App {
         }
         let size = ui.available_size() - egui::Vec2::Y * below_px;
         let (_, actions) = canvas.show(ui, &mut self.panels.workbench, Some(size));
-        if let Some(samples) = motion {
-            motion_plots_header(ui, &mut self.panels.plots_open);
-            if self.panels.plots_open {
-                motion_plots::show(
-                    ui,
-                    samples,
-                    &self.session.doc().profile,
-                    playback_t_s,
-                    plots_px,
-                );
+        if plots {
+            motion_plots_header(ui, &mut self.panels.plots_open, motion.is_none());
+        }
+        if self.panels.plots_open {
+            let profile = &self.session.doc().profile;
+            if let Some(samples) = motion {
+                motion_plots::show(ui, samples, profile, playback_t_s, plots_px);
+            } else if let Some(samples) = axes {
+                super::axis_plot::show(ui, samples, profile, playback_t_s, plots_px);
             }
         }
         let repaint = ui.ctx().clone();
@@ -750,20 +751,25 @@ impl App {
     }
 }
 
-/// The header of the motion plots: shows or hides them.
-fn motion_plots_header(ui: &mut egui::Ui, open: &mut bool) {
+/// The header of the motion plots (on the fly, or the axes' speeds of a job that turns Z, A or
+/// B: `axes`): shows or hides them.
+fn motion_plots_header(ui: &mut egui::Ui, open: &mut bool, axes: bool) {
     let shown = *open;
-    let text = if shown {
-        "Motion plots (on the fly): hide"
+    let what = if axes { "axis speeds" } else { "on the fly" };
+    let text = format!(
+        "Motion plots ({what}): {}",
+        if shown { "hide" } else { "show" }
+    );
+    let hover = if axes {
+        "Each axis's speed over the job as a share of its limit (of the plan shown, as it was \
+         planned)"
     } else {
-        "Motion plots (on the fly): show"
+        "The scanner offset against the field limits and the stage speed over the job \
+         (of the plan shown, as it was planned)"
     };
     if ui
         .selectable_label(shown, text)
-        .on_hover_text(
-            "The scanner offset against the field limits and the stage speed over the job \
-             (of the plan shown, as it was planned)",
-        )
+        .on_hover_text(hover)
         .clicked()
     {
         *open = !shown;

@@ -15,6 +15,7 @@
 
 #![deny(clippy::too_many_lines)]
 
+pub mod axis_plot;
 pub mod canvas;
 pub mod commands;
 pub mod compare;

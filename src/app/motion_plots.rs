@@ -15,7 +15,7 @@ pub const PLOT_STEP_S: f64 = 2e-3;
 /// The most samples kept for a curve (long jobs are sampled more coarsely).
 pub const MAX_SAMPLES: usize = 20_000;
 /// Time step of the finite difference that gives the stage speed at a sample, s.
-const SPEED_DT_S: f64 = 1e-3;
+pub(super) const SPEED_DT_S: f64 = 1e-3;
 /// Colour of the stage route and of the stage speed curve (the playback's stage colour).
 pub const ROUTE: Color32 = Color32::from_rgb(14, 116, 144);
 /// Scanner offset x curve.
@@ -23,9 +23,9 @@ const OFFSET_X: Color32 = Color32::from_rgb(234, 88, 12);
 /// Scanner offset y curve.
 const OFFSET_Y: Color32 = Color32::from_rgb(124, 58, 237);
 /// Limits (field reach, axis speed).
-const LIMIT: Color32 = Color32::from_rgb(200, 30, 30);
+pub(super) const LIMIT: Color32 = Color32::from_rgb(200, 30, 30);
 /// The playback time (legible on the plots' dark and light backgrounds).
-const NOW: Color32 = Color32::from_rgb(234, 179, 8);
+pub(super) const NOW: Color32 = Color32::from_rgb(234, 179, 8);
 
 /// Sample times over `[0, duration_s]`: every `step_s`, or coarser so that there are at most
 /// `max` of them; the last one is the job's end.
@@ -138,7 +138,7 @@ pub fn show(
 
 /// A plot's title, wrapped (never cut), with its explanation on hover; returns the height
 /// left for the plot of a column `height_px` tall (its axis labels counted), at least 60 px.
-fn title(ui: &mut egui::Ui, text: String, hover: String, height_px: f32) -> f32 {
+pub(super) fn title(ui: &mut egui::Ui, text: String, hover: String, height_px: f32) -> f32 {
     let top = ui.cursor().min.y;
     ui.add(egui::Label::new(text).wrap()).on_hover_text(hover);
     let used = ui.cursor().min.y - top;
@@ -148,7 +148,7 @@ fn title(ui: &mut egui::Ui, text: String, hover: String, height_px: f32) -> f32 
 /// How far above the highest curve or limit a plot reaches, as a share of it: the legend
 /// (top right; the curves only: the limit lines are said in the title) sits in that band,
 /// not over the curves.
-const LEGEND_HEADROOM: f64 = 1.45;
+pub(super) const LEGEND_HEADROOM: f64 = 1.45;
 
 fn offset_plot(
     ui: &mut egui::Ui,
@@ -260,7 +260,7 @@ const TIME_LABEL_PX: f64 = 50.0;
 const GRID_MIN_PX: f64 = 8.0;
 
 /// The time axis of the motion plots: "t, s", tick labels from [`TIME_LABEL_PX`] apart.
-fn time_axis() -> egui_plot::AxisHints<'static> {
+pub(super) fn time_axis() -> egui_plot::AxisHints<'static> {
     egui_plot::AxisHints::new_x()
         .label("t, s")
         .label_spacing(40.0..=TIME_LABEL_PX as f32)

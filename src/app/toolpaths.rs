@@ -2,6 +2,7 @@
 //! that the canvas, its hover, the captions and the playback all read the same timed job.
 //! Nothing here is saved; a plan that cannot be lowered keeps the error in words.
 
+use super::axis_plot::AxisSamples;
 use super::motion_plots::{route_points_mm, MotionSamples};
 use crate::document::{Document, MachineProfile, Motion, Plan};
 use crate::geom::Pt;
@@ -20,6 +21,9 @@ pub struct Lowered {
     pub route_mm: Vec<Pt>,
     /// The on-the-fly motion sampled for the plots (`None` for step-and-scan).
     pub motion: Option<MotionSamples>,
+    /// Each axis's speed sampled for the plot of a step-and-scan job that turns Z, A or B
+    /// (`None` for any other).
+    pub axes: Option<AxisSamples>,
     /// Per geometry (index), where its first stroke comes in the marking order, 0…1 (−1: not
     /// marked): the canvas colours marks by it.
     pub rank_by_geometry: Vec<f32>,
@@ -39,12 +43,14 @@ impl Lowered {
         }
         let route_mm = route_points_mm(&toolpath);
         let motion = MotionSamples::of(&toolpath);
+        let axes = AxisSamples::of(&toolpath);
         let rank_by_geometry = rank_by_geometry(&toolpath);
         Self {
             toolpath,
             mark_s,
             route_mm,
             motion,
+            axes,
             rank_by_geometry,
         }
     }
@@ -222,6 +228,7 @@ mod tests {
             size: [70.0; 2],
             locked: false,
             geometries: vec![0],
+            pose: Default::default(),
         };
         let plan = Plan {
             name: "P".into(),

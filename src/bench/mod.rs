@@ -1,5 +1,6 @@
 //! Benchmark runner behind `galvoplan bench`: the whole pipeline per instance, timed per stage.
 
+pub mod cap;
 pub mod hatch;
 
 use crate::document::{MachineProfile, SolverSettings, TraySettings};

@@ -1,6 +1,7 @@
 //! Command-line front end (clap). Errors print as one line: `galvoplan: error: FILE: what`.
 
 mod bench;
+mod cap;
 mod hatch_bench;
 mod linuxcnc;
 mod plan;
@@ -44,6 +45,9 @@ enum Command {
     Tsp(tsp::TspArgs),
     /// Write a LinuxCNC machine configuration (INI, HAL, a headless runner) for a profile.
     LinuxcncConfig(linuxcnc::LinuxcncConfigArgs),
+    /// Seed 002's experiment: a scan-field layout laid on a spherical cap, its placements
+    /// ordered as is, by 3-D distance and by 5-axis time, each timed on a 5-axis profile.
+    CapBench(cap::CapBenchArgs),
 }
 
 /// Field placement, as on the command line.
@@ -570,6 +574,7 @@ pub fn main() -> std::process::ExitCode {
         Some(Command::HatchBench(a)) => hatch_bench::run(&a),
         Some(Command::Tsp(a)) => tsp::run(&a),
         Some(Command::LinuxcncConfig(a)) => linuxcnc::run(&a),
+        Some(Command::CapBench(a)) => cap::run(&a),
         None => open_gui(cli.file),
     };
     match result {

@@ -97,8 +97,12 @@ pub fn run(a: &PlanArgs) -> Result<()> {
         .as_ref()
         .map(|_| sampling_period_s(&plan.profile, plan.motion, a.trajectory_period_ms))
         .transpose()?;
-    let trajectory = period_s.map(|p| trajectory_csv(&toolpath, p));
-    let waypoints = a.waypoints.as_ref().map(|_| waypoints_csv(&toolpath));
+    let axes = plan.profile.extra_axes();
+    let trajectory = period_s.map(|p| trajectory_csv(&toolpath, p, &axes));
+    let waypoints = a
+        .waypoints
+        .as_ref()
+        .map(|_| waypoints_csv(&toolpath, &axes));
     let stream = stream_of(a, &plan, &toolpath)?;
     // streamed into the output file (atomically: written whole or not at all)
     let mut gcode_error = None;

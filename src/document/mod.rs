@@ -1,6 +1,7 @@
 //! The document model: geometries, machine profile, solver settings, scan fields and plans.
 
 mod artwork_import;
+mod axes;
 mod choices;
 mod code;
 mod geometry;
@@ -28,6 +29,9 @@ pub use inputs::{staleness, GeometryRevision, PlanInputs};
 pub use pens::{
     colour_word, layer_label, parse_colour, passes_of, pen_of, sync_layers, validate_layers, Layer,
     MarkTiming, Pen, PenLibrary, PensError, DEFAULT_LAYER, MAX_PASSES, PENS_VERSION,
+};
+pub use axes::{
+    AxisFileError, ExtraAxis, ExtraAxisId, LinearAxis, Pose, PoseError, RotaryAxis,
 };
 pub use plan::{
     GenerationRecord, Metrics, MotionFigures, MotionRegion, ObjectiveKind, Plan, ScanField,

@@ -3,7 +3,7 @@
 use crate::geom::{BBox, Pt};
 use serde::{Deserialize, Serialize};
 
-use super::{Algo, CostModel, Motion};
+use super::{Algo, CostModel, Motion, Pose};
 
 /// A scan field: the base parks at `center` and the scanner reaches `size` around it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -20,6 +20,10 @@ pub struct ScanField {
     /// Geometries allocated to this field (indices into the document's geometries).
     #[serde(default)]
     pub geometries: Vec<usize>,
+    /// Where the axes beyond X/Y stand while it is marked (a 5-axis or rotary machine); the
+    /// rest pose on a flat machine, which files do not write.
+    #[serde(default, skip_serializing_if = "Pose::is_rest")]
+    pub pose: Pose,
 }
 
 impl ScanField {

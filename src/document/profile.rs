@@ -1,5 +1,6 @@
 //! Machine profiles: stroke, scan field, dynamics, laser timing and G-code dialect (TOML).
 
+use super::axes::{LinearAxis, RotaryAxis};
 use super::validate::InvalidValue;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
@@ -17,7 +18,9 @@ use thiserror::Error;
 /// * 4: `[controller] clock_period_s`, a scan head's clock (plans made on it), and
 ///   `stream_period_s`, a LinuxCNC machine that streams on-the-fly plans. Every version-3 file
 ///   is a valid version-4 file.
-pub const PROFILE_VERSION: u32 = 4;
+/// * 5: axes beyond X/Y, `[axis_z]`, `[axis_a]`, `[axis_b]` (document/axes.rs), each with its
+///   own dynamics and travel. Every version-4 file is a valid version-5 file.
+pub const PROFILE_VERSION: u32 = 5;
 
 /// Limits of one base-stage axis (seed 002, Table 2 style).
 ///
@@ -325,6 +328,15 @@ pub struct MachineProfile {
     pub axis_x: AxisLimits,
     /// Base-stage Y axis.
     pub axis_y: AxisLimits,
+    /// A Z axis (the head's height), if the machine has one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub axis_z: Option<LinearAxis>,
+    /// A rotary A axis (about X), if the machine has one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub axis_a: Option<RotaryAxis>,
+    /// A rotary B axis (about Y), if the machine has one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub axis_b: Option<RotaryAxis>,
     /// Scanner speeds.
     pub scanner: ScannerSpeeds,
     /// Laser timing.
@@ -347,6 +359,9 @@ impl Default for MachineProfile {
             field_mm: [70.0, 70.0],
             axis_x: AxisLimits::default(),
             axis_y: AxisLimits::default(),
+            axis_z: None,
+            axis_a: None,
+            axis_b: None,
             scanner: ScannerSpeeds::default(),
             laser: LaserTiming::default(),
             gcode: GcodeDialect::default(),
@@ -402,6 +417,14 @@ pub const BUILTIN: &[(&str, &str)] = &[
         "linuxcnc",
         include_str!("../../assets/profiles/linuxcnc.toml"),
     ),
+    (
+        "five-axis",
+        include_str!("../../assets/profiles/five-axis.toml"),
+    ),
+    (
+        "rotary",
+        include_str!("../../assets/profiles/rotary.toml"),
+    ),
 ];
 
 /// Brings a profile table of an earlier format version to [`PROFILE_VERSION`], one step per
@@ -411,11 +434,11 @@ fn upgrade(table: &mut toml::Table) {
     let Some(version) = table.get("version").and_then(toml::Value::as_integer) else {
         return;
     };
-    if (1..=3).contains(&version) {
-        // 1 → 2, 2 → 3 and 3 → 4 only added fields, each with a default that keeps the earlier
-        // behaviour (acceleration as given, no settling, tool-centre G-code, ideal controller,
-        // no scan-head clock)
-        table.insert("version".into(), toml::Value::Integer(4));
+    if (1..=4).contains(&version) {
+        // 1 → 2, 2 → 3, 3 → 4 and 4 → 5 only added fields, each with a default that keeps the
+        // earlier behaviour (acceleration as given, no settling, tool-centre G-code, ideal
+        // controller, no scan-head clock, no axes beyond X/Y)
+        table.insert("version".into(), toml::Value::Integer(5));
     }
 }
 
@@ -474,6 +497,7 @@ impl MachineProfile {
             ));
         }
         super::spec::check_all(&super::spec::profile_specs(), self)?;
+        self.validate_extra_axes()?;
         let half_field_mm = self.field_mm[0].min(self.field_mm[1]) / 2.0;
         if self.otf_margin_mm >= half_field_mm {
             return Err(InvalidValue::new(

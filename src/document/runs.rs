@@ -409,6 +409,7 @@ mod tests {
             size: [70.0, 70.0],
             locked: false,
             geometries,
+            pose: Default::default(),
         }
     }
 

@@ -361,6 +361,8 @@ macro_rules! choice {
     };
 }
 
+mod axis_rows;
+
 /// The most decimal places a G-code number may have (below a nanometre is noise).
 pub const MAX_DECIMALS: usize = 9;
 
@@ -453,6 +455,18 @@ pub fn profile_specs() -> Vec<FieldSpec<MachineProfile>> {
             NonNegative,
             |p| p.axis_y.settle_s
         ),
+    ]
+    .into_iter()
+    .chain(axis_rows::axis_specs())
+    .chain(scanner_to_gcode_specs())
+    .chain(controller_specs())
+    .collect()
+}
+
+/// The profile's scanner, laser and G-code rows.
+fn scanner_to_gcode_specs() -> Vec<FieldSpec<MachineProfile>> {
+    use Rule::{NonNegative, Positive};
+    vec![
         number!(
             "Scanner jump speed",
             "mm/s",
@@ -620,9 +634,6 @@ pub fn profile_specs() -> Vec<FieldSpec<MachineProfile>> {
             |p| p.gcode.path_tol_mm
         ),
     ]
-    .into_iter()
-    .chain(controller_specs())
-    .collect()
 }
 
 /// The controller's values (a profile's `[controller]` table), and the two choices of
@@ -1153,6 +1164,37 @@ pub mod rows {
     pub const SCANNER_ACCEL: Row<MachineProfile> =
         Row::new("controller.scanner_accel_mm_s2", profile_specs);
 
+    /// Axis Z's rows.
+    pub const AXIS_Z: &[Row<MachineProfile>] = &[
+        Row::new("axis_z.max_velocity_mm_s", profile_specs),
+        Row::new("axis_z.max_accel_mm_s2", profile_specs),
+        Row::new("axis_z.settle_s", profile_specs),
+        Row::new("axis_z.travel_mm[0]", profile_specs),
+        Row::new("axis_z.travel_mm[1]", profile_specs),
+    ];
+    /// Axis A's rows.
+    pub const AXIS_A: &[Row<MachineProfile>] = &[
+        Row::new("axis_a.max_velocity_deg_s", profile_specs),
+        Row::new("axis_a.max_accel_deg_s2", profile_specs),
+        Row::new("axis_a.settle_s", profile_specs),
+        Row::new("axis_a.travel_deg[0]", profile_specs),
+        Row::new("axis_a.travel_deg[1]", profile_specs),
+    ];
+    /// Axis B's rows.
+    pub const AXIS_B: &[Row<MachineProfile>] = &[
+        Row::new("axis_b.max_velocity_deg_s", profile_specs),
+        Row::new("axis_b.max_accel_deg_s2", profile_specs),
+        Row::new("axis_b.settle_s", profile_specs),
+        Row::new("axis_b.travel_deg[0]", profile_specs),
+        Row::new("axis_b.travel_deg[1]", profile_specs),
+    ];
+    /// The Y axis's dynamics (a rotary machine without Y has none).
+    pub const AXIS_Y: &[Row<MachineProfile>] = &[
+        Row::new("axis_y.max_velocity_mm_s", profile_specs),
+        Row::new("axis_y.max_accel_mm_s2", profile_specs),
+        Row::new("axis_y.settle_s", profile_specs),
+    ];
+
     /// A pen's mark speed.
     pub const PEN_SPEED: Row<Pen> = Row::new("mark_speed_mm_s", pen_specs);
     /// A pen's power.
@@ -1203,6 +1245,10 @@ pub const PROFILE_APPLIES: &[AppliesWhen] = &[
     (&[rows::CLOCK], |p| {
         p.controller.kind == ControllerKind::Ideal
     }),
+    (rows::AXIS_Y, MachineProfile::has_y),
+    (rows::AXIS_Z, |p| p.axis_z.is_some()),
+    (rows::AXIS_A, |p| p.axis_a.is_some()),
+    (rows::AXIS_B, |p| p.axis_b.is_some()),
     // also the scanner's acceleration in linuxcnc-config's machine
     (&[rows::SCANNER_ACCEL], |p| {
         p.gcode.mode == GcodeMode::Linuxcnc || p.controller.kind == ControllerKind::Linuxcnc

@@ -5,8 +5,12 @@
 //! * `stage-scanner`: at every field change a `G0 X.. Y..` positions the stage at the field's
 //!   centre; scanner jumps (`G0`) and marks (`G1`) are field-local offsets on the two scanner
 //!   axis words (default `U`, `V`), with the same laser words.
+//!
+//! A machine with axes beyond X/Y (document/axes.rs) turns them at every field change: its
+//! stage words carry `Z`, `A`, `B` for the axes it has (`stage-scanner`, LinuxCNC), a
+//! tool-centre program a `G0 Z.. A.. B..` line. A flat machine's programs are unchanged.
 
-use crate::document::{GcodeMode, Layer, MachineProfile, Plan};
+use crate::document::{ExtraAxisId, GcodeMode, Layer, MachineProfile, Plan, Pose};
 use crate::geom::Pt;
 use crate::motion::Toolpath;
 use std::fmt::Write;
@@ -120,6 +124,37 @@ impl Words<'_> {
         self.push_xy(&mut out, axes, p);
         out
     }
+    /// The stage's words for a placement at `p` with `pose`: `X.. Y..`, then `Z..`, `A..`,
+    /// `B..` for the axes the machine has (a flat machine: `X.. Y..` alone; a rotary machine
+    /// without Y: no `Y`). Mirroring Y turns A the other way (a rotation about X mirrored in Y
+    /// is the opposite rotation); Z and B are unchanged by it.
+    pub(super) fn stage_words(&self, p: Pt, pose: &Pose) -> String {
+        let p = self.position(p);
+        let decimals = self.profile.gcode.decimals;
+        let mut out = String::from("X");
+        crate::geom::push_mm(&mut out, p.x, decimals);
+        if self.profile.has_y() {
+            out.push_str(" Y");
+            crate::geom::push_mm(&mut out, p.y, decimals);
+        }
+        for id in self.profile.extra_axes() {
+            let mut v = pose.values()[id.index()];
+            if id == ExtraAxisId::A && self.profile.gcode.flip_y {
+                v = -v;
+            }
+            out.push(' ');
+            out.push_str(id.word());
+            crate::geom::push_mm(&mut out, v, decimals);
+        }
+        out
+    }
+    /// The pose's words alone (`Z.. A.. B..` for the axes the machine has; empty on a flat
+    /// machine): a tool-centre program turns them at a field change.
+    pub(super) fn pose_words(&self, pose: &Pose) -> String {
+        let all = self.stage_words(Pt::default(), pose);
+        let skip = if self.profile.has_y() { 2 } else { 1 };
+        all.split(' ').skip(skip).collect::<Vec<_>>().join(" ")
+    }
     /// [`Words::xy`] appended to `out`.
     pub(super) fn push_xy(&self, out: &mut String, axes: [&str; 2], p: Pt) {
         let decimals = self.profile.gcode.decimals;
@@ -210,6 +245,8 @@ pub fn write_gcode_to(
         .enumerate()
         .map(|(k, f)| (f.id, k + 1))
         .collect();
+    let pose_of: std::collections::HashMap<usize, Pose> =
+        plan.fields.iter().map(|f| (f.id, f.pose)).collect();
     let mut current_field = None;
     for (k, stroke) in toolpath.strokes.iter().enumerate() {
         if current_field != Some(stroke.field) {
@@ -234,8 +271,14 @@ pub fn write_gcode_to(
                 w.num(c.x),
                 w.num(c.y)
             );
+            let pose = pose_of.get(&stroke.field).copied().unwrap_or_default();
             if stage_scanner {
-                let _ = writeln!(out, "G0 {}", w.xy(["X", "Y"], c));
+                let _ = writeln!(out, "G0 {}", w.stage_words(stroke.stage, &pose));
+            } else {
+                let turn = w.pose_words(&pose);
+                if !turn.is_empty() {
+                    let _ = writeln!(out, "G0 {turn}");
+                }
             }
         }
         let points = toolpath.stroke_points(k);

@@ -20,7 +20,7 @@
 //! synchronised) or, without one, on the profile's power word.
 
 use super::gcode::{GcodeError, PenWords, Words, CHUNK_BYTES};
-use crate::document::{MachineProfile, MarkTiming, Plan};
+use crate::document::{MachineProfile, MarkTiming, Plan, Pose};
 use crate::geom::Pt;
 use crate::motion::controller::otf_lines;
 use crate::motion::{ScanMotion, SegmentKind, StageMotion, Toolpath};
@@ -256,8 +256,8 @@ M65 P{sel}
             .xy([a[0].as_str(), a[1].as_str()], self.w.offset(offset))
     }
 
-    fn stage_words(&self, p: Pt) -> String {
-        self.w.xy(["X", "Y"], self.w.position(p))
+    fn stage_words(&self, p: Pt, pose: &Pose) -> String {
+        self.w.stage_words(p, pose)
     }
 
     fn field_comment(&mut self, plan: &Plan, field: usize, centre: Pt) {
@@ -288,7 +288,7 @@ M65 P{sel}
             let _ = writeln!(
                 self.out,
                 "G0 {} {}",
-                self.stage_words(first.stage),
+                self.stage_words(first.stage, &toolpath.start_pose),
                 self.scan_words(start.minus(first.stage))
             );
         }
@@ -311,7 +311,8 @@ M65 P{sel}
                         ScanMotion::Line { to, .. } => format!(" {}", self.scan_words(to)),
                         _ => String::new(),
                     };
-                    let _ = writeln!(self.out, "G0 {}{jump}", self.stage_words(to));
+                    let pose = mv.pose(seg.duration_s);
+                    let _ = writeln!(self.out, "G0 {}{jump}", self.stage_words(to, &pose));
                 }
                 (SegmentKind::Jump, _, ScanMotion::Line { to, .. }) => {
                     self.before_move(false);
@@ -365,7 +366,7 @@ M65 P{sel}
         let _ = writeln!(
             self.out,
             "G0 {} {}",
-            self.stage_words(start.stage),
+            self.stage_words(start.stage, &Pose::default()),
             self.scan_words(start.scan)
         );
         self.out.push_str("G93\n");
@@ -380,7 +381,7 @@ M65 P{sel}
             let _ = writeln!(
                 self.out,
                 "G1 {} {} F{}",
-                self.stage_words(line.stage),
+                self.stage_words(line.stage, &Pose::default()),
                 self.scan_words(line.scan),
                 fmt_inverse_time(1.0 / duration_min)
             );

@@ -1,7 +1,8 @@
 //! The JSON report (`--report`): fields, order, metrics, settings, history, warnings.
 
 use crate::document::{
-    GenerationRecord, Layer, MachineProfile, Metrics, PartRecord, Plan, SolverSettings, Warning,
+    GenerationRecord, Layer, MachineProfile, Metrics, PartRecord, Plan, Pose, SolverSettings,
+    Warning,
 };
 use serde::Serialize;
 
@@ -21,6 +22,9 @@ pub struct ReportField {
     pub locked: bool,
     /// Geometries allocated to it.
     pub geometries: usize,
+    /// Where Z, A and B stand while it is marked (mm, deg), on a machine with such axes.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pose: Option<Pose>,
 }
 
 /// One stroke in the report.
@@ -110,6 +114,7 @@ pub fn report_json(source: &str, plan: &Plan, warnings: &[Warning]) -> String {
                 size: f.size,
                 locked: f.locked,
                 geometries: f.geometries.len(),
+                pose: (!plan.profile.extra_axes().is_empty()).then_some(f.pose),
             })
             .collect(),
         order: plan

@@ -1,6 +1,7 @@
 //! The sampled stage + scanner trajectory (docs/DESIGN.md, *Trajectory*): what a controller streams.
 
-use crate::motion::Toolpath;
+use crate::document::ExtraAxisId;
+use crate::motion::{PoseTrack, Toolpath};
 use std::fmt::Write;
 use thiserror::Error;
 
@@ -38,18 +39,51 @@ pub fn trajectory_period_s(period_ms: f64) -> Result<f64, PeriodError> {
 /// sampled, never changed: on a profile with a controller clock (and `period_s` that clock)
 /// every mark starts and ends on a sample; a continuous plan's marks shorter than a period may
 /// fall between samples (sample it finer to see them).
-pub fn trajectory_csv(toolpath: &Toolpath, period_s: f64) -> String {
+///
+/// A machine with axes beyond X/Y (`axes`, the profile's [`crate::document::MachineProfile::extra_axes`])
+/// has a column for each after `laser` (`z_mm`, `a_deg`, `b_deg`); a flat machine's header is
+/// [`TRAJECTORY_HEADER`] exactly.
+pub fn trajectory_csv(toolpath: &Toolpath, period_s: f64, axes: &[ExtraAxisId]) -> String {
     let end_s = toolpath.duration_s();
     let samples = crate::motion::ticks_covering(end_s, period_s) + 1;
     let mut out = String::with_capacity(samples * 64);
-    out.push_str(TRAJECTORY_HEADER);
-    out.push('\n');
+    push_header(&mut out, axes);
     let mm_decimals = position_decimals(period_s);
+    let track = (!axes.is_empty()).then(|| toolpath.pose_track());
     for k in 0..samples {
         let t_s = k as f64 * period_s;
         push_row(&mut out, t_s, &toolpath.state_at(t_s), 7, mm_decimals);
+        push_axes(&mut out, track.as_ref(), t_s, axes, mm_decimals);
     }
     out
+}
+
+/// The header, with a column per axis beyond X/Y.
+fn push_header(out: &mut String, axes: &[ExtraAxisId]) {
+    out.push_str(TRAJECTORY_HEADER);
+    for id in axes {
+        let _ = write!(out, ",{}_{}", id.word().to_lowercase(), id.unit());
+    }
+    out.push('\n');
+}
+
+/// The axes beyond X/Y at `t_s`, at the end of the row [`push_row`] wrote.
+fn push_axes(
+    out: &mut String,
+    track: Option<&PoseTrack>,
+    t_s: f64,
+    axes: &[ExtraAxisId],
+    decimals: usize,
+) {
+    let Some(track) = track else {
+        return;
+    };
+    let pose = track.at(t_s).values();
+    out.pop();
+    for id in axes {
+        let _ = write!(out, ",{:.decimals$}", pose[id.index()]);
+    }
+    out.push('\n');
 }
 
 /// Decimals of the positions sampled every `period_s`: 6 (1 nm … 1 µm) at 1 ms, two more for
@@ -87,14 +121,15 @@ fn push_row(
 /// ([`crate::motion::controller::otf_sample_states`]). Positions are the toolpath's own, so a
 /// controller's canonical moves can be checked against them; they are not flipped as the
 /// G-code's Y may be.
-pub fn waypoints_csv(toolpath: &Toolpath) -> String {
+pub fn waypoints_csv(toolpath: &Toolpath, axes: &[ExtraAxisId]) -> String {
     let states = crate::motion::controller::waypoint_states(toolpath);
     let mut out = String::with_capacity(states.len() * 64 + 64);
-    out.push_str(TRAJECTORY_HEADER);
-    out.push('\n');
+    push_header(&mut out, axes);
+    let track = (!axes.is_empty()).then(|| toolpath.pose_track());
     for (t_s, m) in states {
         // exact states: time to the nanosecond, positions to 0.1 µm
         push_row(&mut out, t_s, &m, 9, 7);
+        push_axes(&mut out, track.as_ref(), t_s, axes, 7);
     }
     out
 }

@@ -250,6 +250,7 @@ mod tests {
             size: [70.0, 70.0],
             locked: false,
             geometries: vec![],
+            pose: Default::default(),
         }
     }
 

@@ -71,6 +71,7 @@ pub fn auto_fields(
             size: profile.field_mm,
             locked: false,
             geometries: Vec::new(),
+            pose: Default::default(),
         })
         .collect())
 }

@@ -56,6 +56,7 @@ pub fn add_field(doc: &mut Document, center: Pt) -> (usize, Allocation) {
         size: doc.profile.field_mm,
         locked: false,
         geometries: Vec::new(),
+        pose: Default::default(),
     });
     (id, reallocate(doc))
 }

@@ -75,6 +75,7 @@ pub fn greedy_fields(
             size: profile.field_mm,
             locked: false,
             geometries: members,
+            pose: Default::default(),
         });
     }
     Ok(fields)

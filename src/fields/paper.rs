@@ -292,6 +292,7 @@ pub fn paper_fields(
             size: profile.field_mm,
             locked: false,
             geometries: Vec::new(),
+            pose: Default::default(),
         })
         .collect())
 }

@@ -1,7 +1,12 @@
 //! One stage axis moving point to point from rest to rest with a trapezoidal velocity profile,
-//! and the two-axis stage built from two of them (seed 002 §6.3).
+//! and the machine's axes built from them: the X/Y stage, and a Z and rotary A/B axes where the
+//! profile has them (seed 002 §6.3).
+//!
+//! Seed 002's eq. 14 is this trapezoid in its terms: with nominal feed `F` and acceleration time
+//! `t_a` (so `a = F / t_a`), a displacement `s > F·t_a` takes `s/F + t_a` (= `d/v + v/a`),
+//! a shorter one `2·√(s·t_a/F)` (= `2·√(d/a)`, the triangle).
 
-use crate::document::{AxisLimits, MachineProfile};
+use crate::document::{AxisLimits, ExtraAxisId, MachineProfile, Pose};
 use crate::geom::Pt;
 
 /// A rest-to-rest move of one axis: accelerate at `accel`, cruise at `peak` (when the distance
@@ -68,25 +73,29 @@ impl AxisMove {
     }
 }
 
-/// The two stage axes of a profile: both start together, each runs its own time-optimal
-/// trapezoid, the slower one sets the move time (seed 002 §6.3: cost = max over the axes); each
-/// axis that moved then settles for its `settle_s`.
+/// The axes of a profile that move between placements: all start together, each runs its own
+/// time-optimal trapezoid, the slowest one sets the move time (seed 002 §6.3:
+/// `d = max(t_x, t_y, t_z, t_A, t_B)`); each axis that moved then settles for its `settle_s`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct StageDynamics {
     /// X axis limits.
     pub x: AxisLimits,
     /// Y axis limits.
     pub y: AxisLimits,
+    /// Z, A and B limits where the profile has the axis (in its unit: mm or deg).
+    pub extra: [Option<AxisLimits>; 3],
 }
 
-/// A stage move between two positions: the two axis moves and the settling after them.
+/// A stage move between two positions: the axis moves and the settling after them.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StageMove {
     /// X axis.
     pub x: AxisMove,
     /// Y axis.
     pub y: AxisMove,
-    /// Until both axes stand still, s.
+    /// Z, A and B (zero moves on a machine without them; mm or deg).
+    pub extra: [AxisMove; 3],
+    /// Until every axis stands still, s.
     pub move_s: f64,
     /// From then until every axis that moved has settled, s.
     pub settle_s: f64,
@@ -96,6 +105,15 @@ impl StageMove {
     /// Position at `t_s` after the start.
     pub fn position(&self, t_s: f64) -> Pt {
         Pt::new(self.x.position_mm(t_s), self.y.position_mm(t_s))
+    }
+    /// Pose of Z, A and B at `t_s` after the start.
+    pub fn pose(&self, t_s: f64) -> Pose {
+        let [z, a, b] = self.extra.map(|m| m.position_mm(t_s));
+        Pose {
+            z_mm: z,
+            a_deg: a,
+            b_deg: b,
+        }
     }
     /// Move plus settling, s.
     pub fn total_s(&self) -> f64 {
@@ -109,13 +127,24 @@ impl StageDynamics {
         Self {
             x: profile.axis_x.clone(),
             y: profile.axis_y.clone(),
+            extra: ExtraAxisId::ALL.map(|id| profile.extra_axis(id).map(|a| a.limits())),
         }
     }
-    /// The move from `from` to `to`.
+    /// The move from `from` to `to` (Z, A and B at rest).
     pub fn plan_move(&self, from: Pt, to: Pt) -> StageMove {
+        self.plan_pose_move(from, &Pose::default(), to, &Pose::default())
+    }
+    /// The move from `from` at `from_pose` to `to` at `to_pose`. An axis the machine does not
+    /// have does not move ([`MachineProfile::check_pose`] refuses a pose that needs it).
+    pub fn plan_pose_move(&self, from: Pt, from_pose: &Pose, to: Pt, to_pose: &Pose) -> StageMove {
         let x = AxisMove::new(from.x, to.x, &self.x);
         let y = AxisMove::new(from.y, to.y, &self.y);
-        let move_s = x.duration_s.max(y.duration_s);
+        let (p, q) = (from_pose.values(), to_pose.values());
+        let extra = [0, 1, 2].map(|k| match &self.extra[k] {
+            Some(l) => AxisMove::new(p[k], q[k], l),
+            None => AxisMove::new(p[k], p[k], &self.x),
+        });
+        let mut move_s = x.duration_s.max(y.duration_s);
         let settled = |m: &AxisMove, l: &AxisLimits| {
             if m.distance_mm != 0.0 {
                 m.duration_s + l.settle_s
@@ -123,10 +152,17 @@ impl StageDynamics {
                 0.0
             }
         };
-        let done_s = settled(&x, &self.x).max(settled(&y, &self.y));
+        let mut done_s = settled(&x, &self.x).max(settled(&y, &self.y));
+        for (m, l) in extra.iter().zip(&self.extra) {
+            if let Some(l) = l {
+                move_s = move_s.max(m.duration_s);
+                done_s = done_s.max(settled(m, l));
+            }
+        }
         StageMove {
             x,
             y,
+            extra,
             move_s,
             settle_s: (done_s - move_s).max(0.0),
         }
@@ -134,6 +170,15 @@ impl StageDynamics {
     /// Time from rest at `from` to settled at `to`, s: the stage part of the time cost.
     pub fn move_time_s(&self, from: Pt, to: Pt) -> f64 {
         self.plan_move(from, to).total_s()
+    }
+    /// Time from rest at `from` (`from_pose`) to settled at `to` (`to_pose`), s: the slowest
+    /// axis's time (seed 002's 5-axis time cost).
+    pub fn pose_move_time_s(&self, from: Pt, from_pose: &Pose, to: Pt, to_pose: &Pose) -> f64 {
+        self.plan_pose_move(from, from_pose, to, to_pose).total_s()
+    }
+    /// The machine moves axes beyond X/Y.
+    pub fn has_extra(&self) -> bool {
+        self.extra.iter().any(Option::is_some)
     }
 }
 
@@ -182,6 +227,7 @@ mod tests {
         let mut st = StageDynamics {
             x: axis(100.0, 1000.0),
             y: axis(50.0, 1000.0),
+            extra: [None, None, None],
         };
         st.y.settle_s = 0.05;
         let m = st.plan_move(Pt::new(0.0, 0.0), Pt::new(100.0, 100.0));
@@ -191,5 +237,53 @@ mod tests {
         let m = st.plan_move(Pt::new(0.0, 0.0), Pt::new(100.0, 0.0));
         assert_eq!(m.settle_s, 0.0);
         assert_eq!(st.move_time_s(Pt::new(3.0, 4.0), Pt::new(3.0, 4.0)), 0.0);
+    }
+
+    /// Seed 002's eq. 14 for one axis: `s/F + t_a` beyond `F·t_a`, else `2·√(s·t_a/F)`.
+    fn eq14_s(s: f64, f_nom: f64, t_a: f64) -> f64 {
+        if s > f_nom * t_a {
+            s / f_nom + t_a
+        } else {
+            2.0 * (s * t_a / f_nom).sqrt()
+        }
+    }
+
+    #[test]
+    fn a_move_whose_slowest_axis_is_b_costs_bs_eq_14_time() {
+        let p = MachineProfile::builtin("five-axis").unwrap();
+        let st = StageDynamics::of(&p);
+        let b = p.axis_b.as_ref().unwrap();
+        let (f_b, t_b) = (b.0.max_velocity, b.0.max_velocity / b.0.max_accel);
+        let from = Pose::default();
+        // 40 mm in X (≈ 0.42 s) and 5 mm in Z, while B turns 60° (≈ 1.36 s): B sets the time
+        let to = Pose {
+            z_mm: 5.0,
+            a_deg: 10.0,
+            b_deg: 60.0,
+        };
+        let m = st.plan_pose_move(Pt::new(100.0, 100.0), &from, Pt::new(140.0, 100.0), &to);
+        let want = eq14_s(60.0, f_b, t_b);
+        assert!((m.move_s - want).abs() < 1e-12, "{} vs {want}", m.move_s);
+        assert!(m.x.duration_s < want && m.extra[1].duration_s < want);
+        assert!(
+            (st.pose_move_time_s(Pt::new(100.0, 100.0), &from, Pt::new(140.0, 100.0), &to) - want)
+                .abs()
+                < 1e-12
+        );
+        // a short B move is the triangle
+        let small = Pose {
+            b_deg: 2.0,
+            ..Pose::default()
+        };
+        let m = st.plan_pose_move(Pt::default(), &from, Pt::default(), &small);
+        assert!((m.move_s - eq14_s(2.0, f_b, t_b)).abs() < 1e-12);
+        // X alone follows eq. 14 with X's own law (seed 002 Table 2: 218 mm/s, 0.239 s)
+        let m = st.plan_move(Pt::default(), Pt::new(200.0, 0.0));
+        assert!((m.move_s - eq14_s(200.0, 218.0, 0.239)).abs() < 1e-9);
+        // the pose is followed along the move
+        let m = st.plan_pose_move(Pt::default(), &from, Pt::default(), &to);
+        assert_eq!(m.pose(0.0), from);
+        let end = m.pose(m.move_s);
+        assert!((end.b_deg - 60.0).abs() < 1e-9 && (end.z_mm - 5.0).abs() < 1e-9);
     }
 }

@@ -55,6 +55,11 @@ pub struct LinuxcncClock {
     pub amax_mm_s2: [f64; 4],
     /// `[TRAJ] MAX_LINEAR_VELOCITY`, mm/s.
     pub v_limit_mm_s: f64,
+    /// Z, A, B: speed limits (mm/s, deg/s); infinite where the machine has no such axis (it
+    /// never moves).
+    pub extra_vmax: [f64; 3],
+    /// Z, A, B: acceleration limits (mm/s², deg/s²).
+    pub extra_amax: [f64; 3],
 }
 
 impl LinuxcncClock {
@@ -74,7 +79,10 @@ impl LinuxcncClock {
             scanner_v,
             scanner_v,
         ];
+        let extra = crate::document::ExtraAxisId::ALL.map(|id| profile.extra_axis(id));
         Some(Self {
+            extra_vmax: extra.map(|a| a.map_or(f64::INFINITY, |a| a.max_velocity)),
+            extra_amax: extra.map(|a| a.map_or(f64::INFINITY, |a| a.max_accel)),
             period_s: profile.controller.servo_period_s,
             vmax_mm_s,
             amax_mm_s2: [
@@ -92,11 +100,17 @@ impl LinuxcncClock {
     /// a feed move at `feed_mm_s`, or a rapid (`None`). Zero for no travel (LinuxCNC drops
     /// zero-length moves).
     pub fn move_s(&self, d_mm: [f64; 4], feed_mm_s: Option<f64>) -> f64 {
-        self.planned(d_mm, feed_mm_s, false).map_or(0.0, |m| {
-            let speed = m.requested_mm_s.min(m.max_mm_s);
-            exact_stop_cycles(m.length_mm, speed, m.accel_mm_s2, self.period_s) as f64
-                * self.period_s
-        })
+        self.move_axes_s(d_mm, [0.0; 3], feed_mm_s)
+    }
+
+    /// [`LinuxcncClock::move_s`] with Z, A and B moving too (`turn`: mm, deg, deg).
+    pub fn move_axes_s(&self, d_mm: [f64; 4], turn: [f64; 3], feed_mm_s: Option<f64>) -> f64 {
+        self.planned_axes(d_mm, turn, feed_mm_s, false)
+            .map_or(0.0, |m| {
+                let speed = m.requested_mm_s.min(m.max_mm_s);
+                exact_stop_cycles(m.length_mm, speed, m.accel_mm_s2, self.period_s) as f64
+                    * self.period_s
+            })
     }
 
     /// Time of a polyline marked by the scanner at `feed_mm_s` through `points` (the stage at
@@ -431,20 +445,38 @@ impl LinuxcncClock {
     /// The limits of a straight move by `d_mm` asking for `requested` mm/s of its length
     /// (none: a rapid), and its length; none for no travel.
     fn planned(&self, d_mm: [f64; 4], requested: Option<f64>, blend: bool) -> Option<PlannedMove> {
-        let xy = d_mm[0].hypot(d_mm[1]);
+        self.planned_axes(d_mm, [0.0; 3], requested, blend)
+    }
+
+    /// [`LinuxcncClock::planned`] with Z, A and B: the length is the X/Y/Z length when they
+    /// move, else the scanner's, else the rotaries' (`emccanon.cc`'s order: cartesian, then
+    /// U/V/W, then A/B/C); every axis is scaled into its own box either way.
+    fn planned_axes(
+        &self,
+        d_mm: [f64; 4],
+        turn: [f64; 3],
+        requested: Option<f64>,
+        blend: bool,
+    ) -> Option<PlannedMove> {
+        let xyz = d_mm[0].hypot(d_mm[1]).hypot(turn[0]);
         let uv = d_mm[2].hypot(d_mm[3]);
-        let length_mm = if xy > POSITION_EPS_MM { xy } else { uv };
+        let ab = turn[1].hypot(turn[2]);
+        let length_mm = [xyz, uv, ab]
+            .into_iter()
+            .find(|l| *l > POSITION_EPS_MM)
+            .unwrap_or(0.0);
         if length_mm <= POSITION_EPS_MM {
             return None;
         }
-        let slowest = |limits: &[f64; 4]| {
+        let slowest = |limits: &[f64; 4], extra: &[f64; 3]| {
             d_mm.iter()
                 .zip(limits)
+                .chain(turn.iter().zip(extra))
                 .map(|(d, l)| d.abs() / l)
                 .fold(0.0, f64::max)
         };
-        let v_axes = length_mm / slowest(&self.vmax_mm_s);
-        let accel = length_mm / slowest(&self.amax_mm_s2);
+        let v_axes = length_mm / slowest(&self.vmax_mm_s, &self.extra_vmax);
+        let accel = length_mm / slowest(&self.amax_mm_s2, &self.extra_amax);
         Some(PlannedMove {
             length_mm,
             requested_mm_s: requested.unwrap_or(v_axes),

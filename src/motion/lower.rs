@@ -3,7 +3,7 @@
 use super::axis::StageDynamics;
 use super::controller::LinuxcncClock;
 use super::toolpath::{ScanMotion, Segment, SegmentKind, StageMotion, Toolpath};
-use crate::document::{Geometry, MachineProfile, MarkTiming, Plan, ScanField};
+use crate::document::{Geometry, MachineProfile, MarkTiming, Plan, Pose, PoseError, ScanField};
 use crate::geom::{is_dot, Pt};
 use thiserror::Error;
 
@@ -48,6 +48,9 @@ pub enum LowerError {
         /// How far beyond the field edge, mm.
         excess_mm: f64,
     },
+    /// A field's pose the machine cannot take.
+    #[error(transparent)]
+    Pose(#[from] PoseError),
 }
 
 /// Lowers a step-and-scan plan to the machine's motion.
@@ -94,6 +97,9 @@ pub fn lower(
                     field: step.field,
                 })?,
         };
+        if field_at.is_none_or(|f| f.id != field.id) {
+            profile.check_pose(field.id, &field.pose)?;
+        }
         field_at = Some(field);
         let path = g.marking_path(step.start_vertex, step.reversed);
         check_reach(&path, field.center, field.size).map_err(|excess_mm| {
@@ -109,7 +115,7 @@ pub fn lower(
                 geometry: step.geometry,
             });
         };
-        b.go_to(field.center, start.minus(field.center), k == 0);
+        b.go_to(field.center, &field.pose, start.minus(field.center), k == 0);
         let stroke = b
             .path
             .push_stroke(k, step.geometry, step.field, field.center, &path);
@@ -141,6 +147,8 @@ struct Builder<'a> {
     path: Toolpath,
     t_s: f64,
     stage_at: Pt,
+    /// Where Z, A and B stand.
+    pose_at: Pose,
     scan_at: Pt,
     /// The controller's clock (LinuxCNC), which times moves and dwells; none: the scan head's
     /// own timing.
@@ -157,6 +165,7 @@ impl<'a> Builder<'a> {
             path: Toolpath::default(),
             t_s: 0.0,
             stage_at: Pt::default(),
+            pose_at: Pose::default(),
             scan_at: Pt::default(),
             clock: LinuxcncClock::of(profile),
             pausing: false,
@@ -214,18 +223,23 @@ impl<'a> Builder<'a> {
         self.hold(SegmentKind::JumpDelay, self.profile.laser.jump_delay_s);
     }
 
-    /// Brings the stage to `center` and the scanner to `offset` (the first stroke: places them).
-    fn go_to(&mut self, center: Pt, offset: Pt, first: bool) {
+    /// Brings the stage to `center` at `pose` and the scanner to `offset` (the first stroke:
+    /// places them).
+    fn go_to(&mut self, center: Pt, pose: &Pose, offset: Pt, first: bool) {
         if first {
             self.stage_at = center;
+            self.pose_at = *pose;
+            self.path.start_pose = *pose;
             self.scan_at = offset;
             return;
         }
-        if center == self.stage_at {
+        if center == self.stage_at && *pose == self.pose_at {
             self.jump(offset);
             return;
         }
-        let mv = self.stage.plan_move(self.stage_at, center);
+        let mv = self
+            .stage
+            .plan_pose_move(self.stage_at, &self.pose_at, center, pose);
         let jump_s = offset.dist(self.scan_at) / self.profile.scanner.jump_speed_mm_s;
         // on a controller clock the jump is part of the stage's move (one coordinated G0),
         // which comes to rest on both
@@ -234,8 +248,10 @@ impl<'a> Builder<'a> {
         let move_s = match &self.clock {
             Some(c) => {
                 let (d, j) = (center.minus(self.stage_at), offset.minus(self.scan_at));
+                let turn = crate::order::objective::pose_diff(&self.pose_at, pose);
                 // never shorter than the axes' own trapezoids (the stage's position is timed by them)
-                c.move_s([d.x, d.y, j.x, j.y], None).max(mv.move_s)
+                c.move_axes_s([d.x, d.y, j.x, j.y], turn, None)
+                    .max(mv.move_s)
             }
             None => mv.move_s,
         };
@@ -252,6 +268,7 @@ impl<'a> Builder<'a> {
         let moving = StageMotion::Move(self.path.stage_moves.len() - 1);
         self.push(SegmentKind::StageMove, move_s, moving, scan);
         self.stage_at = center;
+        self.pose_at = *pose;
         if hidden {
             self.scan_at = offset;
         }

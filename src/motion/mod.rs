@@ -36,7 +36,8 @@ pub use otf::{lower_on_the_fly, still_reach_mm, OtfError};
 pub use route::{AxisRoute, SmoothedAxis, StageRoute};
 pub use seed_routes::plan_stage_route;
 pub use toolpath::{
-    MachineState, ScanMotion, Segment, SegmentKind, StageMotion, Stroke, Toolpath, TIME_EPS_S,
+    MachineState, PoseTrack, ScanMotion, Segment, SegmentKind, StageMotion, Stroke, Toolpath,
+    TIME_EPS_S,
 };
 
 use crate::document::{Geometry, Layer, Motion, Plan};

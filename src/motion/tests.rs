@@ -18,6 +18,7 @@ fn field(id: usize, c: Pt) -> ScanField {
         size: [70.0, 70.0],
         locked: false,
         geometries: vec![],
+        pose: Default::default(),
     }
 }
 

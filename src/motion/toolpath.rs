@@ -4,7 +4,7 @@
 use super::axis::StageMove;
 use super::clock::MarkClock;
 use super::route::StageRoute;
-use crate::document::{Motion, MotionFigures, MotionRegion, TimeBreakdown};
+use crate::document::{Motion, MotionFigures, MotionRegion, Pose, TimeBreakdown};
 use crate::geom::Pt;
 use std::ops::Range;
 
@@ -143,6 +143,26 @@ impl MachineState {
     }
 }
 
+/// Where Z, A and B stand over a toolpath: the stage moves that turn them, by start time
+/// ([`Toolpath::pose_track`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PoseTrack {
+    start: Pose,
+    /// (start time, stage move) of every stage move, in time order.
+    moves: Vec<(f64, StageMove)>,
+}
+
+impl PoseTrack {
+    /// The pose at `t_s`.
+    pub fn at(&self, t_s: f64) -> Pose {
+        let k = self.moves.partition_point(|(start_s, _)| *start_s <= t_s);
+        match k.checked_sub(1).and_then(|k| self.moves.get(k)) {
+            Some((start_s, mv)) => mv.pose(t_s - start_s),
+            None => self.start,
+        }
+    }
+}
+
 /// A job as the machine runs it: contiguous segments from t = 0, and the marked strokes.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Toolpath {
@@ -160,6 +180,9 @@ pub struct Toolpath {
     /// A mixed job (on the fly): the ids of the fields whose strokes are marked with the stage
     /// at rest, ascending ([`crate::document::Plan::step_fields`]); empty: one motion.
     pub still_fields: Vec<usize>,
+    /// Where Z, A and B stand at the start (the first field's pose); stage moves carry them
+    /// from there ([`Toolpath::pose_track`]).
+    pub start_pose: Pose,
     /// Tool-centre points of all strokes, concatenated.
     points: Vec<Pt>,
     /// Arc length from each stroke's first point to each point, mm (parallel to `points`).
@@ -176,6 +199,31 @@ impl Toolpath {
         self.arc_mm.reserve_exact(points);
         self.segments.reserve_exact(segments);
     }
+    /// Where Z, A and B stand at any instant (one pass over the segments; then
+    /// O(log moves) per instant).
+    pub fn pose_track(&self) -> PoseTrack {
+        let moves = self
+            .segments
+            .iter()
+            .filter_map(|s| match s.stage {
+                StageMotion::Move(k) => self.stage_moves.get(k).map(|m| (s.start_s, *m)),
+                _ => None,
+            })
+            .collect();
+        PoseTrack {
+            start: self.start_pose,
+            moves,
+        }
+    }
+    /// The job turns or lifts an axis beyond X/Y somewhere.
+    pub fn moves_extra_axes(&self) -> bool {
+        !self.start_pose.is_rest()
+            || self
+                .stage_moves
+                .iter()
+                .any(|m| m.extra.iter().any(|e| e.distance_mm != 0.0))
+    }
+
     /// Adds a stroke's points; returns its index.
     pub(crate) fn push_stroke(
         &mut self,
@@ -224,6 +272,7 @@ impl Toolpath {
             route: None,
             stretch: None,
             still_fields: self.still_fields.clone(),
+            start_pose: self.start_pose,
             points: self.points.clone(),
             arc_mm: self.arc_mm.clone(),
         };

@@ -105,6 +105,7 @@ mod tests {
             size: [100.0, 100.0],
             locked: false,
             geometries: (0..6).collect(),
+            pose: Default::default(),
         };
         let o = band_order(&geometries, &[field], 15.0, &JobCtx::default()).unwrap();
         let order: Vec<usize> = o.steps.iter().map(|s| s.geometry).collect();

@@ -28,10 +28,12 @@ pub fn compute(
     toolpath: &Toolpath,
 ) -> Metrics {
     let idle_mm = idle_mm(geometries, steps);
+    // `+ 0.0`: dots alone sum to −0.0
     let marked_mm = steps
         .iter()
         .map(|s| geometries[s.geometry].length_mm())
-        .sum();
+        .sum::<f64>()
+        + 0.0;
     let centers: Vec<Pt> = fields.iter().map(|f| f.center).collect();
     // `+ 0.0` turns the empty sum (−0.0) into 0.0
     let base_mm = centers.windows(2).map(|w| w[0].dist(w[1])).sum::<f64>() + 0.0;
@@ -229,6 +231,7 @@ mod tests {
             size: [70.0, 70.0],
             locked: false,
             geometries: vec![],
+            pose: Default::default(),
         }
     }
 

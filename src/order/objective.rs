@@ -16,7 +16,7 @@
 //! large jobs); the step-and-scan figure is then an estimate used only to rank chromosomes, and
 //! the plan's own choice between candidates is made on their lowered toolpaths.
 
-use crate::document::{pen_of, Geometry, Layer, MachineProfile, MarkTiming, ScanField, Step};
+use crate::document::{pen_of, Geometry, Layer, MachineProfile, MarkTiming, Pose, ScanField, Step};
 use crate::geom::{is_dot, Pt};
 use crate::motion::controller::LinuxcncClock;
 use crate::motion::StageDynamics;
@@ -26,7 +26,8 @@ use std::collections::HashMap;
 pub struct StepTime<'a> {
     geometries: &'a [Geometry],
     layers: &'a [Layer],
-    centre: HashMap<usize, Pt>,
+    /// Each field's centre and pose.
+    centre: HashMap<usize, (Pt, Pose)>,
     stage: StageDynamics,
     jump_speed_mm_s: f64,
     jump_delay_s: f64,
@@ -68,7 +69,7 @@ impl<'a> StepTime<'a> {
         Self {
             geometries,
             layers,
-            centre: fields.iter().map(|f| (f.id, f.center)).collect(),
+            centre: fields.iter().map(|f| (f.id, (f.center, f.pose))).collect(),
             stage: StageDynamics::of(profile),
             jump_speed_mm_s: profile.scanner.jump_speed_mm_s,
             jump_delay_s: laser.jump_delay_s,
@@ -89,13 +90,13 @@ impl<'a> StepTime<'a> {
         }
     }
 
-    /// A step's field centre and its stroke's start and end; none when the step names a field
-    /// or geometry that does not exist.
-    fn place(&self, s: &Step) -> Option<(Pt, Pt, Pt)> {
+    /// A step's field centre and pose and its stroke's start and end; none when the step names
+    /// a field or geometry that does not exist.
+    fn place(&self, s: &Step) -> Option<(Pt, Pose, Pt, Pt)> {
         let g = self.geometries.get(s.geometry)?;
-        let centre = *self.centre.get(&s.field)?;
+        let (centre, pose) = *self.centre.get(&s.field)?;
         let (start, end) = g.ends(s.choice(g));
-        Some((centre, start, end))
+        Some((centre, pose, start, end))
     }
 
     fn sum(&self, steps: &[Step]) -> f64 {
@@ -104,24 +105,25 @@ impl<'a> StepTime<'a> {
         }
         let mut t = 0.0;
         let (mut stage_at, mut scan_at) = (Pt::default(), Pt::default());
+        let mut pose_at = Pose::default();
         for (k, s) in steps.iter().enumerate() {
-            let Some((centre, start, end)) = self.place(s) else {
+            let Some((centre, pose, start, end)) = self.place(s) else {
                 return f64::INFINITY;
             };
             let offset = start.minus(centre);
             if k == 0 {
-                stage_at = centre;
-            } else if centre == stage_at {
+                (stage_at, pose_at) = (centre, pose);
+            } else if centre == stage_at && pose == pose_at {
                 t += offset.dist(scan_at) / self.jump_speed_mm_s + self.jump_delay_s;
             } else {
-                let mv = self.stage.plan_move(stage_at, centre);
+                let mv = self.stage.plan_pose_move(stage_at, &pose_at, centre, &pose);
                 let jump_s = offset.dist(scan_at) / self.jump_speed_mm_s;
                 let hidden = jump_s <= mv.move_s && jump_s + self.jump_delay_s <= mv.total_s();
                 t += mv.total_s();
                 if !hidden {
                     t += jump_s + self.jump_delay_s;
                 }
-                stage_at = centre;
+                (stage_at, pose_at) = (centre, pose);
             }
             t += self.mark_s[s.geometry];
             scan_at = end.minus(stage_at);
@@ -138,6 +140,7 @@ impl StepTime<'_> {
     fn sum_clocked(&self, steps: &[Step], clock: &LinuxcncClock) -> f64 {
         let mut t = 0.0;
         let (mut stage_at, mut scan_at) = (Pt::default(), Pt::default());
+        let mut pose_at = Pose::default();
         // the last thing done was a pause: the next pause joins its dwell
         let mut pausing = false;
         let hold = |t: &mut f64, pausing: &mut bool, d: f64| {
@@ -148,13 +151,13 @@ impl StepTime<'_> {
             }
         };
         for (k, s) in steps.iter().enumerate() {
-            let Some((centre, start, end)) = self.place(s) else {
+            let Some((centre, pose, start, end)) = self.place(s) else {
                 return f64::INFINITY;
             };
             let offset = start.minus(centre);
             if k == 0 {
-                stage_at = centre;
-            } else if centre == stage_at {
+                (stage_at, pose_at) = (centre, pose);
+            } else if centre == stage_at && pose == pose_at {
                 let j = offset.minus(scan_at);
                 let jump_s = clock.move_s([0.0, 0.0, j.x, j.y], None);
                 if jump_s > 0.0 {
@@ -163,12 +166,15 @@ impl StepTime<'_> {
                 }
                 hold(&mut t, &mut pausing, self.jump_delay_s);
             } else {
-                let mv = self.stage.plan_move(stage_at, centre);
+                let mv = self.stage.plan_pose_move(stage_at, &pose_at, centre, &pose);
                 let (d, j) = (centre.minus(stage_at), offset.minus(scan_at));
-                t += clock.move_s([d.x, d.y, j.x, j.y], None).max(mv.move_s);
+                let turn = pose_diff(&pose_at, &pose);
+                t += clock
+                    .move_axes_s([d.x, d.y, j.x, j.y], turn, None)
+                    .max(mv.move_s);
                 pausing = false;
                 hold(&mut t, &mut pausing, mv.settle_s);
-                stage_at = centre;
+                (stage_at, pose_at) = (centre, pose);
             }
             hold(&mut t, &mut pausing, self.laser.on_delay_s);
             t += self.mark_s[s.geometry];
@@ -208,10 +214,10 @@ pub fn step_job_time_lower_bound_s(
         .zip(&model.mark_s)
         .map(|(g, t)| t * f64::from(crate::document::passes_of(layers, g)))
         .sum();
-    let mut centres: Vec<Pt> = Vec::new();
+    let mut centres: Vec<(Pt, Pose)> = Vec::new();
     for f in fields.iter().filter(|f| !f.geometries.is_empty()) {
-        if !centres.contains(&f.center) {
-            centres.push(f.center);
+        if !centres.contains(&(f.center, f.pose)) {
+            centres.push((f.center, f.pose));
         }
     }
     let stage = spanning_tree_s(&centres, &model.stage);
@@ -275,8 +281,15 @@ fn box_gap_mm(a: &crate::geom::BBox, b: &crate::geom::BBox) -> f64 {
     dx.hypot(dy)
 }
 
-/// Weight of a minimum spanning tree of `points` under the stage's move time (Prim), s.
-fn spanning_tree_s(points: &[Pt], stage: &StageDynamics) -> f64 {
+/// How far each of Z, A and B turns from `from` to `to` (mm, deg).
+pub(crate) fn pose_diff(from: &Pose, to: &Pose) -> [f64; 3] {
+    let (p, q) = (from.values(), to.values());
+    [q[0] - p[0], q[1] - p[1], q[2] - p[2]]
+}
+
+/// Weight of a minimum spanning tree of `points` (placements) under the stage's move time over
+/// every axis (Prim), s.
+fn spanning_tree_s(points: &[(Pt, Pose)], stage: &StageDynamics) -> f64 {
     let n = points.len();
     if n < 2 {
         return 0.0;
@@ -292,7 +305,8 @@ fn spanning_tree_s(points: &[Pt], stage: &StageDynamics) -> f64 {
             if done[j] {
                 continue;
             }
-            best[j] = best[j].min(stage.move_time_s(points[next], points[j]));
+            let ((a, pa), (b, pb)) = (&points[next], &points[j]);
+            best[j] = best[j].min(stage.pose_move_time_s(*a, pa, *b, pb));
             if pick.is_none_or(|k| best[j] < best[k]) {
                 pick = Some(j);
             }
@@ -363,6 +377,7 @@ mod tests {
                 size: profile.field_mm,
                 geometries: vec![2 * j, 2 * j + 1],
                 locked: false,
+                pose: Default::default(),
             })
             .collect();
         let steps: Vec<Step> = (0..12)
@@ -403,6 +418,7 @@ mod tests {
                 size: profile.field_mm,
                 geometries: (0..n).collect(),
                 locked: false,
+                pose: Default::default(),
             };
             let steps: Vec<Step> = (0..n).map(|g| Step::from_choice(g, 0, &gs[g], 0)).collect();
             let inputs = PlanInputs {

@@ -9,7 +9,7 @@
 //! the distance, so the strokes are ordered on distance with free ends and no directional
 //! penalty, and the start vertices chosen exactly per field.
 
-use super::cost::TravelCost;
+use super::cost::{PoseMap, TravelCost};
 use super::hha::{field_runs, refine_field};
 use super::metrics::idle_mm;
 use super::tsp::{IlsBudget, LocalSearch, LsOptions, PathProblem, Tour};
@@ -55,7 +55,8 @@ pub fn refine_for_time(
         // a step names a field that does not exist: lowering reports it with its step
         return Ok(ordering.clone());
     };
-    let visit = path_on_stage_time(&centres, profile, seed, ctx)?;
+    let poses = PoseMap::new(fields.iter().map(|f| (f.center, f.pose)));
+    let visit = path_on_stage_time(&centres, &poses, profile, seed, ctx)?;
     let searches = searches_per_field(visit.len(), until);
     let refined: Vec<Result<Vec<Step>, Cancelled>> = visit
         .par_iter()
@@ -76,9 +77,11 @@ pub fn refine_for_time(
 }
 
 /// The order (indices into `centres`, the stage positions in their current order) that the
-/// stage visits them in, re-optimised on stage time with both ends free.
+/// stage visits them in, re-optimised on stage time (over every axis the placements' `poses`
+/// move) with both ends free.
 fn path_on_stage_time(
     centres: &[Pt],
+    poses: &PoseMap,
     profile: &MachineProfile,
     seed: u64,
     ctx: &JobCtx,
@@ -92,7 +95,7 @@ fn path_on_stage_time(
         return Ok(tour.order);
     }
     let mut prob = PathProblem::points(centres, &vec![0.0; n], 0.0);
-    prob.metric = TravelCost::StageTime(StageDynamics::of(profile));
+    prob.metric = TravelCost::stage_time(StageDynamics::of(profile), poses.clone());
     let kicks = (2 * n).clamp(STAGE_KICKS_MIN, STAGE_KICKS_MAX);
     LocalSearch::new(&prob, LsOptions::default(), ctx)?.iterated(&mut tour, kicks, seed, ctx)?;
     Ok(tour.order)

@@ -9,6 +9,7 @@ fn field(id: usize, x: f64, y: f64, geometries: Vec<usize>) -> ScanField {
         size: [70.0, 70.0],
         locked: false,
         geometries,
+        pose: Default::default(),
     }
 }
 
