@@ -1018,9 +1018,14 @@ pub fn order_document_lowered(
     doc: &Document,
     ctx: &JobCtx,
 ) -> Result<(Plan, Toolpath), PipelineError> {
+    check_poses(doc)?;
     let file = doc.source.clone().unwrap_or_else(|| "document".into());
     log_inputs(doc, ctx);
-    let inputs = PlanInputs::of(doc);
+    let mut inputs = PlanInputs::of(doc);
+    if doc.fields.iter().any(|f| !f.pose.is_rest()) {
+        // a job whose fields turn Z, A or B has one motion: auto plans it step-and-scan
+        inputs.settings.motion = MotionMode::Step;
+    }
     let (plan, toolpath) = order_plan(&doc.geometries, &doc.fields, &inputs, ctx)
         .map_err(|source| PipelineError::Order { file, source })?;
     complete_plan(doc, plan, toolpath, ctx)

@@ -2445,3 +2445,48 @@ fn a_streamed_plan_says_why_its_job_time_is_what_it_is() {
     solve(&mut h, "Run HHA");
     h.get_by_label_contains("Streamed to LinuxCNC's joints every 0.1 ms");
 }
+
+/// `tests/data/projects/cap-stand-in.galvoplan`: 40 of texture-3043's placements laid on a
+/// spherical cap (`galvoplan cap-bench`), a spot each, on the five-axis machine.
+fn cap_stand_in() -> PathBuf {
+    common::root().join("tests/data/projects/cap-stand-in.galvoplan")
+}
+
+#[test]
+fn a_five_axis_job_shows_its_axes_in_their_units_and_compares_time_with_distance() {
+    let mut h = opened(&cap_stand_in());
+    assert!(h.state().session.doc().fields.iter().all(|f| !f.pose.is_rest()));
+    section(&mut h, "Machine profile");
+    for row in [
+        "Base X max velocity (mm/s)",
+        "Axis Z max velocity (mm/s)",
+        "Axis A max velocity (deg/s)",
+        "Axis B max accel (deg/s²)",
+        "Axis B travel from (deg)",
+    ] {
+        h.get_by_label(row);
+    }
+    // time against distance, side by side
+    let by_time = solve(&mut h, "Run HHA");
+    section(&mut h, "Solver settings");
+    h.get_by_label("Cost model").click();
+    settle(&mut h);
+    h.get_by_label("Idle travel distance").click();
+    settle(&mut h);
+    let by_distance = solve(&mut h, "Run HHA");
+    let (t, d) = (
+        by_time.metrics.job_time_s.unwrap(),
+        by_distance.metrics.job_time_s.unwrap(),
+    );
+    assert!(t <= d, "{t} s !<= {d} s");
+    // the plan shown turns Z, A and B: its plots are the axes' speeds
+    if h.query_by_label("Motion plots (axis speeds): show").is_some() {
+        h.get_by_label("Motion plots (axis speeds): show").click();
+        settle(&mut h);
+    }
+    h.get_by_label("Motion plots (axis speeds): hide");
+    h.get_by_label_contains("Axis speeds, % of each axis's limit (dashed 100 %): peak X");
+    h.get_by_label("Compare").click();
+    settle(&mut h);
+    h.get_by_label("B vs A");
+}

@@ -124,7 +124,8 @@ pub fn distance_3d_mm(fields: &[ScanField], order: &[usize]) -> f64 {
         .sum()
 }
 
-/// Iterated-local-search kicks per placement for each searched order.
+/// Iterated-local-search kicks per placement for each searched order: on texture-3043 on the cap
+/// (R 200 mm) 16 kicks per placement give the same 5-axis time to 0.1 s (420.6 s) in 4× the time.
 const KICKS_PER_PLACEMENT: usize = 4;
 
 /// The three orders of seed 002's experiment on placements `fields` (with their poses) for

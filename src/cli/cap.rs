@@ -141,8 +141,14 @@ fn stand_in(placements: &[ScanField], layout: &Document, profile: MachineProfile
         .collect();
     let mut layers = Vec::new();
     sync_layers(&mut layers, &geometries, &layout.settings.default_pen());
+    // the artwork's name, not its path on this machine
+    let source = layout.source.as_deref().map(|s| {
+        std::path::Path::new(s)
+            .file_name()
+            .map_or(s.to_string(), |n| n.to_string_lossy().into_owned())
+    });
     Document {
-        source: layout.source.clone(),
+        source,
         page_mm: layout.page_mm,
         artwork: geometries.clone(),
         geometries,
