@@ -30,6 +30,11 @@ impl Pose {
     pub fn is_rest(&self) -> bool {
         *self == Pose::default()
     }
+    /// How far each of Z, A and B moves from this pose to `to` (mm, deg, deg).
+    pub fn turn_to(&self, to: &Pose) -> [f64; 3] {
+        let (p, q) = (self.values(), to.values());
+        [q[0] - p[0], q[1] - p[1], q[2] - p[2]]
+    }
     /// The values by axis, in [`ExtraAxisId::ALL`]'s order.
     pub fn values(&self) -> [f64; 3] {
         [self.z_mm, self.a_deg, self.b_deg]

@@ -248,7 +248,7 @@ impl<'a> Builder<'a> {
         let move_s = match &self.clock {
             Some(c) => {
                 let (d, j) = (center.minus(self.stage_at), offset.minus(self.scan_at));
-                let turn = crate::order::objective::pose_diff(&self.pose_at, pose);
+                let turn = self.pose_at.turn_to(pose);
                 // never shorter than the axes' own trapezoids (the stage's position is timed by them)
                 c.move_axes_s([d.x, d.y, j.x, j.y], turn, None)
                     .max(mv.move_s)

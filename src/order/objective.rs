@@ -168,7 +168,7 @@ impl StepTime<'_> {
             } else {
                 let mv = self.stage.plan_pose_move(stage_at, &pose_at, centre, &pose);
                 let (d, j) = (centre.minus(stage_at), offset.minus(scan_at));
-                let turn = pose_diff(&pose_at, &pose);
+                let turn = pose_at.turn_to(&pose);
                 t += clock
                     .move_axes_s([d.x, d.y, j.x, j.y], turn, None)
                     .max(mv.move_s);
@@ -279,12 +279,6 @@ fn box_gap_mm(a: &crate::geom::BBox, b: &crate::geom::BBox) -> f64 {
     let dx = (b.min_x - a.max_x).max(a.min_x - b.max_x).max(0.0);
     let dy = (b.min_y - a.max_y).max(a.min_y - b.max_y).max(0.0);
     dx.hypot(dy)
-}
-
-/// How far each of Z, A and B turns from `from` to `to` (mm, deg).
-pub(crate) fn pose_diff(from: &Pose, to: &Pose) -> [f64; 3] {
-    let (p, q) = (from.values(), to.values());
-    [q[0] - p[0], q[1] - p[1], q[2] - p[2]]
 }
 
 /// Weight of a minimum spanning tree of `points` (placements) under the stage's move time over
