@@ -62,14 +62,14 @@ pub enum PipelineError {
     },
     /// A project could not be read.
     #[error(transparent)]
-    Project(#[from] crate::document::ProjectError),
+    Project(Box<crate::document::ProjectError>),
     /// A field's pose the machine cannot take.
     #[error("{file}: {source}")]
     Pose {
         /// The document's source file.
         file: String,
         /// The cause.
-        source: crate::document::PoseError,
+        source: Box<crate::document::PoseError>,
     },
     /// Placements that turn or lift axes beyond X/Y, planned on the fly.
     #[error("{file}: the fields turn or lift axes beyond X/Y ({axes}), which only step-and-scan moves between fields; plan with step-and-scan")]
@@ -243,7 +243,8 @@ fn load_project_job(
     settings: SolverSettings,
     t0: Instant,
 ) -> Result<Loaded, PipelineError> {
-    let mut doc = crate::document::load_project(path)?;
+    let mut doc =
+        crate::document::load_project(path).map_err(|e| PipelineError::Project(Box::new(e)))?;
     doc.profile = profile;
     doc.settings = settings;
     doc.plans.clear();
@@ -354,7 +355,7 @@ fn check_poses(doc: &Document) -> Result<(), PipelineError> {
             .check_pose(f.id, &f.pose)
             .map_err(|source| PipelineError::Pose {
                 file: file(),
-                source,
+                source: Box::new(source),
             })?;
     }
     if doc.settings.motion == MotionMode::OnTheFly && doc.fields.iter().any(|f| !f.pose.is_rest()) {

@@ -2455,7 +2455,13 @@ fn cap_stand_in() -> PathBuf {
 #[test]
 fn a_five_axis_job_shows_its_axes_in_their_units_and_compares_time_with_distance() {
     let mut h = opened(&cap_stand_in());
-    assert!(h.state().session.doc().fields.iter().all(|f| !f.pose.is_rest()));
+    assert!(h
+        .state()
+        .session
+        .doc()
+        .fields
+        .iter()
+        .all(|f| !f.pose.is_rest()));
     section(&mut h, "Machine profile");
     for row in [
         "Base X max velocity (mm/s)",
@@ -2480,7 +2486,9 @@ fn a_five_axis_job_shows_its_axes_in_their_units_and_compares_time_with_distance
     );
     assert!(t <= d, "{t} s !<= {d} s");
     // the plan shown turns Z, A and B: its plots are the axes' speeds
-    if h.query_by_label("Motion plots (axis speeds): show").is_some() {
+    if h.query_by_label("Motion plots (axis speeds): show")
+        .is_some()
+    {
         h.get_by_label("Motion plots (axis speeds): show").click();
         settle(&mut h);
     }

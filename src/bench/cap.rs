@@ -55,7 +55,7 @@ impl Cap {
         let (dx, dy) = (p.x - self.centre.x, p.y - self.centre.y);
         let r = dx.hypot(dy);
         let radius = self.radius_mm;
-        if !(r < radius) {
+        if r.is_nan() || r >= radius {
             return Err(OffCap {
                 field,
                 x: p.x,

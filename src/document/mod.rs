@@ -20,6 +20,7 @@ pub mod validate;
 mod warning;
 
 pub use artwork_import::{ArtworkImport, LayerHidden, Place, PlaceError, SkippedLayer};
+pub use axes::{AxisFileError, ExtraAxis, ExtraAxisId, LinearAxis, Pose, PoseError, RotaryAxis};
 pub use code::{CodeKind, CodeOptions, CodeSpec, Ecc, CODE_LAYER};
 pub use geometry::{is_hatch_output, Geometry, Run, RunOrder, Source, HATCH_LAYER_PREFIX};
 pub use hatch::{
@@ -29,9 +30,6 @@ pub use inputs::{staleness, GeometryRevision, PlanInputs};
 pub use pens::{
     colour_word, layer_label, parse_colour, passes_of, pen_of, sync_layers, validate_layers, Layer,
     MarkTiming, Pen, PenLibrary, PensError, DEFAULT_LAYER, MAX_PASSES, PENS_VERSION,
-};
-pub use axes::{
-    AxisFileError, ExtraAxis, ExtraAxisId, LinearAxis, Pose, PoseError, RotaryAxis,
 };
 pub use plan::{
     GenerationRecord, Metrics, MotionFigures, MotionRegion, ObjectiveKind, Plan, ScanField,

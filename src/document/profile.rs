@@ -421,10 +421,7 @@ pub const BUILTIN: &[(&str, &str)] = &[
         "five-axis",
         include_str!("../../assets/profiles/five-axis.toml"),
     ),
-    (
-        "rotary",
-        include_str!("../../assets/profiles/rotary.toml"),
-    ),
+    ("rotary", include_str!("../../assets/profiles/rotary.toml")),
 ];
 
 /// Brings a profile table of an earlier format version to [`PROFILE_VERSION`], one step per

@@ -50,7 +50,7 @@ pub enum LowerError {
     },
     /// A field's pose the machine cannot take.
     #[error(transparent)]
-    Pose(#[from] PoseError),
+    Pose(Box<PoseError>),
 }
 
 /// Lowers a step-and-scan plan to the machine's motion.
@@ -98,7 +98,9 @@ pub fn lower(
                 })?,
         };
         if field_at.is_none_or(|f| f.id != field.id) {
-            profile.check_pose(field.id, &field.pose)?;
+            profile
+                .check_pose(field.id, &field.pose)
+                .map_err(|e| LowerError::Pose(Box::new(e)))?;
         }
         field_at = Some(field);
         let path = g.marking_path(step.start_vertex, step.reversed);
