@@ -24,6 +24,15 @@
 # slowly) stops with the laser off in the period it runs dry and says so; a stream with a
 # sample beyond the INI's limits is refused before it runs; `--motion auto` picks streamed on
 # the fly for oversize.svg at no more than half the step-and-scan job time.
+#
+# Seed 002's 5-axis machine (mode "step-five-axis"): a LinuxCNC copy of the built-in five-axis
+# profile and its XYZABUV machine (`linuxcnc-config`: trivkins, seven joints, A and B angular),
+# running the 5-axis stand-in (tests/data/linuxcnc/five-axis-stand-in.galvoplan: `galvoplan
+# cap-bench` with texture-3043's fields on a spherical cap, 300 placements of one spot each)
+# planned --cost time step-and-scan: stage moves of X, Y, Z, A and B between dots. The
+# interpreter check compares Z, A and B too; ok when it and the run are clean, the ratio lies
+# within 0.95-1.05, and the laser is never on while the machine moves (dots: M64, G4, M65 at
+# rest). About 50 s.
 # Installs linuxcnc-uspace (without recommends) when it is missing.
 set -uo pipefail
 cd "$(dirname "$0")/.."
@@ -53,11 +62,13 @@ fi
 export RUNTESTS=1
 
 sim() { # program result -> runs it; one retry when LinuxCNC did not come up
-  # (a streamed job: GALVOPLAN_STREAM and GALVOPLAN_TRACE in the environment)
+  # (a streamed job: GALVOPLAN_STREAM and GALVOPLAN_TRACE in the environment; another machine
+  # than $CFG: MACHINE)
   local try
   for try in 1 2; do
     rm -f "$2"
-    GALVOPLAN_PROGRAM="$1" GALVOPLAN_RESULT="$2" timeout 900 linuxcnc "$CFG/galvoplan.ini" >"$2.log" 2>&1
+    GALVOPLAN_PROGRAM="$1" GALVOPLAN_RESULT="$2" timeout 900 linuxcnc "${MACHINE:-$CFG}/galvoplan.ini" \
+      >"$2.log" 2>&1
     [ -s "$2" ] && return 0
     sleep 2
   done
@@ -186,6 +197,62 @@ sys.exit(0 if ok else 1)
 PY
 }
 
+five_axis_job() { # the 5-axis stand-in on seed 002's machine (see the top of this file)
+  local name=five-axis-stand-in o="$OUT/five-axis-stand-in" p="$OUT/five-axis-linuxcnc.toml"
+  local machine="$OUT/machine-five-axis"
+  # the built-in profile in the LinuxCNC dialect: its laser words and feed are the other
+  # dialect's; the laser on digital output 0, LinuxCNC's clock with a 1 ms servo period
+  sed -e '/^laser_on = /d' -e '/^laser_off = /d' -e '/^feed_mm_min = /d' \
+    -e 's/^mode = .*/mode = "linuxcnc"\nlaser_output = 0/' assets/profiles/five-axis.toml >"$p"
+  if grep -q '^\[controller\]' "$p"; then
+    sed -i 's/^\[controller\]/[controller]\nkind = "linuxcnc"\nservo_period_s = 0.001/' "$p"
+  else
+    printf '\n[controller]\nkind = "linuxcnc"\nservo_period_s = 0.001\n' >>"$p"
+  fi
+  if ! { "$B" linuxcnc-config --profile "$p" --out "$machine" >"$o.config.log" 2>&1 &&
+      "$B" plan tests/data/linuxcnc/five-axis-stand-in.galvoplan --profile "$p" --cost time \
+        --motion step -o "$o.ngc" --report "$o.json" --waypoints "$o.waypoints.csv" \
+        2>"$o.plan.log"; }; then
+    echo "{\"job\": \"$name\", \"mode\": \"step-five-axis\", \"ok\": false, \"error\": \"config or plan failed: $(cat "$o.config.log" "$o.plan.log" | tail -1 | tr -d '"')\"}"
+    status=1; return
+  fi
+  # the waypoints' z_mm, a_deg, b_deg columns: the check compares Z, A and B too
+  (cd "$OUT" && /usr/bin/python3 "$ROOT/scripts/linuxcnc_check.py" "$o.ngc" "$o.waypoints.csv" \
+    --tol-mm 0.005 >"$o.interp.json" 2>"$o.interp.log")
+  MACHINE="$machine" sim "$(realpath "$o.ngc")" "$o.sim.json"
+  python3 - "$name" "$o" "$machine/galvoplan.ini" <<'PY' || status=1
+import json, re, sys
+name, o, ini = sys.argv[1:]
+rep = json.load(open(o + ".json"))["metrics"]
+def load(path, what):
+    try:
+        return json.load(open(path))
+    except (OSError, ValueError):
+        return {"ok": False, "errors": [what]}
+interp = load(o + ".interp.json", "the interpreter check did not run (see %s.interp.log)" % o)
+sim = load(o + ".sim.json", "LinuxCNC did not run (see %s.sim.json.log)" % o)
+coords = re.search(r"^COORDINATES = (\S+)", open(ini).read(), re.M)
+g = rep.get("job_time_s") or 0.0
+lc = sim.get("job_s")
+ratio = lc / g if lc and g else None
+moving_lit = sim.get("laser_on_moving_s")
+errors = interp.get("errors", []) + sim.get("errors", [])
+if moving_lit is None or moving_lit > 0.01:
+    errors.append("the laser is on while the machine moves (%s s): dots are fired at rest"
+                  % moving_lit)
+ok = bool(interp.get("ok") and sim.get("ok") and ratio is not None and 0.95 <= ratio <= 1.05
+          and moving_lit is not None and moving_lit <= 0.01)
+row = {"job": name, "mode": "step-five-axis", "axes": coords.group(1) if coords else None,
+       "linuxcnc_s": lc, "galvoplan_s": round(g, 4),
+       "ratio": round(ratio, 4) if ratio else None, "laser_on_moving_s": moving_lit,
+       "laser_s": sim.get("laser_s"), "fields": rep.get("fields"), "ok": ok,
+       "canonical_moves": interp.get("canonical_moves"),
+       "max_move_error_um": interp.get("max_move_error_um"), "errors": errors}
+print(json.dumps(row))
+sys.exit(0 if ok else 1)
+PY
+}
+
 auto_job() { # --motion auto picks the stream for oversize.svg, at most half step-and-scan's time
   local o="$OUT/auto"
   "$B" plan assets/examples/oversize.svg --profile linuxcnc --motion auto -o "$o.ngc" \
@@ -217,6 +284,7 @@ job lissajous tests/data/linuxcnc/lissajous.svg on-the-fly
 job tray-2x2 assets/examples/part.svg step --array 2x2@40,32 --serial 1001 --date 2026-12-07
 # a dotted DataMatrix on each part (one spot per module, fired for the dwell) on the fly
 job tray-dots assets/examples/part.svg on-the-fly --array 2x2@40,32 --serial 1001 --code "datamatrix:GP{serial:05}@3,3:6:dots"
+five_axis_job
 for n in oversize lissajous spiral tree; do
   f=tests/data/linuxcnc/$n.svg; [ "$n" = oversize ] && f=assets/examples/oversize.svg
   stream_job "$n" "$f"

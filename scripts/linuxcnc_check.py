@@ -3,6 +3,10 @@
 compares its canonical moves with the toolpath's exact states (`galvoplan plan --waypoints`).
 
 usage: linuxcnc_check.py PROGRAM.ngc WAYPOINTS.csv --tol-mm T [--axes XYUV]
+--axes: the machine's axis words, the scanner's two last (default: XY, then Z, A, B for the
+waypoints' z_mm, a_deg, b_deg columns, a machine with axes beyond X/Y, then UV). Z, A and B are
+compared too: a move ends on its toolpath state when the stage, the scanner (mm) and each of Z
+(mm), A and B (degrees) are within 1 um (1 mdeg) of it.
 Prints one JSON object: parse result and errors, canonical moves, the largest distance of a
 move's end from its toolpath state (um), and for on-the-fly programs the largest distance of a
 skipped toolpath sample from the line that replaced it (mm).
@@ -22,15 +26,20 @@ import gcode
 
 MM_PER_INCH = 25.4
 MASK = {"X": 1, "Y": 2, "Z": 4, "A": 8, "B": 16, "C": 32, "U": 64, "V": 128, "W": 256}
-MATCH_MM = 1e-3  # 1 um
+MATCH_MM = 1e-3  # 1 um (and 1 mdeg for a rotary)
+EXTRA = (("Z", "z_mm"), ("A", "a_deg"), ("B", "b_deg"))
+ANGULAR = "ABC"
 
 
 class Canon:
-    """The interpreter's canonical machine: records straight moves (mm), ignores the rest."""
+    """The interpreter's canonical machine: records straight moves (mm, rotaries in degrees),
+    ignores the rest. A move's position: X, Y, the scanner's two axes (the last two of `axes`),
+    then Z, A, B where the machine has them."""
 
     def __init__(self, axes):
         self.mask = sum(MASK[a] for a in axes)
-        self.axes = axes
+        extra = [a for a, _ in EXTRA if a in axes]
+        self.axes = ["X", "Y", axes[-2], axes[-1]] + extra
         self.moves = []
         self.g93 = False
         self.parameter_file = ""
@@ -59,7 +68,7 @@ class Canon:
 
     def _pos(self, x, y, z, a, b, c, u, v, w):
         named = dict(zip("XYZABCUVW", (x, y, z, a, b, c, u, v, w)))
-        return tuple(named[k] * MM_PER_INCH for k in self.axes)
+        return tuple(named[k] * (1.0 if k in ANGULAR else MM_PER_INCH) for k in self.axes)
 
     def straight_traverse(self, *args):
         self.moves.append(("G0", self.lineno) + self._pos(*args))
@@ -71,18 +80,32 @@ class Canon:
         return lambda *a, **k: None
 
 
+def waypoint_axes(path):
+    """The axes beyond X/Y the waypoints have columns for (Z, A, B: z_mm, a_deg, b_deg)."""
+    with open(path) as f:
+        header = next(csv.reader(f), [])
+    return [a for a, col in EXTRA if col in header]
+
+
 def read_waypoints(path):
+    """(t, x, y, u, v, then Z, A, B where the file has them) per row."""
+    extra = [col for _, col in EXTRA]
     out = []
     with open(path) as f:
         for row in csv.DictReader(f):
             out.append((float(row["t_s"]), float(row["stage_x_mm"]), float(row["stage_y_mm"]),
-                        float(row["scan_x_mm"]), float(row["scan_y_mm"])))
+                        float(row["scan_x_mm"]), float(row["scan_y_mm"]))
+                       + tuple(float(row[c]) for c in extra if c in row))
     return out
 
 
 def dist(p, q):
-    """Largest of the stage and scanner distances, mm (p, q = x, y, u, v)."""
-    return max(math.hypot(p[0] - q[0], p[1] - q[1]), math.hypot(p[2] - q[2], p[3] - q[3]))
+    """Largest of the stage and scanner distances, mm (p, q = x, y, u, v), and of the
+    differences of Z, A and B (mm, degrees) after them."""
+    d = max(math.hypot(p[0] - q[0], p[1] - q[1]), math.hypot(p[2] - q[2], p[3] - q[3]))
+    for k in range(4, min(len(p), len(q))):
+        d = max(d, abs(p[k] - q[k]))
+    return d
 
 
 def off_line(a, b, s, ta, tb, ts):
@@ -100,9 +123,14 @@ def main():
     ap.add_argument("program")
     ap.add_argument("waypoints")
     ap.add_argument("--tol-mm", type=float, required=True)
-    ap.add_argument("--axes", default="XYUV")
+    ap.add_argument("--axes", default=None)
     a = ap.parse_args()
-    canon = Canon(a.axes)
+    extra = waypoint_axes(a.waypoints)
+    axes = a.axes or "XY" + "".join(extra) + "UV"
+    missing = [x for x in extra if x not in axes]
+    if missing:
+        sys.exit("linuxcnc_check: --axes %s lacks the waypoints' %s" % (axes, ", ".join(missing)))
+    canon = Canon(axes)
     result, seq = gcode.parse(a.program, canon, "G21", "")
     errors = []
     if result > gcode.MIN_ERROR:
@@ -127,8 +155,8 @@ def main():
             d = dist(m, p)
             worst_um = max(worst_um, d * 1e3)
             if d > MATCH_MM and len(errors) < 5:
-                errors.append("move %d (line %d) ends %.4f mm from the toolpath"
-                              % (k + 1, canon.moves[k][1], d))
+                errors.append("move %d (line %d) ends %.4f %s from the toolpath"
+                              % (k + 1, canon.moves[k][1], d, "mm (or deg)" if extra else "mm"))
     else:
         j = 0  # the last matched sample
         if dist(moves[0], pts[0]) > MATCH_MM:

@@ -399,3 +399,66 @@ fn the_workbench_exports_a_streamed_plans_stream_beside_its_program() {
         .unwrap()
         .contains("M64 P1"));
 }
+
+/// The 5-axis stand-in that scripts/check-linuxcnc.sh runs on LinuxCNC (seed 002's machine,
+/// XYZABUV): it plans on a LinuxCNC copy of the five-axis profile, every stage move carries Z,
+/// A and B, the waypoints have their columns, and `linuxcnc-config` makes the 7-joint machine.
+#[test]
+fn the_five_axis_stand_in_plans_for_an_xyzabuv_machine() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut profile = MachineProfile::builtin("five-axis").unwrap();
+    profile.gcode.mode = galvoplan::document::GcodeMode::Linuxcnc;
+    profile.controller.kind = galvoplan::document::ControllerKind::Linuxcnc;
+    profile.controller.servo_period_s = 1e-3;
+    let p = dir.path().join("five-axis-linuxcnc.toml");
+    std::fs::write(&p, profile.to_toml().unwrap()).unwrap();
+    let (ngc, csv, cfg) = (
+        dir.path().join("s.ngc"),
+        dir.path().join("s.csv"),
+        dir.path().join("machine"),
+    );
+    let project = common::root().join("tests/data/linuxcnc/five-axis-stand-in.galvoplan");
+    let run = |args: &[&std::ffi::OsStr]| {
+        let r = std::process::Command::new(env!("CARGO_BIN_EXE_galvoplan"))
+            .args(args)
+            .output()
+            .unwrap();
+        assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    };
+    run(&[
+        "plan".as_ref(),
+        project.as_os_str(),
+        "--profile".as_ref(),
+        p.as_os_str(),
+        "--cost".as_ref(),
+        "time".as_ref(),
+        "--motion".as_ref(),
+        "step".as_ref(),
+        "-o".as_ref(),
+        ngc.as_os_str(),
+        "--waypoints".as_ref(),
+        csv.as_os_str(),
+    ]);
+    let g = std::fs::read_to_string(&ngc).unwrap();
+    let moves: Vec<&str> = g.lines().filter(|l| l.starts_with("G0 ")).collect();
+    assert_eq!(moves.len(), 300, "one stage move per placement");
+    for m in &moves {
+        let w = words(m, &['X', 'Y', 'Z', 'A', 'B', 'U', 'V']);
+        assert!(w.iter().all(Option::is_some), "{m}");
+    }
+    // dots at rest: on, dwell, off, never a lit move
+    assert_eq!(g.matches("M64 P0\nG4 P").count(), 300);
+    assert!(!g.contains("M62") && !g.contains("G1 "));
+    let waypoints = std::fs::read_to_string(&csv).unwrap();
+    assert!(waypoints
+        .starts_with("t_s,stage_x_mm,stage_y_mm,scan_x_mm,scan_y_mm,laser,z_mm,a_deg,b_deg\n"));
+    run(&[
+        "linuxcnc-config".as_ref(),
+        "--profile".as_ref(),
+        p.as_os_str(),
+        "--out".as_ref(),
+        cfg.as_os_str(),
+    ]);
+    let ini = std::fs::read_to_string(cfg.join("galvoplan.ini")).unwrap();
+    assert!(ini.contains("coordinates=XYZABUV\nJOINTS = 7\n"), "{ini}");
+}

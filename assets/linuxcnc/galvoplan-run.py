@@ -40,7 +40,10 @@ def check_stream(path, errors):
     """The stream's samples against the INI's axis limits; returns its line count (None when
     a sample is beyond them or a line is malformed: the errors say which)."""
     ini = linuxcnc.ini(ini_path())
-    letters = (ini.find("TRAJ", "COORDINATES") or "XYUV").replace(" ", "")[:4]
+    coords = (ini.find("TRAJ", "COORDINATES") or "XYUV").replace(" ", "")
+    # the stream's X Y U V: the stage's X and Y, the scanner's two (the last coordinates; a
+    # machine's Z, A and B between them stay with motion)
+    letters = "XY" + coords[-2:]
     limits = []
     for letter in letters:
         lo = float(ini.find("AXIS_" + letter, "MIN_LIMIT") or "-1e9")

@@ -1,9 +1,11 @@
 //! A LinuxCNC machine configuration from a machine profile (docs/GCODE.md, *LinuxCNC*):
 //! `galvoplan linuxcnc-config --profile P.toml --out DIR`.
 //!
-//! One trivkins machine with four joints, X and Y for the stage and the profile's two scanner
-//! axis words (default U, V) for the scanner, with the profile's stroke, field, speeds and
-//! accelerations as limits, and a digital output for the laser. The files:
+//! One trivkins machine with a joint per axis: X and Y for the stage, the profile's axes beyond
+//! X/Y (Z in mm, rotaries A and B in degrees, `TYPE = ANGULAR`), and the profile's two scanner
+//! axis words (default U, V) for the scanner, with the profile's stroke, travels, field, speeds
+//! and accelerations as limits, and a digital output for the laser. A flat profile's machine is
+//! XYUV with four joints; seed 002's 5-axis machine is XYZABUV with seven. The files:
 //!
 //! * `galvoplan.ini`: the machine, with `[EMCMOT] SERVO_PERIOD` from the profile's controller;
 //! * `galvoplan.hal`: motion, and the simulated machine (each joint's command looped back as its
@@ -15,7 +17,7 @@
 //! * `README.txt`: how to run it, and which pins a real machine's Mesa card takes instead of the
 //!   loopbacks.
 
-use crate::document::{GcodeMode, MachineProfile};
+use crate::document::{ExtraAxisId, GcodeMode, MachineProfile};
 use std::fmt::Write;
 
 /// Headroom added to every axis limit, mm: positions written with the dialect's decimals may
@@ -46,13 +48,49 @@ pub struct ConfigFile {
 /// The runner LinuxCNC starts as its display (`[DISPLAY] DISPLAY`).
 const RUNNER: &str = include_str!("../../assets/linuxcnc/galvoplan-run.py");
 
-/// One axis of the configuration.
+/// The limits of an axis without a travel (an endless rotary, a Z without `travel_mm`), mm or
+/// deg: far beyond any position a program reaches, well within LinuxCNC's own default (±1e99).
+pub const ENDLESS_LIMIT: f64 = 1e9;
+
+/// What an axis of the configuration moves.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Role {
+    /// The X/Y stage.
+    Stage,
+    /// Z, A or B.
+    Extra(ExtraAxisId),
+    /// The scanner.
+    Scanner,
+}
+
+/// One axis of the configuration (and its joint, the same index). Units are mm, or degrees for
+/// a rotary (the `_mm` fields then hold degrees).
 struct Axis {
     letter: String,
+    role: Role,
     min_mm: f64,
     max_mm: f64,
     velocity_mm_s: f64,
     accel_mm_s2: f64,
+    /// Where homing in place puts it: 0, or the travel's nearer end when 0 is outside it.
+    home: f64,
+}
+
+impl Axis {
+    fn angular(&self) -> bool {
+        matches!(self.role, Role::Extra(ExtraAxisId::A | ExtraAxisId::B))
+    }
+}
+
+/// The joint of the axis named `letter`, if the machine has it.
+fn joint_of(axes: &[Axis], letter: &str) -> Option<usize> {
+    axes.iter().position(|a| a.letter == letter)
+}
+
+/// The joints of the scanner's two axes.
+fn scanner_joints(axes: &[Axis]) -> [usize; 2] {
+    let n = axes.len();
+    [n - 2, n - 1]
 }
 
 /// The configuration files for `profile` (see the module documentation).
@@ -60,7 +98,7 @@ pub fn linuxcnc_config(profile: &MachineProfile) -> Vec<ConfigFile> {
     let axes = axes(profile);
     let stream = profile.controller.stream_period_s.map(|_| ConfigFile {
         name: "galvoplan-stream.hal",
-        text: stream_hal(profile),
+        text: stream_hal(profile, &axes),
         executable: false,
     });
     let mut files = vec![
@@ -71,7 +109,7 @@ pub fn linuxcnc_config(profile: &MachineProfile) -> Vec<ConfigFile> {
         },
         ConfigFile {
             name: "galvoplan.hal",
-            text: hal(profile),
+            text: hal(profile, &axes),
             executable: false,
         },
         ConfigFile {
@@ -108,24 +146,46 @@ fn axes(profile: &MachineProfile) -> Vec<Axis> {
     let words = &profile.gcode.scanner_axes;
     let stage = |letter: &str, k: usize, limits: &crate::document::AxisLimits| Axis {
         letter: letter.into(),
+        role: Role::Stage,
         min_mm: -LIMIT_MARGIN_MM,
         max_mm: profile.stroke_mm[k] + LIMIT_MARGIN_MM,
         velocity_mm_s: limits.max_velocity_mm_s,
         accel_mm_s2: limits.max_accel_mm_s2,
+        home: 0.0,
     };
     let scanner = |k: usize| Axis {
         letter: words[k].trim().to_uppercase(),
+        role: Role::Scanner,
         min_mm: -half(k),
         max_mm: half(k),
         velocity_mm_s: scanner_velocity,
         accel_mm_s2: profile.controller.scanner_accel_mm_s2,
+        home: 0.0,
     };
-    vec![
-        stage("X", 0, &profile.axis_x),
-        stage("Y", 1, &profile.axis_y),
-        scanner(0),
-        scanner(1),
-    ]
+    let extra = |id: ExtraAxisId| {
+        let a = profile.extra_axis(id)?;
+        let ([min, max], margin) = match a.travel {
+            Some(t) => (t, LIMIT_MARGIN_MM),
+            None => ([-ENDLESS_LIMIT, ENDLESS_LIMIT], 0.0),
+        };
+        Some(Axis {
+            letter: id.word().into(),
+            role: Role::Extra(id),
+            min_mm: min - margin,
+            max_mm: max + margin,
+            velocity_mm_s: a.max_velocity,
+            accel_mm_s2: a.max_accel,
+            home: 0.0_f64.clamp(min, max),
+        })
+    };
+    let mut axes = vec![stage("X", 0, &profile.axis_x)];
+    if profile.has_y() {
+        axes.push(stage("Y", 1, &profile.axis_y));
+    }
+    axes.extend(ExtraAxisId::ALL.into_iter().filter_map(extra));
+    axes.push(scanner(0));
+    axes.push(scanner(1));
+    axes
 }
 
 fn num(v: f64) -> String {
@@ -135,12 +195,37 @@ fn num(v: f64) -> String {
 fn ini(profile: &MachineProfile, axes: &[Axis]) -> String {
     let coords: String = axes.iter().map(|a| a.letter.as_str()).collect();
     let servo_ns = (profile.controller.servo_period_s * 1e9).round() as u64;
-    let fastest = axes.iter().map(|a| a.velocity_mm_s).fold(0.0, f64::max);
+    let fastest = axes
+        .iter()
+        .filter(|a| !a.angular())
+        .map(|a| a.velocity_mm_s)
+        .fold(0.0, f64::max);
+    // rotaries: the fastest's speed, so that neither limit clips a move the axes allow
+    let fastest_deg = axes
+        .iter()
+        .filter(|a| a.angular())
+        .map(|a| a.velocity_mm_s)
+        .fold(0.0, f64::max);
+    let angular = if fastest_deg > 0.0 {
+        format!(
+            "DEFAULT_ANGULAR_VELOCITY = {v}\nMAX_ANGULAR_VELOCITY = {v}\n",
+            v = num(fastest_deg)
+        )
+    } else {
+        String::new()
+    };
+    let [su, sv] = scanner_joints(axes);
+    // the stage's words: X/Y, and the axes beyond them
+    let mut stage = String::from(if profile.has_y() { "X/Y" } else { "X" });
+    for a in axes.iter().filter(|a| matches!(a.role, Role::Extra(_))) {
+        stage.push_str(", ");
+        stage.push_str(&a.letter);
+    }
     let mut s = String::new();
     let _ = write!(
         s,
         "# LinuxCNC machine for galvoplan profile: {name}
-# Written by galvoplan {version} (galvoplan linuxcnc-config). Stage X/Y, scanner {u}/{v}.
+# Written by galvoplan {version} (galvoplan linuxcnc-config). Stage {stage}, scanner {u}/{v}.
 
 [EMC]
 VERSION = 1.1
@@ -178,7 +263,7 @@ HALFILE = galvoplan-timers.hal
 {stream_hal}
 [KINS]
 KINEMATICS = trivkins coordinates={coords}
-JOINTS = 4
+JOINTS = {joints}
 
 [TRAJ]
 COORDINATES = {coords}
@@ -186,12 +271,13 @@ LINEAR_UNITS = mm
 ANGULAR_UNITS = degree
 DEFAULT_LINEAR_VELOCITY = {default_v}
 MAX_LINEAR_VELOCITY = {fastest}
-",
+{angular}",
         name = profile.name.replace('\n', " "),
         name_short = profile.name.split(" (").next().unwrap_or("machine"),
         version = env!("CARGO_PKG_VERSION"),
-        u = axes[2].letter,
-        v = axes[3].letter,
+        u = axes[su].letter,
+        v = axes[sv].letter,
+        joints = axes.len(),
         default_v = num(profile.axis_x.max_velocity_mm_s),
         fastest = num(fastest),
         stream_hal = if profile.controller.stream_period_s.is_some() {
@@ -217,15 +303,17 @@ MAX_LINEAR_VELOCITY = {fastest}
         );
         let _ = write!(
             s,
-            "\n[AXIS_{l}]\n{limits}\n[JOINT_{j}]\nTYPE = LINEAR\n{limits}FERROR = 1\nMIN_FERROR = 1\n\
-             HOME = 0\nHOME_OFFSET = 0\nHOME_SEARCH_VEL = 0\nHOME_LATCH_VEL = 0\nHOME_SEQUENCE = 0\n",
-            l = a.letter
+            "\n[AXIS_{l}]\n{limits}\n[JOINT_{j}]\nTYPE = {kind}\n{limits}FERROR = 1\nMIN_FERROR = 1\n\
+             HOME = {home}\nHOME_OFFSET = {home}\nHOME_SEARCH_VEL = 0\nHOME_LATCH_VEL = 0\nHOME_SEQUENCE = 0\n",
+            l = a.letter,
+            kind = if a.angular() { "ANGULAR" } else { "LINEAR" },
+            home = num(a.home),
         );
     }
     s
 }
 
-fn hal(profile: &MachineProfile) -> String {
+fn hal(profile: &MachineProfile, axes: &[Axis]) -> String {
     let d = &profile.gcode;
     let streams = profile.controller.stream_period_s.is_some();
     let dio = (stream_output(profile) + 1).max(4);
@@ -247,7 +335,7 @@ addf motion-controller servo-thread
 # module.
 "
     );
-    for j in 0..4 {
+    for j in 0..axes.len() {
         let _ = writeln!(
             s,
             "net j{j}-pos joint.{j}.motor-pos-cmd => joint.{j}.motor-pos-fb"
@@ -296,8 +384,9 @@ const STREAM_NOT: &str = ",st-full,st-not-end,st-ok";
 /// The stream of a streamed on-the-fly job into the joints and the laser (docs/GCODE.md,
 /// *Streamed on the fly*): `streamer` in the base thread, `mux2` per joint between motion and
 /// the stream, the laser gated by the stream's state in the same period, and an E-stop when the
-/// stream runs dry before its last sample.
-fn stream_hal(profile: &MachineProfile) -> String {
+/// stream runs dry before its last sample. The stream's X, Y, U and V (mux2.0-3) go to those
+/// axes' joints; a machine's Z, A and B stay with motion.
+fn stream_hal(profile: &MachineProfile, axes: &[Axis]) -> String {
     let d = &profile.gcode;
     let period_s = profile.controller.stream_period_s.unwrap_or(1e-4);
     let depth = stream_depth(period_s);
@@ -364,10 +453,15 @@ net st-underruns streamer.0.underruns => sampler.0.pin.7
 ",
         end = STREAM_END_INPUT,
     );
-    for j in 0..4 {
+    let [su, sv] = scanner_joints(axes);
+    let joints = [joint_of(axes, "X"), joint_of(axes, "Y"), Some(su), Some(sv)];
+    for (m, j) in joints.into_iter().enumerate() {
+        if let Some(j) = j {
+            let _ = writeln!(s, "net j{j}-pos => mux2.{m}.in0");
+        }
         let _ = writeln!(
             s,
-            "net j{j}-pos => mux2.{j}.in0\nnet st-p{j} streamer.0.pin.{j} => mux2.{j}.in1\nnet m{j}-pos mux2.{j}.out => sampler.0.pin.{j}"
+            "net st-p{m} streamer.0.pin.{m} => mux2.{m}.in1\nnet m{m}-pos mux2.{m}.out => sampler.0.pin.{m}"
         );
     }
     if let Some(e) = power {
@@ -439,6 +533,45 @@ net tm-job-v tm-job-f.out => t-job.in
 
 fn readme(profile: &MachineProfile, axes: &[Axis]) -> String {
     let d = &profile.gcode;
+    let [ju, jv] = scanner_joints(axes);
+    let mut axis_lines = String::new();
+    for a in &axes[..ju] {
+        let (unit, what) = match a.role {
+            Role::Extra(ExtraAxisId::A) => ("deg", "rotary about X"),
+            Role::Extra(ExtraAxisId::B) => ("deg", "rotary about Y"),
+            Role::Extra(ExtraAxisId::Z) => ("mm", "Z"),
+            _ => ("mm", "stage"),
+        };
+        let range = if a.max_mm >= ENDLESS_LIMIT {
+            "endless".to_string()
+        } else {
+            format!("{} .. {} {unit}", num(a.min_mm), num(a.max_mm))
+        };
+        let _ = writeln!(
+            axis_lines,
+            "  {l}: {range}, {v} {unit}/s, {acc} {unit}/s^2 ({what})",
+            l = a.letter,
+            v = num(a.velocity_mm_s),
+            acc = num(a.accel_mm_s2),
+        );
+    }
+    let extras: Vec<(usize, &Axis)> = axes
+        .iter()
+        .enumerate()
+        .filter(|(_, a)| matches!(a.role, Role::Extra(_)))
+        .collect();
+    let extra_hw = match (extras.first(), extras.last()) {
+        (Some((j0, _)), Some((j1, _))) => format!(
+            "  {words}: joints {j0}-{j1} the same way (stepgen.{j0:02}-{j1:02}), rotaries in degrees\n\
+             \x20          (the stepgen's position-scale in steps per degree).\n",
+            words = extras
+                .iter()
+                .map(|(_, a)| a.letter.as_str())
+                .collect::<Vec<_>>()
+                .join(", "),
+        ),
+        _ => String::new(),
+    };
     let dialect_note = if d.mode == GcodeMode::Linuxcnc {
         String::new()
     } else {
@@ -450,10 +583,8 @@ fn readme(profile: &MachineProfile, axes: &[Axis]) -> String {
         "LinuxCNC configuration for galvoplan profile: {name}
 Written by galvoplan {version}.
 {dialect_note}
-Machine: trivkins, joints 0-3 = axes {x} {y} {u} {v}.
-  {x}: {x0} .. {x1} mm, {xv} mm/s, {xa} mm/s^2 (stage)
-  {y}: {y0} .. {y1} mm, {yv} mm/s, {ya} mm/s^2 (stage)
-  {u}, {v}: +/-{half} mm (the field), {sv} mm/s, {sa} mm/s^2 (scanner)
+Machine: trivkins, joints 0-{last} = axes {letters}.
+{axis_lines}  {u}, {v}: +/-{half} mm (the field), {sv} mm/s, {sa} mm/s^2 (scanner)
 Servo period {servo} s. The laser: digital output {n} (motion.digital-out-{n:02}).
 
 Run a program on the simulated machine without a screen (as scripts/check-linuxcnc.sh does):
@@ -471,11 +602,11 @@ A real machine (Mesa card with hostmot2): replace the loopback nets in galvoplan
 the card's pins and add its read/write functions to the servo thread, e.g. for a 7i96S:
   stage X: joint.0.motor-pos-cmd => hm2_7i96s.0.stepgen.00.position-cmd,
            joint.0.motor-pos-fb  <= hm2_7i96s.0.stepgen.00.position-fb,
-           joint.0.amp-enable-out => hm2_7i96s.0.stepgen.00.enable (Y: stepgen.01);
+           joint.0.amp-enable-out => hm2_7i96s.0.stepgen.00.enable{y_stepgen};
            servo drives: a pwmgen for the command and an encoder for the feedback, with a pid.
-  scanner {u}/{v} over XY2-100 (firmware with an xy2mod):
-           joint.2.motor-pos-cmd => hm2_<board>.0.xy2mod.00.posx-cmd,
-           joint.3.motor-pos-cmd => hm2_<board>.0.xy2mod.00.posy-cmd (set posx-scale and
+{extra_hw}  scanner {u}/{v} over XY2-100 (firmware with an xy2mod):
+           joint.{ju}.motor-pos-cmd => hm2_<board>.0.xy2mod.00.posx-cmd,
+           joint.{jv}.motor-pos-cmd => hm2_<board>.0.xy2mod.00.posy-cmd (set posx-scale and
            posy-scale to half the field, {half} mm, so that full scale is the field's edge),
            feedback from posx-fb/posy-fb, enable from amp-enable-out.
   laser:   motion.digital-out-{n:02} => the laser's gate input (a GPIO or sserial output){power}.
@@ -483,21 +614,18 @@ Home switches, limits and E-stop wiring are the machine's own; this file homes i
 {stream}",
         name = profile.name.replace('\n', " "),
         version = env!("CARGO_PKG_VERSION"),
-        x = axes[0].letter,
-        y = axes[1].letter,
-        u = axes[2].letter,
-        v = axes[3].letter,
-        x0 = num(axes[0].min_mm),
-        x1 = num(axes[0].max_mm),
-        xv = num(axes[0].velocity_mm_s),
-        xa = num(axes[0].accel_mm_s2),
-        y0 = num(axes[1].min_mm),
-        y1 = num(axes[1].max_mm),
-        yv = num(axes[1].velocity_mm_s),
-        ya = num(axes[1].accel_mm_s2),
+        last = axes.len() - 1,
+        y_stepgen = if profile.has_y() { " (Y: stepgen.01)" } else { "" },
+        letters = axes
+            .iter()
+            .map(|a| a.letter.as_str())
+            .collect::<Vec<_>>()
+            .join(" "),
+        u = axes[ju].letter,
+        v = axes[jv].letter,
         half = num(profile.field_mm[0].min(profile.field_mm[1]) / 2.0),
-        sv = num(axes[2].velocity_mm_s),
-        sa = num(axes[2].accel_mm_s2),
+        sv = num(axes[ju].velocity_mm_s),
+        sa = num(axes[ju].accel_mm_s2),
         servo = num(profile.controller.servo_period_s),
         n = d.laser_output,
         stream = profile.controller.stream_period_s.map_or(String::new(), |p| format!(
@@ -535,4 +663,105 @@ On a real machine the same wiring holds, with the mux outputs going to the hardw
             "\n  power:   motion.analog-out-{e:02} => the laser's analog power input (a PWM or DAC)"
         )),
     )
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+
+    fn text(files: &[ConfigFile], name: &str) -> String {
+        files
+            .iter()
+            .find(|f| f.name == name)
+            .map(|f| f.text.clone())
+            .unwrap_or_default()
+    }
+
+    /// The joints' `TYPE`s, in joint order.
+    fn types(ini: &str) -> Vec<&str> {
+        ini.lines()
+            .filter_map(|l| l.strip_prefix("TYPE = "))
+            .collect()
+    }
+
+    #[test]
+    fn a_five_axis_profile_is_a_seven_joint_machine_with_angular_rotaries() {
+        let mut p = MachineProfile::builtin("five-axis").unwrap();
+        p.gcode.mode = GcodeMode::Linuxcnc;
+        let files = linuxcnc_config(&p);
+        let ini = text(&files, "galvoplan.ini");
+        assert!(
+            ini.contains("KINEMATICS = trivkins coordinates=XYZABUV\nJOINTS = 7\n"),
+            "{ini}"
+        );
+        assert!(ini.contains("COORDINATES = XYZABUV\n"));
+        assert_eq!(
+            types(&ini),
+            ["LINEAR", "LINEAR", "LINEAR", "ANGULAR", "ANGULAR", "LINEAR", "LINEAR"]
+        );
+        // Z from its travel (mm); A and B from theirs, in degrees
+        assert!(ini.contains(
+            "[AXIS_Z]\nMIN_LIMIT = -150.001\nMAX_LIMIT = 150.001\nMAX_VELOCITY = 218\n\
+             MAX_ACCELERATION = 889.795918\n\n[JOINT_2]\nTYPE = LINEAR\n"
+        ));
+        assert!(ini.contains(
+            "[AXIS_A]\nMIN_LIMIT = -110.001\nMAX_LIMIT = 110.001\nMAX_VELOCITY = 121.467053\n\
+             MAX_ACCELERATION = 586.797355\n\n[JOINT_3]\nTYPE = ANGULAR\n"
+        ));
+        assert!(ini.contains("[JOINT_4]\nTYPE = ANGULAR\nMIN_LIMIT = -110.001\nMAX_LIMIT = 110.001\nMAX_VELOCITY = 49.847328\n"));
+        assert!(ini.contains("[JOINT_5]\nTYPE = LINEAR\nMIN_LIMIT = -35.001\n"));
+        // neither trajectory limit clips an axis: the scanner's speed, the fastest rotary's
+        assert!(ini.contains("MAX_LINEAR_VELOCITY = 5000\nDEFAULT_ANGULAR_VELOCITY = 121.467053\nMAX_ANGULAR_VELOCITY = 121.467053\n"));
+        let hal = text(&files, "galvoplan.hal");
+        for j in 0..7 {
+            assert!(hal.contains(&format!(
+                "net j{j}-pos joint.{j}.motor-pos-cmd => joint.{j}.motor-pos-fb\n"
+            )));
+        }
+        assert!(!hal.contains("joint.7"));
+        let readme = text(&files, "README.txt");
+        assert!(readme.contains("joints 0-6 = axes X Y Z A B U V."));
+        assert!(readme.contains("  A: -110.001 .. 110.001 deg, 121.467053 deg/s"));
+        assert!(readme.contains("joint.5.motor-pos-cmd => hm2_<board>.0.xy2mod.00.posx-cmd"));
+        // an endless rotary: limits far out; a Z whose travel leaves out 0: homed at its end
+        p.axis_b.as_mut().unwrap().0.travel = None;
+        p.axis_z.as_mut().unwrap().0.travel = Some([10.0, 100.0]);
+        let ini = text(&linuxcnc_config(&p), "galvoplan.ini");
+        assert!(ini.contains("[AXIS_B]\nMIN_LIMIT = -1000000000\nMAX_LIMIT = 1000000000\n"));
+        assert!(ini.contains("[JOINT_2]\nTYPE = LINEAR\nMIN_LIMIT = 9.999\nMAX_LIMIT = 100.001\n"));
+        assert!(ini.contains("HOME = 10\nHOME_OFFSET = 10\n"));
+    }
+
+    #[test]
+    fn a_rotary_machine_without_y_has_no_y_joint() {
+        let p = MachineProfile::builtin("rotary").unwrap();
+        let files = linuxcnc_config(&p);
+        let ini = text(&files, "galvoplan.ini");
+        assert!(ini.contains("coordinates=XAUV\nJOINTS = 4\n") && !ini.contains("[AXIS_Y]"));
+        assert_eq!(types(&ini), ["LINEAR", "ANGULAR", "LINEAR", "LINEAR"]);
+        // endless A
+        assert!(ini.contains("[AXIS_A]\nMIN_LIMIT = -1000000000\n"));
+        let readme = text(&files, "README.txt");
+        assert!(readme.contains("axes X A U V.") && readme.contains("  A: endless, 360 deg/s"));
+        assert!(!readme.contains("(Y: stepgen.01)"));
+    }
+
+    #[test]
+    fn a_flat_profiles_machine_is_xyuv_with_linear_joints() {
+        let p = MachineProfile::builtin("linuxcnc").unwrap();
+        let files = linuxcnc_config(&p);
+        let ini = text(&files, "galvoplan.ini");
+        assert!(ini.contains("Stage X/Y, scanner U/V.\n"));
+        assert!(ini.contains("coordinates=XYUV\nJOINTS = 4\n"));
+        assert_eq!(types(&ini), ["LINEAR"; 4]);
+        assert!(ini.contains("MAX_LINEAR_VELOCITY = 5000\n\n[AXIS_X]"));
+        assert!(!ini.contains("ANGULAR_VELOCITY"));
+        // the stream drives joints 0-3 through mux2.0-3
+        let stream = text(&files, "galvoplan-stream.hal");
+        assert!(stream.contains(
+            "net j3-pos => mux2.3.in0\nnet st-p3 streamer.0.pin.3 => mux2.3.in1\nnet m3-pos mux2.3.out => sampler.0.pin.3\n"
+        ));
+        assert!(text(&files, "README.txt").contains("joints 0-3 = axes X Y U V.\n  X: -0.001 .. 300.001 mm, 500 mm/s, 5000 mm/s^2 (stage)\n  Y: -0.001 .. 300.001 mm, 500 mm/s, 5000 mm/s^2 (stage)\n  U, V: +/-35 mm (the field)"));
+    }
 }
