@@ -1226,8 +1226,8 @@ fn a_profile_edit_makes_the_headline_stale() {
     );
     let why = h.state().plan_staleness(0).to_vec();
     assert_eq!(why.len(), 1, "{why:?}");
-    assert!(why[0].starts_with("base x max velocity ") && why[0].ends_with("→ 100 mm/s"));
-    h.get_by_label_contains("HHA · job time · step-and-scan is stale: base x max velocity");
+    assert!(why[0].starts_with("base X max velocity ") && why[0].ends_with("→ 100 mm/s"));
+    h.get_by_label_contains("HHA · job time · step-and-scan is stale: base X max velocity");
     h.get_by_label("stale");
     // the plan keeps the figures and the toolpath of its own profile
     let plan = h.state().session.doc().plans[0].clone();
@@ -2497,4 +2497,30 @@ fn a_five_axis_job_shows_its_axes_in_their_units_and_compares_time_with_distance
     h.get_by_label("Compare").click();
     settle(&mut h);
     h.get_by_label("B vs A");
+    h.get_by_label("Workbench").click();
+    settle(&mut h);
+    // the rotary machine has no Z, no B, no Y: their rows go, and the solve says why it cannot
+    let rotary = galvoplan::document::MachineProfile::builtin("rotary").unwrap();
+    h.state_mut()
+        .execute(Command::SetProfile(Box::new(rotary)))
+        .unwrap();
+    settle(&mut h);
+    assert!(h
+        .state()
+        .status()
+        .contains("the job cannot run on this machine"));
+    section(&mut h, "Machine profile");
+    h.get_by_label("Axis A max velocity (deg/s)");
+    for gone in [
+        "Axis B max velocity (deg/s)",
+        "Axis Z max velocity (mm/s)",
+        "Base Y max velocity (mm/s)",
+    ] {
+        assert!(h.query_by_label(gone).is_none(), "{gone}");
+    }
+    let why = h.state().solve_blocker().unwrap();
+    assert!(
+        why.contains("needs axis Z (") && !why.contains("0000"),
+        "{why}"
+    );
 }

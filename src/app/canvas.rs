@@ -824,6 +824,10 @@ impl Canvas<'_> {
                 super::words::count(f.geometries.len(), "stroke", "strokes"),
                 if f.locked { ", locked" } else { "" }
             ));
+            let pose = super::words::pose_words(&f.pose, self.profile);
+            if !pose.is_empty() {
+                lines.push(format!("  pose {pose}"));
+            }
             if word == "region" {
                 let [w, h] = self.profile.field_mm;
                 lines.push(format!(

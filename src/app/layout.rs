@@ -619,6 +619,10 @@ impl App {
             ))
             .wrap(),
         );
+        let pose = super::words::pose_words(&f.pose, &self.session.doc().profile);
+        if !pose.is_empty() {
+            ui.label(format!("pose {pose}"));
+        }
         if word == "region" {
             let [w, h] = self.session.doc().profile.field_mm;
             ui.add(
@@ -739,7 +743,13 @@ impl App {
             motion_plots_header(ui, &mut self.panels.plots_open, motion.is_none());
         }
         if self.panels.plots_open {
-            let profile = &self.session.doc().profile;
+            // the plan's own machine: its motion was made on it, whatever the document's is now
+            let doc = self.session.doc();
+            let profile = self
+                .session
+                .active()
+                .and_then(|k| doc.plans.get(k))
+                .map_or(&doc.profile, |p| &p.profile);
             if let Some(samples) = motion {
                 motion_plots::show(ui, samples, profile, playback_t_s, plots_px);
             } else if let Some(samples) = axes {

@@ -658,15 +658,21 @@ impl App {
         match &r {
             Ok(o) => {
                 if group.is_none() {
-                    let cover = match o.uncovered.len() {
-                        0 => "every stroke is in a scan field".to_string(),
-                        n => format!(
+                    let doc = self.session.doc();
+                    let pose = doc
+                        .fields
+                        .iter()
+                        .find_map(|f| doc.profile.check_pose(f.id, &f.pose).err());
+                    let cover = match (o.uncovered.len(), &pose) {
+                        (_, Some(e)) => format!("the job cannot run on this machine: {e}"),
+                        (0, None) => "every stroke is in a scan field".to_string(),
+                        (n, None) => format!(
                             "{} outside every scan field: \"Re-place automatically\" places \
                              fields for them",
                             count(n, "stroke", "strokes")
                         ),
                     };
-                    self.set_status(format!("{what}: done; {cover}"), false);
+                    self.set_status(format!("{what}: done; {cover}"), pose.is_some());
                 }
                 if o.uncovered.is_empty() && self.session.problem().is_some() {
                     self.session.set_problem(None);
@@ -868,7 +874,12 @@ impl App {
                 n => format!("{n} strokes are not covered by a scan field"),
             })
         } else {
-            None
+            // a field whose pose the machine cannot take (an axis it lacks, beyond a travel)
+            let doc = self.session.doc();
+            doc.fields
+                .iter()
+                .find_map(|f| doc.profile.check_pose(f.id, &f.pose).err())
+                .map(|e| e.to_string())
         }
     }
 

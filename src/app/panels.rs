@@ -55,6 +55,9 @@ pub(super) struct Form<T> {
     error: Vec<Option<String>>,
     /// Whether a row's value is used by the value as it stands (a row that is not is greyed).
     applies: fn(&FieldSpec<T>, &T) -> bool,
+    /// Whether a row belongs to the value at all (a machine's axis rows): rows that do not are
+    /// left out.
+    present: fn(&FieldSpec<T>, &T) -> bool,
 }
 
 impl<T: Clone + PartialEq> Form<T> {
@@ -65,6 +68,7 @@ impl<T: Clone + PartialEq> Form<T> {
             text: Vec::new(),
             error: Vec::new(),
             applies: |_, _| true,
+            present: |_, _| true,
         }
     }
 
@@ -105,7 +109,12 @@ impl<T: Clone + PartialEq> Form<T> {
             .num_columns(2)
             .striped(true)
             .show(ui, |ui| {
-                for k in (0..self.specs.len()).filter(|&k| !wide[k]) {
+                let present = |k: &usize| (self.present)(&self.specs[*k], value);
+                let shown: Vec<usize> = (0..self.specs.len())
+                    .filter(|&k| !wide[k])
+                    .filter(present)
+                    .collect();
+                for k in shown {
                     let label = ui.label(self.specs[k].words());
                     let (bad, help) = (self.error[k].is_some(), self.specs[k].help);
                     let edit =
@@ -225,6 +234,7 @@ impl Default for Editors {
         Self {
             profile: Form {
                 applies: spec::profile_row_applies,
+                present: spec::profile_row_present,
                 ..Form::new(profile_specs())
             },
             settings: Form::new(settings_specs()),

@@ -108,8 +108,20 @@ pub fn state_text(l: &Lowered, t_s: f64) -> String {
         Some(_) => " (on the fly)",
         None => "",
     };
+    // Z, A and B where the job turns them
+    let pose = l.poses.as_ref().map_or(String::new(), |track| {
+        let p = track.at(t_s).values();
+        let words = ["Z", "A", "B"];
+        (0..3)
+            .filter(|&k| l.pose_axes[k])
+            .map(|k| match k {
+                0 => format!(", Z {:.1} mm", p[0]),
+                _ => format!(", {} {:.1}°", words[k], p[k]),
+            })
+            .collect()
+    });
     format!(
-        "{doing}{how}; stage ({:.1}, {:.1}) mm; laser {}",
+        "{doing}{how}; stage ({:.1}, {:.1}) mm{pose}; laser {}",
         state.stage.x,
         state.stage.y,
         if state.laser { "on" } else { "off" }

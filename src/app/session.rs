@@ -448,7 +448,7 @@ pub(super) mod tests {
         assert_eq!(s.doc.plans.len(), 1);
         let why = s.plan_staleness(k);
         assert_eq!(why.len(), 1, "{why:?}");
-        assert!(why[0].starts_with("base y max velocity "), "{why:?}");
+        assert!(why[0].starts_with("base Y max velocity "), "{why:?}");
         // the plan keeps its own machine: its toolpath is the one it was measured on
         let l = s.toolpath(k).unwrap().unwrap();
         assert_eq!(Some(l.duration_s()), s.doc.plans[k].metrics.job_time_s);

@@ -24,6 +24,10 @@ pub struct Lowered {
     /// Each axis's speed sampled for the plot of a step-and-scan job that turns Z, A or B
     /// (`None` for any other).
     pub axes: Option<AxisSamples>,
+    /// Where Z, A and B stand over the job (a job that turns them; `None` for any other).
+    pub poses: Option<crate::motion::PoseTrack>,
+    /// Which of Z, A and B the job turns or holds away from zero.
+    pub pose_axes: [bool; 3],
     /// Per geometry (index), where its first stroke comes in the marking order, 0…1 (−1: not
     /// marked): the canvas colours marks by it.
     pub rank_by_geometry: Vec<f32>,
@@ -44,6 +48,15 @@ impl Lowered {
         let route_mm = route_points_mm(&toolpath);
         let motion = MotionSamples::of(&toolpath);
         let axes = AxisSamples::of(&toolpath);
+        let poses = toolpath.moves_extra_axes().then(|| toolpath.pose_track());
+        let start = toolpath.start_pose.values();
+        let pose_axes = [0, 1, 2].map(|k| {
+            start[k] != 0.0
+                || toolpath
+                    .stage_moves
+                    .iter()
+                    .any(|m| m.extra[k].distance_mm != 0.0)
+        });
         let rank_by_geometry = rank_by_geometry(&toolpath);
         Self {
             toolpath,
@@ -51,6 +64,8 @@ impl Lowered {
             route_mm,
             motion,
             axes,
+            poses,
+            pose_axes,
             rank_by_geometry,
         }
     }

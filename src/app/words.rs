@@ -2,7 +2,26 @@
 //! numbers, pipeline errors with what the operator can do, a plan's staleness. At the bottom of
 //! the GUI's modules: nothing here imports another file of the GUI.
 
-use crate::document::{MachineProfile, ScanField};
+use crate::document::{MachineProfile, Pose, ScanField};
+
+/// A pose in words, the axes `profile` has and any other the pose turns (`Z -60.83 mm,
+/// A 29.65°, B -36.81°`): empty for a flat machine's rest pose.
+pub fn pose_words(pose: &Pose, profile: &MachineProfile) -> String {
+    crate::document::ExtraAxisId::ALL
+        .into_iter()
+        .filter_map(|id| {
+            let v = pose.values()[id.index()];
+            if profile.extra_axis(id).is_none() && v == 0.0 {
+                return None;
+            }
+            Some(match id {
+                crate::document::ExtraAxisId::Z => format!("Z {v:.2} mm"),
+                _ => format!("{} {v:.2}°", id.word()),
+            })
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
+}
 
 /// `n` and the noun for it: "1 geometry", "3 geometries".
 pub fn count(n: usize, one: &str, many: &str) -> String {

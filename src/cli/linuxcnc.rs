@@ -9,7 +9,7 @@ use std::path::PathBuf;
 /// Arguments of `galvoplan linuxcnc-config`.
 #[derive(Args, Debug)]
 pub struct LinuxcncConfigArgs {
-    /// Machine profile: a TOML file or a built-in name (seed000, small-field, linuxcnc).
+    /// Machine profile: a TOML file or a built-in name (seed000, small-field, linuxcnc, five-axis, rotary).
     #[arg(long, default_value = "linuxcnc")]
     profile: String,
     /// Folder to write the configuration into (made when missing; files of the same names in

@@ -122,9 +122,11 @@ enum VertexArg {
 /// Options shared by `plan` and `bench`.
 #[derive(Args, Debug, Clone)]
 struct JobOpts {
-    /// Machine profile: a TOML file or a built-in name (seed000, small-field, linuxcnc).
-    #[arg(long, default_value = "seed000")]
-    profile: String,
+    /// Machine profile: a TOML file or a built-in name (seed000, small-field, linuxcnc,
+    /// five-axis, rotary); default seed000, or a project's own profile when the input is a
+    /// project.
+    #[arg(long)]
+    profile: Option<String>,
     /// Scan-field placement.
     #[arg(long, value_enum, default_value = "auto")]
     fields: FieldsArg,
@@ -346,9 +348,10 @@ impl PlanArgs {
         let mut v = vec![self.input.as_path()];
         v.extend(self.job.pens.as_deref());
         v.extend(self.job.tray.data.as_deref());
-        let profile = std::path::Path::new(&self.job.profile);
-        if profile.exists() {
-            v.push(profile);
+        if let Some(profile) = self.job.profile.as_deref().map(std::path::Path::new) {
+            if profile.exists() {
+                v.push(profile);
+            }
         }
         v
     }
@@ -375,8 +378,18 @@ impl PlanArgs {
 }
 
 impl JobOpts {
+    /// The profile given, else the built-in `seed000`.
     fn profile(&self) -> Result<MachineProfile> {
-        Ok(MachineProfile::load(&self.profile)?)
+        Ok(MachineProfile::load(
+            self.profile.as_deref().unwrap_or("seed000"),
+        )?)
+    }
+    /// The profile given, else `input`'s own when it is a project, else `seed000`.
+    fn profile_for(&self, input: &std::path::Path) -> Result<MachineProfile> {
+        if self.profile.is_none() && input.extension().is_some_and(|e| e == "galvoplan") {
+            return Ok(galvoplan::document::load_project(input)?.profile);
+        }
+        self.profile()
     }
     fn settings(&self) -> Result<SolverSettings> {
         let s = self.unchecked_settings()?;

@@ -18,7 +18,7 @@ use std::time::Instant;
 
 pub fn run(a: &PlanArgs) -> Result<()> {
     check_outputs(&a.inputs(), &a.outputs())?;
-    let profile = a.job.profile()?;
+    let profile = a.job.profile_for(&a.input)?;
     let settings = a.job.settings()?;
     let opts = a.job.import()?;
     // an impossible period is refused before any work; one the plan's clock differs from, once

@@ -238,7 +238,7 @@ impl From<RotaryAxis> for RotaryAxisOut {
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum PoseError {
     /// The job turns or lifts an axis the profile does not have.
-    #[error("field {field} needs axis {axis} ({value} {unit}), which profile '{profile}' does not have (its axes: {axes})")]
+    #[error("field {field} needs axis {axis} ({} {unit}), which the machine '{profile}' does not have (its axes: {axes})", short(*.value))]
     MissingAxis {
         /// Field id.
         field: usize,
@@ -254,7 +254,7 @@ pub enum PoseError {
         axes: String,
     },
     /// A pose outside an axis's travel.
-    #[error("field {field}: {axis} {value} {unit} is outside axis {axis}'s travel {min} to {max} {unit}")]
+    #[error("field {field}: {axis} {} {unit} is outside axis {axis}'s travel {} to {} {unit}", short(*.value), short(*.min), short(*.max))]
     OutOfTravel {
         /// Field id.
         field: usize,
@@ -362,6 +362,11 @@ impl MachineProfile {
         }
         Ok(())
     }
+}
+
+/// A position in words: three decimals at most, no trailing zeros.
+fn short(v: f64) -> String {
+    crate::geom::format_mm(v, 3)
 }
 
 /// A pose this close outside an axis's travel is within it (decimals written to files), mm or

@@ -204,10 +204,27 @@ pub fn differences<T>(specs: &[FieldSpec<T>], old: &T, new: &T) -> Vec<String> {
                 } else {
                     format!(" {}", s.unit)
                 };
-                format!("{} {a} → {b}{unit}", s.label.to_lowercase())
+                // the unit goes with a number: after the new value, or the old one when the
+                // new one is none
+                let (a, b) = if b == "none" {
+                    (format!("{a}{unit}"), b)
+                } else {
+                    (a, format!("{b}{unit}"))
+                };
+                format!("{} {a} → {b}", lower_first(s.label))
             })
         })
         .collect()
+}
+
+/// A label in the middle of a sentence: its first word in lower case, an axis letter kept
+/// (`Base X max velocity` → `base X max velocity`).
+fn lower_first(label: &str) -> String {
+    let mut chars = label.chars();
+    match chars.next() {
+        Some(c) => c.to_lowercase().chain(chars).collect(),
+        None => String::new(),
+    }
 }
 
 /// A number typed by the operator.
@@ -1245,15 +1262,28 @@ pub const PROFILE_APPLIES: &[AppliesWhen] = &[
     (&[rows::CLOCK], |p| {
         p.controller.kind == ControllerKind::Ideal
     }),
-    (rows::AXIS_Y, MachineProfile::has_y),
-    (rows::AXIS_Z, |p| p.axis_z.is_some()),
-    (rows::AXIS_A, |p| p.axis_a.is_some()),
-    (rows::AXIS_B, |p| p.axis_b.is_some()),
     // also the scanner's acceleration in linuxcnc-config's machine
     (&[rows::SCANNER_ACCEL], |p| {
         p.gcode.mode == GcodeMode::Linuxcnc || p.controller.kind == ControllerKind::Linuxcnc
     }),
 ];
+
+/// Profile rows of axes a machine may not have, and the test of the machines that have them: an
+/// editor leaves them out where the machine lacks the axis.
+pub const PROFILE_AXES: &[AppliesWhen] = &[
+    (rows::AXIS_Y, MachineProfile::has_y),
+    (rows::AXIS_Z, |p| p.axis_z.is_some()),
+    (rows::AXIS_A, |p| p.axis_a.is_some()),
+    (rows::AXIS_B, |p| p.axis_b.is_some()),
+];
+
+/// Whether profile row `spec` belongs to `p`'s machine (not the row of an axis it lacks).
+pub fn profile_row_present(spec: &FieldSpec<MachineProfile>, p: &MachineProfile) -> bool {
+    PROFILE_AXES
+        .iter()
+        .filter(|(rows, _)| rows.iter().any(|r| r.is(spec)))
+        .all(|(_, has)| has(p))
+}
 
 /// Whether profile row `spec` is used with `p`'s G-code dialect and controller.
 pub fn profile_row_applies(spec: &FieldSpec<MachineProfile>, p: &MachineProfile) -> bool {
@@ -1268,6 +1298,7 @@ pub fn editor_rows() -> EditorRows {
     use rows::*;
     let mut profile = vec![PROFILE_NAME];
     profile.extend(PROFILE_APPLIES.iter().flat_map(|(r, _)| r.iter().copied()));
+    profile.extend(PROFILE_AXES.iter().flat_map(|(r, _)| r.iter().copied()));
     let pen = vec![
         PEN_SPEED,
         PEN_POWER,
@@ -1315,7 +1346,7 @@ mod tests {
         p.name = "other".into();
         let d = differences(&specs, &old, &p);
         assert_eq!(d.len(), 1, "{d:?}");
-        assert!(d[0].starts_with("base x max velocity ") && d[0].ends_with(" → 100 mm/s"));
+        assert!(d[0].starts_with("base X max velocity ") && d[0].ends_with(" → 100 mm/s"));
         p.field_mm[0] = -1.0;
         let e = check_all(&specs, &p).unwrap_err();
         assert_eq!(

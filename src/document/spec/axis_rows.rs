@@ -29,12 +29,12 @@ macro_rules! axis_number {
 
 /// One end of an axis's travel: empty text makes it endless.
 macro_rules! travel_end {
-    ($label:expr, $unit:expr, $key:expr, $get:expr, $end:expr) => {
+    ($label:expr, $unit:expr, $key:expr, $help:expr, $get:expr, $end:expr) => {
         FieldSpec {
             label: $label,
             unit: $unit,
             key: $key,
-            help: "empty: endless (no limit)",
+            help: $help,
             rule: Rule::Finite,
             optional: true,
             shapes_plan: true,
@@ -85,6 +85,11 @@ fn b(p: &MachineProfile) -> Option<&ExtraAxis> {
     p.axis_b.as_ref().map(|a| &a.0)
 }
 
+/// Help of Z's travel.
+const Z_TRAVEL: &str = "empty: no limit";
+/// Help of a rotary's travel.
+const ROTARY_TRAVEL: &str = "empty: endless (the axis turns freely)";
+
 /// The Z, A and B rows, in that order.
 pub(super) fn axis_specs() -> Vec<FieldSpec<MachineProfile>> {
     use Rule::{NonNegative, Positive};
@@ -116,8 +121,22 @@ pub(super) fn axis_specs() -> Vec<FieldSpec<MachineProfile>> {
             z,
             settle_s
         ),
-        travel_end!("Axis Z travel from", "mm", "axis_z.travel_mm[0]", z, 0),
-        travel_end!("Axis Z travel to", "mm", "axis_z.travel_mm[1]", z, 1),
+        travel_end!(
+            "Axis Z travel from",
+            "mm",
+            "axis_z.travel_mm[0]",
+            Z_TRAVEL,
+            z,
+            0
+        ),
+        travel_end!(
+            "Axis Z travel to",
+            "mm",
+            "axis_z.travel_mm[1]",
+            Z_TRAVEL,
+            z,
+            1
+        ),
         axis_number!(
             "Axis A max velocity",
             "deg/s",
@@ -145,8 +164,22 @@ pub(super) fn axis_specs() -> Vec<FieldSpec<MachineProfile>> {
             a,
             settle_s
         ),
-        travel_end!("Axis A travel from", "deg", "axis_a.travel_deg[0]", a, 0),
-        travel_end!("Axis A travel to", "deg", "axis_a.travel_deg[1]", a, 1),
+        travel_end!(
+            "Axis A travel from",
+            "deg",
+            "axis_a.travel_deg[0]",
+            ROTARY_TRAVEL,
+            a,
+            0
+        ),
+        travel_end!(
+            "Axis A travel to",
+            "deg",
+            "axis_a.travel_deg[1]",
+            ROTARY_TRAVEL,
+            a,
+            1
+        ),
         axis_number!(
             "Axis B max velocity",
             "deg/s",
@@ -174,7 +207,21 @@ pub(super) fn axis_specs() -> Vec<FieldSpec<MachineProfile>> {
             b,
             settle_s
         ),
-        travel_end!("Axis B travel from", "deg", "axis_b.travel_deg[0]", b, 0),
-        travel_end!("Axis B travel to", "deg", "axis_b.travel_deg[1]", b, 1),
+        travel_end!(
+            "Axis B travel from",
+            "deg",
+            "axis_b.travel_deg[0]",
+            ROTARY_TRAVEL,
+            b,
+            0
+        ),
+        travel_end!(
+            "Axis B travel to",
+            "deg",
+            "axis_b.travel_deg[1]",
+            ROTARY_TRAVEL,
+            b,
+            1
+        ),
     ]
 }
