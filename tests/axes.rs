@@ -103,7 +103,9 @@ fn the_stand_in_is_planned_on_time_with_its_poses_in_every_output() {
     // without --profile a project is planned on its own machine
     ok(&galvoplan(&["plan", &project, "-o", &d("own.ngc")]));
     let own = std::fs::read_to_string(d("own.ngc")).unwrap();
-    assert!(own.lines().any(|l| l.starts_with("G0 X") && l.contains(" B")));
+    assert!(own
+        .lines()
+        .any(|l| l.starts_with("G0 X") && l.contains(" B")));
 }
 
 #[test]
