@@ -33,6 +33,10 @@
 # interpreter check compares Z, A and B too; ok when it and the run are clean, the ratio lies
 # within 0.95-1.05, and the laser is never on while the machine moves (dots: M64, G4, M65 at
 # rest). About 50 s.
+#
+# demo-delays (mode "step"): demo.svg on the `linuxcnc` profile with a scan head's delays (laser
+# on 0.1 ms, off 0.1 ms, jump 0.2 ms) and 5 ms settling: dwells around every mark, written with
+# their own times, and M62/M63 after them (the task law in src/motion/controller.rs).
 # Installs linuxcnc-uspace (without recommends) when it is missing.
 set -uo pipefail
 cd "$(dirname "$0")/.."
@@ -76,9 +80,9 @@ sim() { # program result -> runs it; one retry when LinuxCNC did not come up
 }
 
 status=0
-job() { # name svg mode [plan options...]
+job() { # name svg mode [plan options...]; JOB_PROFILE: another profile than `linuxcnc`
   local name=$1 svg=$2 mode=$3; shift 3
-  local o="$OUT/$name" profile=linuxcnc
+  local o="$OUT/$name" profile=${JOB_PROFILE:-linuxcnc}
   # on the fly as an inverse-time program: the profile without its stream (a LinuxCNC machine
   # without the streamer wiring; the program runs on this one too)
   [ "$mode" = on-the-fly ] && profile="$G93_PROFILE"
@@ -124,6 +128,10 @@ PY
 }
 
 PERIOD_S=$(sed -n 's/^stream_period_s = //p' assets/profiles/linuxcnc.toml)
+DELAYS_PROFILE="$OUT/linuxcnc-delays.toml"
+sed -e 's/^on_delay_s = .*/on_delay_s = 0.0001/' -e 's/^off_delay_s = .*/off_delay_s = 0.0001/' \
+  -e 's/^jump_delay_s = .*/jump_delay_s = 0.0002/' \
+  -e 's/^\(max_accel_mm_s2 = .*\)/\1\nsettle_s = 0.005/' assets/profiles/linuxcnc.toml >"$DELAYS_PROFILE"
 G93_PROFILE="$OUT/linuxcnc-g93.toml"
 sed '/^stream_period_s/d' assets/profiles/linuxcnc.toml >"$G93_PROFILE"
 
@@ -284,6 +292,7 @@ job lissajous tests/data/linuxcnc/lissajous.svg on-the-fly
 job tray-2x2 assets/examples/part.svg step --array 2x2@40,32 --serial 1001 --date 2026-12-07
 # a dotted DataMatrix on each part (one spot per module, fired for the dwell) on the fly
 job tray-dots assets/examples/part.svg on-the-fly --array 2x2@40,32 --serial 1001 --code "datamatrix:GP{serial:05}@3,3:6:dots"
+JOB_PROFILE="$DELAYS_PROFILE" job demo-delays assets/examples/demo.svg step
 five_axis_job
 for n in oversize lissajous spiral tree; do
   f=tests/data/linuxcnc/$n.svg; [ "$n" = oversize ] && f=assets/examples/oversize.svg

@@ -448,6 +448,21 @@ fn the_five_axis_stand_in_plans_for_an_xyzabuv_machine() {
     }
     // dots at rest: on, dwell, off, never a lit move
     assert_eq!(g.matches("M64 P0\nG4 P").count(), 300);
+    // every dwell is its pauses' own time (the laser delays, the dot's dwell), without what
+    // LinuxCNC's task adds to it (the toolpath's time has that)
+    let (l, dot) = (
+        &profile.laser,
+        galvoplan::document::MarkTiming::of(None, &profile).dot_dwell_s,
+    );
+    for p in g.lines().filter_map(|l| l.strip_prefix("G4 P")) {
+        let p: f64 = p.parse().unwrap();
+        assert!(
+            [l.on_delay_s, l.off_delay_s, dot]
+                .iter()
+                .any(|d| (p - d).abs() < 1e-7),
+            "G4 P{p}"
+        );
+    }
     assert!(!g.contains("M62") && !g.contains("G1 "));
     let waypoints = std::fs::read_to_string(&csv).unwrap();
     assert!(waypoints

@@ -7,7 +7,9 @@
 //!
 //! * **step-and-scan**: a stage move is `G0 X.. Y..` (with the scanner words when the scanner
 //!   jumps during it), a scanner jump `G0 U.. V..`, a mark `G1 U.. V..` through the stroke's
-//!   points at its pen's feed; settling, jump and laser delays are dwells (`G4 P<s>`);
+//!   points at its pen's feed; settling, jump and laser delays are dwells (`G4 P<s>`), those
+//!   next to each other one dwell of their own times added (the toolpath's pauses last what
+//!   LinuxCNC's task adds to them too: [`crate::motion::controller`]);
 //! * **on the fly**: the whole job in inverse time (`G93`), `G1 X.. Y.. U.. V.. F<1/min>`, each
 //!   line lasting what the toolpath takes between its two ends; the toolpath is sampled every
 //!   millisecond (and at every segment end and mark vertex) and consecutive samples are merged
@@ -69,6 +71,8 @@ struct Program<'a, 'w> {
     lit: bool,
     /// Dwell not yet written, s.
     dwell_s: f64,
+    /// The settling of the last stage move, s.
+    settle_s: f64,
     /// The pen whose power and feed were last written (layer index; none: the profile's).
     pen: Option<Option<usize>>,
     /// That pen's feed (F), mm/min.
@@ -90,6 +94,7 @@ impl<'a, 'w> Program<'a, 'w> {
             out: String::with_capacity(CHUNK_BYTES + 4096),
             lit: false,
             dwell_s: 0.0,
+            settle_s: 0.0,
             pen: None,
             feed: String::new(),
             comment_layers: false,
@@ -177,9 +182,18 @@ M65 P{sel}
         Ok(())
     }
 
-    /// A pause at rest, written as one dwell with the pauses next to it.
-    fn dwell(&mut self, duration_s: f64) {
-        self.dwell_s += duration_s;
+    /// A pause at rest of `kind`, written as one dwell with the pauses next to it: its own
+    /// time (the profile's delay, the stage move's settling), not the segment's, which holds
+    /// what the controller adds to the dwell as well.
+    fn dwell(&mut self, kind: SegmentKind) {
+        let laser = &self.profile.laser;
+        self.dwell_s += match kind {
+            SegmentKind::Settle => self.settle_s,
+            SegmentKind::JumpDelay => laser.jump_delay_s,
+            SegmentKind::LaserOnDelay => laser.on_delay_s,
+            SegmentKind::LaserOffDelay => laser.off_delay_s,
+            _ => 0.0,
+        };
     }
 
     fn flush_dwell(&mut self) {
@@ -300,6 +314,7 @@ M65 P{sel}
                         return Err(GcodeError::Unwritable { kind: seg.kind });
                     };
                     self.before_move(false);
+                    self.settle_s = mv.settle_s;
                     let to = mv.position(seg.duration_s);
                     if let Some(s) = toolpath.strokes.iter().find(|s| s.stage == to) {
                         if field != Some(s.field) {
@@ -347,7 +362,7 @@ M65 P{sel}
                     | SegmentKind::LaserOffDelay,
                     _,
                     _,
-                ) => self.dwell(seg.duration_s),
+                ) => self.dwell(seg.kind),
                 _ => return Err(GcodeError::Unwritable { kind: seg.kind }),
             }
         }

@@ -20,9 +20,42 @@
 //!   the move is done in the period where its remaining distance reaches zero, and the next move
 //!   starts in the period after. So a move takes a whole number of periods, at least two for
 //!   any move that needs to accelerate and brake.
-//! * **Dwells** (`G4 P`) are done by task, not the planner: task waits for motion to stop, then
-//!   polls its clock every task cycle. Measured on this machine's simulated LinuxCNC (1 ms task
-//!   cycle): P plus [`DWELL_OVERHEAD_S`].
+//! * **Task-level commands**: between two moves the step-and-scan program may have a dwell
+//!   (`G4 P`: settling, jump and laser delays next to each other, written as one) and dots
+//!   (`M64`, `G4 P<dot dwell>`, `M65`). Task runs them, not the planner (`emctaskmain.cc`): the
+//!   first waits for motion to come to rest, then each is issued in turn; a dwell ends at the
+//!   first task cycle that finds its time passed (`WAITING_FOR_DELAY`), and an output (`M64`,
+//!   `M65`) waits for motion to take the command (`usrmotWriteEmcmotCommand` polls for its echo,
+//!   one servo period). The run of commands between two moves takes
+//!   [`LinuxcncClock::dwell_s`] and [`LinuxcncClock::dot_s`] summed in order, `first` for the
+//!   first command after a move:
+//!   - after a move: [`TASK_RESUME_S`] (task finds motion done, and the next move restarts
+//!     after the run);
+//!   - a dwell first after a move: P rounded up to whole task cycles as they run
+//!     ([`TASK_CYCLE_RUN_S`]: `RCS_TIMER::wait` sleeps one `[TASK] CYCLE_TIME` from the end of
+//!     its last sleep, and each sleep overruns by the kernel's timer slack), at least one;
+//!   - a dwell after an output: P plus [`DWELL_TAIL_S`];
+//!   - an output: one servo period ([`LinuxcncClock::output_s`]); `M62`/`M63`, which the
+//!     program writes before a move that switches the laser, only after a dwell or a dot
+//!     (between moves motion takes it while it runs).
+//!
+//!   Measured on the simulated machine of the `linuxcnc` profile (1 ms servo period, 1 ms task
+//!   cycle): programs of 300 or 500 short scanner jumps (`G0 U1`, `G0 U0`), each followed by
+//!   the same commands, against the jumps alone, per jump (ms; law in brackets): `G4 P` of
+//!   0.1, 0.5, 0.9, 1.0 ms: 3.20–3.27 [3.23]; of 1.1, 1.5, 2.0 ms: 4.27–4.35 [4.31]; 2.5, 3.0:
+//!   5.39, 5.37 [5.38]; 4.0, 4.1: 6.44, 6.40 [6.46]; 5: 7.45 [7.53]; 6: 8.57 [8.61]; 8: 10.75
+//!   [10.76]; 10, 10.5: 12.92, 12.91 [12.91]; 20: 22.63 [22.58]. `M65`: 3.17 [3.16]; `M64 M65`:
+//!   4.17–4.21 [4.16]; `M64 M65 M64 M65`: 6.15 [6.16]. A dot (`M64`, `G4 P`, `M65`) of 0.1,
+//!   0.5, 1, 2, 5 ms: 4.37–4.39, 4.83, 5.37, 6.35, 9.32 [4.39, 4.79, 5.29, 6.29, 9.29]; `M65`
+//!   then `G4 P` 0.5, 2, 10 ms: 3.73, 5.29, 13.29 [3.79, 5.29, 13.29]; a laser-delayed dot
+//!   (`G4 P0.0001`, `M64`, `G4 P0.0005`, `M65`, `G4 P0.0001`): 5.99–6.09 [6.09]. Root mean
+//!   square error 0.04 ms. `M63` between moves: −0.06 [0]; `G4 P0.0001` then `M62` or `M63`:
+//!   4.09, 4.18 [4.23]; `G4 P0.002`, `M63`: 5.24 [5.31]; a dot then `M63`: 5.73 [5.79]. With a
+//!   0.5 ms servo period the law is off by up to 0.4 ms (`M65` 2.26 [2.66], a 0.1 ms dot 3.36
+//!   [3.37], a 2 ms dwell 4.23 [4.31]): its constants hold for the 1 ms periods galvoplan's
+//!   configuration writes. Whole jobs (scripts/check-linuxcnc.sh): the five-axis stand-in (a
+//!   dot between 0.1 ms laser delays at each of 300 placements) and demo.svg with 0.1/0.1/0.2 ms
+//!   laser and jump delays and 5 ms settling run within 0.2 % of the law.
 //!
 //! The law was checked against the simulated machine (docs/BENCHMARKS.md, *LinuxCNC*): a port of
 //! the planner's run-time code to Python reproduced the servo-period counts of exact-stop moves
@@ -35,10 +68,21 @@ use crate::document::{ControllerKind, MachineProfile};
 /// Remaining distance below which the planner takes a move as done, mm (`TP_POS_EPSILON`).
 pub const POSITION_EPS_MM: f64 = 1e-12;
 
-/// What a dwell costs beyond its own time, s: task waits for motion to come to rest, then checks
-/// its clock once per task cycle (1 ms in the configuration galvoplan writes); measured 3–12 ms,
-/// typically 4 ms, on the simulated machine.
-pub const DWELL_OVERHEAD_S: f64 = 4e-3;
+/// What the first task-level command after a move adds, s: task finds motion at rest (at its
+/// next cycle), and motion takes the next move after the run (its command's echo, the
+/// planner's first period). Measured (see the module documentation).
+pub const TASK_RESUME_S: f64 = 2.16e-3;
+
+/// `[TASK] CYCLE_TIME` of the configuration `galvoplan linuxcnc-config` writes, s.
+pub const TASK_CYCLE_S: f64 = 1e-3;
+
+/// A task cycle as it runs on the simulated machine, s: [`TASK_CYCLE_S`] from the end of the
+/// last sleep, plus the sleep's overrun (Linux's 50 µs timer slack and the wake-up, 75 µs).
+/// Measured: dwells of 1 to 20 ms first after a move took whole numbers of these.
+pub const TASK_CYCLE_RUN_S: f64 = TASK_CYCLE_S + 7.5e-5;
+
+/// What a dwell after an output (`M64`/`M65`) adds to its own time, s (measured).
+pub const DWELL_TAIL_S: f64 = 1.3e-4;
 
 /// Most servo periods one move is simulated for before the law falls back to the
 /// continuous-time trapezoid (a move longer than this many periods is timed to within one
@@ -131,13 +175,34 @@ impl LinuxcncClock {
             .sum()
     }
 
-    /// Time of a dwell of `p_s` (`G4 P`), with what task adds to it.
-    pub fn dwell_s(&self, p_s: f64) -> f64 {
-        if p_s > 0.0 {
-            p_s + DWELL_OVERHEAD_S
-        } else {
+    /// Time of a dwell of `p_s` (`G4 P`, pauses next to each other written as one), with what
+    /// task adds to it; `first`: the first command task runs after a move (else it follows a
+    /// dot's output). None for no dwell.
+    pub fn dwell_s(&self, p_s: f64, first: bool) -> f64 {
+        if p_s <= 0.0 {
             0.0
+        } else if first {
+            // the dwell starts at the task cycle that found motion done, and ends at the first
+            // cycle after its time (a whole-cycle dwell is not taken one cycle late)
+            let cycles = (p_s / TASK_CYCLE_RUN_S - 1e-9).ceil().max(1.0);
+            TASK_RESUME_S + cycles * TASK_CYCLE_RUN_S
+        } else {
+            p_s + DWELL_TAIL_S
         }
+    }
+
+    /// Time of a dot fired for `dwell_s` (`M64`, `G4 P`, `M65`); `first`: the first command
+    /// task runs after a move (else it follows a dwell).
+    pub fn dot_s(&self, dwell_s: f64, first: bool) -> f64 {
+        let resume = if first { TASK_RESUME_S } else { 0.0 };
+        resume + 2.0 * self.output_s() + dwell_s.max(0.0) + DWELL_TAIL_S
+    }
+
+    /// Time of a digital output issued after task-level commands, s: task waits for motion to
+    /// take it (one servo period). `M64`/`M65` always; `M62`/`M63` (switching the laser with
+    /// the next move) only after a dwell or a dot: between moves it is taken while motion runs.
+    pub fn output_s(&self) -> f64 {
+        self.period_s
     }
 }
 
@@ -222,6 +287,52 @@ mod tests {
         // tiny moves still take two periods (accelerate, brake), as measured
         assert_eq!(exact_stop_cycles(0.3, 300.0, 1e6, t), 2);
         assert_eq!(exact_stop_cycles(0.0, 300.0, 1e6, t), 0);
+    }
+
+    #[test]
+    fn task_commands_take_what_the_simulated_machine_measured() {
+        // per run of commands after a move, ms (the module documentation's table); each
+        // within 0.15 ms
+        let mut p = MachineProfile::builtin("linuxcnc").unwrap();
+        p.controller.servo_period_s = 1e-3;
+        let c = LinuxcncClock::of(&p).unwrap();
+        let ms = 1e-3;
+        let dwell = |p: f64| c.dwell_s(p * ms, true);
+        let out = c.period_s;
+        let cases = [
+            (dwell(0.1), 3.22),
+            (dwell(1.0), 3.27),
+            (dwell(1.1), 4.27),
+            (dwell(2.0), 4.33),
+            (dwell(3.0), 5.37),
+            (dwell(4.1), 6.40),
+            (dwell(10.0), 12.92),
+            (dwell(20.0), 22.63),
+            (TASK_RESUME_S + out, 3.17),
+            (TASK_RESUME_S + 2.0 * out, 4.19),
+            (c.dot_s(0.1 * ms, true), 4.38),
+            (c.dot_s(2.0 * ms, true), 6.35),
+            (TASK_RESUME_S + out + c.dwell_s(2.0 * ms, false), 5.29),
+            (dwell(0.1) + c.output_s(), 4.18),
+            (dwell(2.0) + c.output_s(), 5.24),
+            (
+                dwell(0.1) + c.dot_s(0.5 * ms, false) + c.dwell_s(0.1 * ms, false),
+                6.04,
+            ),
+        ];
+        for (k, (law, measured)) in cases.into_iter().enumerate() {
+            assert!(
+                (law / ms - measured).abs() <= 0.15,
+                "case {k}: law {} ms, measured {measured} ms",
+                law / ms
+            );
+        }
+        // no dwell costs nothing; a dwell of whole cycles is not taken one cycle late
+        assert_eq!(c.dwell_s(0.0, true), 0.0);
+        assert!(
+            (dwell(TASK_CYCLE_RUN_S / ms * 3.0) - TASK_RESUME_S - 3.0 * TASK_CYCLE_RUN_S).abs()
+                < 1e-15
+        );
     }
 
     #[test]

@@ -123,6 +123,7 @@ pub fn lower(
             .push_stroke(k, step.geometry, step.field, field.center, &path);
         b.mark(stroke, plan.mark_timing(g, profile));
     }
+    b.end_pauses();
     Ok(b.path)
 }
 
@@ -152,11 +153,18 @@ struct Builder<'a> {
     /// Where Z, A and B stand.
     pose_at: Pose,
     scan_at: Pt,
-    /// The controller's clock (LinuxCNC), which times moves and dwells; none: the scan head's
-    /// own timing.
+    /// The controller's clock (LinuxCNC), which times moves and task's commands; none: the
+    /// scan head's own timing.
     clock: Option<LinuxcncClock>,
-    /// The last segment was a pause: a pause next to it is the same dwell on the controller.
-    pausing: bool,
+    /// On a controller clock: the pauses since the last move or dot, not yet pushed (one dwell
+    /// on the controller, timed when it ends).
+    pauses: Vec<(SegmentKind, f64)>,
+    /// On a controller clock: the last thing done was a move (or nothing yet: the program
+    /// moves to the start), so that the next dwell or dot is the first command task runs after
+    /// it.
+    moved: bool,
+    /// On a controller clock: the laser output as the last move (or dot) left it.
+    lit: bool,
 }
 
 impl<'a> Builder<'a> {
@@ -170,12 +178,13 @@ impl<'a> Builder<'a> {
             pose_at: Pose::default(),
             scan_at: Pt::default(),
             clock: LinuxcncClock::of(profile),
-            pausing: false,
+            pauses: Vec::new(),
+            moved: true,
+            lit: false,
         }
     }
 
     fn push(&mut self, kind: SegmentKind, duration_s: f64, stage: StageMotion, scan: ScanMotion) {
-        self.pausing = matches!(stage, StageMotion::Hold(_)) && matches!(scan, ScanMotion::Hold(_));
         self.path.segments.push(Segment {
             kind,
             start_s: self.t_s,
@@ -187,21 +196,66 @@ impl<'a> Builder<'a> {
     }
 
     /// A pause with stage and scanner at rest (skipped when zero); on a controller clock, pauses
-    /// next to each other are one dwell.
+    /// next to each other are one dwell, pushed when it ends ([`Builder::end_pauses`]).
     fn hold(&mut self, kind: SegmentKind, duration_s: f64) {
-        let duration_s = match &self.clock {
-            Some(c) if !self.pausing => c.dwell_s(duration_s),
-            _ => duration_s,
-        };
-        if duration_s > 0.0 {
-            let (stage, scan) = (self.stage_at, self.scan_at);
-            self.push(
-                kind,
-                duration_s,
-                StageMotion::Hold(stage),
-                ScanMotion::Hold(scan),
-            );
+        if duration_s <= 0.0 {
+            return;
         }
+        if self.clock.is_some() {
+            self.pauses.push((kind, duration_s));
+        } else {
+            self.push_hold(kind, duration_s);
+        }
+    }
+
+    fn push_hold(&mut self, kind: SegmentKind, duration_s: f64) {
+        let (stage, scan) = (self.stage_at, self.scan_at);
+        self.push(
+            kind,
+            duration_s,
+            StageMotion::Hold(stage),
+            ScanMotion::Hold(scan),
+        );
+    }
+
+    /// On a controller clock, before a move, a dot or the end: the pauses held since the last
+    /// move or dot as one dwell, timed by the clock; its first pause carries what the clock
+    /// adds, the others their own time.
+    fn end_pauses(&mut self) {
+        let Some(clock) = &self.clock else {
+            return;
+        };
+        if self.pauses.is_empty() {
+            return;
+        }
+        let total_s: f64 = self.pauses.iter().map(|p| p.1).sum();
+        let dwell_s = clock.dwell_s(total_s, self.moved);
+        let rest_s: f64 = self.pauses[1..].iter().map(|p| p.1).sum();
+        let mut pauses = std::mem::take(&mut self.pauses);
+        for (k, &(kind, p_s)) in pauses.iter().enumerate() {
+            self.push_hold(kind, if k == 0 { dwell_s - rest_s } else { p_s });
+        }
+        pauses.clear();
+        self.pauses = pauses;
+        self.moved = false;
+    }
+
+    /// On a controller clock, before a move (`lit`: a mark): the pauses held since the last
+    /// move or dot as one dwell; after such task-level commands a move that switches the laser
+    /// (`M62`/`M63` before it) waits for that output too, added to the last of them.
+    fn before_move(&mut self, lit: bool) {
+        let Some(output_s) = self.clock.as_ref().map(LinuxcncClock::output_s) else {
+            return;
+        };
+        self.end_pauses();
+        if !self.moved && lit != self.lit {
+            if let Some(last) = self.path.segments.last_mut() {
+                last.duration_s += output_s;
+                self.t_s += output_s;
+            }
+        }
+        self.moved = true;
+        self.lit = lit;
     }
 
     /// A scanner jump to `offset` and its delay, the stage at rest.
@@ -212,6 +266,7 @@ impl<'a> Builder<'a> {
             None => d.norm() / self.profile.scanner.jump_speed_mm_s,
         };
         if move_s > 0.0 {
+            self.before_move(false);
             let from = self.scan_at;
             let stage = StageMotion::Hold(self.stage_at);
             let scan = ScanMotion::Line {
@@ -266,6 +321,7 @@ impl<'a> Builder<'a> {
         } else {
             ScanMotion::Hold(self.scan_at)
         };
+        self.before_move(false);
         self.path.stage_moves.push(mv);
         let moving = StageMotion::Move(self.path.stage_moves.len() - 1);
         self.push(SegmentKind::StageMove, move_s, moving, scan);
@@ -286,13 +342,25 @@ impl<'a> Builder<'a> {
         let laser = &self.profile.laser;
         let (on_s, off_s) = (laser.on_delay_s, laser.off_delay_s);
         self.hold(SegmentKind::LaserOnDelay, on_s);
+        let dot = is_dot(self.path.stroke_points(stroke));
+        if dot {
+            self.end_pauses();
+        } else {
+            self.before_move(true);
+        }
         let length_mm = self.path.strokes[stroke].length_mm;
         let points = self.path.stroke_points(stroke);
         let duration_s = match &self.clock {
-            Some(c) if is_dot(points) => c.dwell_s(timing.dot_dwell_s),
+            // M64, G4, M65: task-level commands, like a dwell
+            Some(c) if dot => c.dot_s(timing.dot_dwell_s, self.moved),
             Some(c) => c.polyline_s(points, timing.speed_mm_s),
             None => timing.mark_s(points, length_mm),
         };
+        if dot {
+            // the program switches the laser off (M63) before a dot where a mark left it on
+            self.moved = false;
+            self.lit = false;
+        }
         let stage = StageMotion::Hold(self.stage_at);
         self.push(
             SegmentKind::Mark,

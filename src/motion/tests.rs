@@ -202,3 +202,88 @@ fn on_the_clock_marks_start_and_end_on_ticks() {
         assert!((w[0].end_s() - w[1].start_s).abs() < 1e-12);
     }
 }
+
+/// On a LinuxCNC clock, pauses next to each other are one dwell, timed as task runs it (first
+/// after a move: task's resume and whole task cycles; after a dot's output: its time and a
+/// tail), a dot costs its two outputs; the step-time model equals the lowering, and the program
+/// writes each dwell with the pauses' own times, not the law's.
+#[test]
+fn linuxcnc_dwells_and_dots_are_timed_by_task_and_written_with_their_own_times() {
+    use super::controller::{DWELL_TAIL_S, TASK_CYCLE_RUN_S, TASK_RESUME_S};
+    let mut profile = MachineProfile::builtin("linuxcnc").unwrap();
+    profile.laser.on_delay_s = 1e-4;
+    profile.laser.off_delay_s = 2e-4;
+    profile.laser.jump_delay_s = 3e-4;
+    profile.axis_x.settle_s = 5e-3;
+    let dot = |p: Pt| Geometry::new(vec![p], false, Source::default());
+    // two dots and a line in one field, a dot in a field 100 mm to the right
+    let g = vec![
+        dot(Pt::new(45.0, 50.0)),
+        dot(Pt::new(50.0, 55.0)),
+        line(Pt::new(40.0, 60.0), Pt::new(50.0, 60.0)),
+        dot(Pt::new(150.0, 50.0)),
+    ];
+    let fields = vec![
+        field(0, Pt::new(50.0, 50.0)),
+        field(7, Pt::new(150.0, 50.0)),
+    ];
+    let steps = vec![step(0, 0), step(1, 0), step(2, 0), step(3, 7)];
+    let mut p = plan(fields.clone(), steps.clone());
+    p.profile = profile.clone();
+    let tp = lower(&g, &p, &profile).unwrap();
+    let clock = super::controller::LinuxcncClock::of(&profile).unwrap();
+    let dwell = crate::document::MarkTiming::of(None, &profile).dot_dwell_s;
+    // dwells: on delay (first after the move to the start), off delay (after a dot), jump and
+    // on delay (after a jump) twice, off delay (after the line), settling and on delay (after
+    // the stage move: 5.1 ms, five task cycles), off delay (after a dot); the line's M62 and
+    // the M63 after it wait for motion (after a dwell each)
+    let tc = TASK_CYCLE_RUN_S;
+    let tail = 2e-4 + DWELL_TAIL_S;
+    let holds = 5.0 * TASK_RESUME_S + 9.0 * tc + 3.0 * tail + 2.0 * clock.output_s();
+    let held: f64 = tp
+        .segments
+        .iter()
+        .filter(|s| {
+            matches!(
+                s.kind,
+                SegmentKind::Settle
+                    | SegmentKind::JumpDelay
+                    | SegmentKind::LaserOnDelay
+                    | SegmentKind::LaserOffDelay
+            )
+        })
+        .map(|s| s.duration_s)
+        .sum();
+    assert!((held - holds).abs() < 1e-12, "{held} vs {holds}");
+    // dots, each after a dwell: M64, the dwell and its tail, M65
+    let dots: Vec<f64> = tp
+        .segments
+        .iter()
+        .filter(|s| s.kind == SegmentKind::Mark)
+        .map(|s| s.duration_s)
+        .collect();
+    let one = 2.0 * clock.period_s + dwell + DWELL_TAIL_S;
+    for k in [0, 1, 3] {
+        assert!((dots[k] - one).abs() < 1e-12, "{dots:?}");
+    }
+    assert_eq!(one, clock.dot_s(dwell, false));
+    // the step-time model takes the same time
+    let model =
+        crate::order::objective::StepTime::new(&g, &fields, &[], &profile).job_time_s(&steps);
+    assert!(
+        (model - tp.duration_s()).abs() <= 1e-9 * tp.duration_s(),
+        "{model} vs {}",
+        tp.duration_s()
+    );
+    // the program's dwells: the pauses' own times, added where they are next to each other
+    let gcode = crate::export::write_gcode(&tp, &p, 297.0, "t").unwrap();
+    let dwells: Vec<&str> = gcode
+        .lines()
+        .filter_map(|l| l.strip_prefix("G4 P"))
+        .collect();
+    let d = crate::geom::format_mm(dwell, 7);
+    let want = [
+        "0.0001", &d, "0.0002", "0.0004", &d, "0.0002", "0.0004", "0.0002", "0.0051", &d, "0.0002",
+    ];
+    assert_eq!(dwells, want, "{gcode}");
+}

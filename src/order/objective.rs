@@ -18,7 +18,7 @@
 
 use crate::document::{pen_of, Geometry, Layer, MachineProfile, MarkTiming, Pose, ScanField, Step};
 use crate::geom::{is_dot, Pt};
-use crate::motion::controller::LinuxcncClock;
+use crate::motion::controller::{LinuxcncClock, TASK_RESUME_S};
 use crate::motion::StageDynamics;
 use std::collections::HashMap;
 
@@ -32,7 +32,8 @@ pub struct StepTime<'a> {
     jump_speed_mm_s: f64,
     jump_delay_s: f64,
     /// Per geometry: laser-on delay + mark + laser-off delay, s (on a controller clock: the
-    /// mark alone; [`StepTime::sum_clocked`] adds the delays as dwells).
+    /// mark alone, a dot as if it followed a dwell; [`StepTime::sum_clocked`] adds the delays
+    /// as dwells, and what a dot first after a move adds).
     mark_s: Vec<f64>,
     /// The controller's clock (LinuxCNC), which times moves and dwells as `motion::lower` does
     /// on it.
@@ -55,7 +56,7 @@ impl<'a> StepTime<'a> {
             .map(|g| {
                 let timing = MarkTiming::of(pen_of(layers, g), profile);
                 match &clock {
-                    Some(c) if is_dot(&g.points) => c.dwell_s(timing.dot_dwell_s),
+                    Some(c) if is_dot(&g.points) => c.dot_s(timing.dot_dwell_s, false),
                     // every start vertex and direction marks the same edges
                     Some(c) => c.polyline_s(&g.marking_path(0, false), timing.speed_mm_s),
                     None => {
@@ -135,21 +136,41 @@ impl<'a> StepTime<'a> {
 impl StepTime<'_> {
     /// [`StepTime::sum`] on a controller clock, by `motion::lower`'s rules there: a field
     /// change is one coordinated move of stage and scanner (never shorter than the stage's own
-    /// trapezoids), a jump is an exact-stop move, and pauses next to each other (settling, jump
-    /// delay, laser-on delay) are one dwell.
+    /// trapezoids), a jump is an exact-stop move, pauses next to each other (settling, jump
+    /// delay, laser delays) are one dwell, and a dwell or a dot costs more as the first command
+    /// after a move.
     fn sum_clocked(&self, steps: &[Step], clock: &LinuxcncClock) -> f64 {
         let mut t = 0.0;
         let (mut stage_at, mut scan_at) = (Pt::default(), Pt::default());
         let mut pose_at = Pose::default();
-        // the last thing done was a pause: the next pause joins its dwell
-        let mut pausing = false;
-        let hold = |t: &mut f64, pausing: &mut bool, d: f64| {
-            let d = if *pausing { d } else { clock.dwell_s(d) };
+        // the pauses since the last move or dot (one dwell), and whether a move came last
+        // (the program moves to the start first)
+        let mut pausing = 0.0;
+        let mut moved = true;
+        let hold = |pausing: &mut f64, d: f64| {
             if d > 0.0 {
-                *t += d;
-                *pausing = true;
+                *pausing += d;
             }
         };
+        let end_pauses = |t: &mut f64, pausing: &mut f64, moved: &mut bool| {
+            if *pausing > 0.0 {
+                *t += clock.dwell_s(*pausing, *moved);
+                *pausing = 0.0;
+                *moved = false;
+            }
+        };
+        // the laser as the last move or dot left it: a move that switches it after a dwell or
+        // a dot waits for its output (M62/M63)
+        let mut lit = false;
+        let before_move =
+            |t: &mut f64, pausing: &mut f64, moved: &mut bool, lit_at: &mut bool, lit: bool| {
+                end_pauses(t, pausing, moved);
+                if !*moved && lit != *lit_at {
+                    *t += clock.output_s();
+                }
+                *moved = true;
+                *lit_at = lit;
+            };
         for (k, s) in steps.iter().enumerate() {
             let Some((centre, pose, start, end)) = self.place(s) else {
                 return f64::INFINITY;
@@ -161,27 +182,41 @@ impl StepTime<'_> {
                 let j = offset.minus(scan_at);
                 let jump_s = clock.move_s([0.0, 0.0, j.x, j.y], None);
                 if jump_s > 0.0 {
+                    before_move(&mut t, &mut pausing, &mut moved, &mut lit, false);
                     t += jump_s;
-                    pausing = false;
                 }
-                hold(&mut t, &mut pausing, self.jump_delay_s);
+                hold(&mut pausing, self.jump_delay_s);
             } else {
                 let mv = self.stage.plan_pose_move(stage_at, &pose_at, centre, &pose);
                 let (d, j) = (centre.minus(stage_at), offset.minus(scan_at));
                 let turn = pose_at.turn_to(&pose);
+                before_move(&mut t, &mut pausing, &mut moved, &mut lit, false);
                 t += clock
                     .move_axes_s([d.x, d.y, j.x, j.y], turn, None)
                     .max(mv.move_s);
-                pausing = false;
-                hold(&mut t, &mut pausing, mv.settle_s);
+                hold(&mut pausing, mv.settle_s);
                 (stage_at, pose_at) = (centre, pose);
             }
-            hold(&mut t, &mut pausing, self.laser.on_delay_s);
+            hold(&mut pausing, self.laser.on_delay_s);
+            let dot = self
+                .geometries
+                .get(s.geometry)
+                .is_some_and(|g| is_dot(&g.points));
+            if dot {
+                end_pauses(&mut t, &mut pausing, &mut moved);
+                // first after a move: what task adds after one (the dot's own part is in mark_s)
+                if moved {
+                    t += TASK_RESUME_S;
+                }
+                (moved, lit) = (false, false);
+            } else {
+                before_move(&mut t, &mut pausing, &mut moved, &mut lit, true);
+            }
             t += self.mark_s[s.geometry];
-            pausing = false;
-            hold(&mut t, &mut pausing, self.laser.off_delay_s);
+            hold(&mut pausing, self.laser.off_delay_s);
             scan_at = end.minus(stage_at);
         }
+        end_pauses(&mut t, &mut pausing, &mut moved);
         t
     }
 }
