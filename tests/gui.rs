@@ -2518,6 +2518,17 @@ fn a_five_axis_job_shows_its_axes_in_their_units_and_compares_time_with_distance
     ] {
         assert!(h.query_by_label(gone).is_none(), "{gone}");
     }
+    // the plan is stale for the machine's change, said without the rows of the axes it lacks
+    let stale = h.state().plan_staleness(0).to_vec();
+    assert!(
+        stale.iter().any(|w| w.starts_with("stroke Y 300 → 0")),
+        "{stale:?}"
+    );
+    assert!(
+        stale.iter().any(|w| w.starts_with("axis A max velocity ")),
+        "{stale:?}"
+    );
+    assert!(!stale.iter().any(|w| w.starts_with("base Y")), "{stale:?}");
     let why = h.state().solve_blocker().unwrap();
     assert!(
         why.contains("needs axis Z (") && !why.contains("0000"),

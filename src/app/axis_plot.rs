@@ -130,9 +130,11 @@ pub fn show(
                     .collect();
                 pui.line(Line::new(name, points).color(COLOURS[k]));
             }
+            // 2 px: the grid line at 100 % under it must not fill its gaps
             pui.hline(
                 HLine::new("", 100.0)
                     .color(LIMIT)
+                    .width(2.0)
                     .style(LineStyle::dashed_loose()),
             );
             if let Some(t) = t_s {

@@ -111,8 +111,13 @@ pub fn staleness(plan: &Plan, doc: &Document) -> Vec<String> {
     } else if fields_key(&plan.fields) != fields_key(&doc.fields) {
         why.push("the scan fields changed".to_string());
     }
+    // rows of an axis the new machine does not have are not said (its Y on a rotary machine)
+    let profile_rows: Vec<_> = super::spec::profile_specs()
+        .into_iter()
+        .filter(|s| super::spec::profile_row_present(s, &doc.profile))
+        .collect();
     why.extend(super::spec::differences(
-        &super::spec::profile_specs(),
+        &profile_rows,
         &plan.profile,
         &doc.profile,
     ));
