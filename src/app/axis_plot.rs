@@ -7,7 +7,7 @@ use super::motion_plots::{
     PLOT_STEP_S, SPEED_DT_S,
 };
 use crate::document::{ExtraAxisId, MachineProfile};
-use crate::motion::Toolpath;
+use crate::motion::{PoseTrack, Toolpath};
 use egui::Color32;
 use egui_plot::{HLine, Legend, Line, LineStyle, Plot, PlotPoints, VLine};
 
@@ -27,16 +27,18 @@ pub struct AxisSamples {
     pub t_s: Vec<f64>,
     /// Per axis (X, Y, Z, A, B): |speed| at each sample, mm/s or deg/s.
     pub speed: [Vec<f64>; 5],
+    /// Per axis: the highest sampled speed, mm/s or deg/s (the title's peaks).
+    pub peak: [f64; 5],
 }
 
 impl AxisSamples {
-    /// Samples a toolpath that turns or lifts an axis beyond X/Y every [`PLOT_STEP_S`] (at
-    /// most [`MAX_SAMPLES`]); `None` for any other.
-    pub fn of(tp: &Toolpath) -> Option<Self> {
-        if tp.route.is_some() || !tp.moves_extra_axes() {
+    /// Samples a toolpath that turns or lifts an axis beyond X/Y, where Z, A and B stand on
+    /// `track` (its [`Toolpath::pose_track`]), every [`PLOT_STEP_S`] (at most
+    /// [`MAX_SAMPLES`]); `None` on the fly.
+    pub fn of(tp: &Toolpath, track: &PoseTrack) -> Option<Self> {
+        if tp.route.is_some() {
             return None;
         }
-        let track = tp.pose_track();
         let at = |t: f64| {
             let stage = tp.state_at(t).stage;
             let [z, a, b] = track.at(t).values();
@@ -47,7 +49,9 @@ impl AxisSamples {
             let (p0, p1) = (at(t - SPEED_DT_S / 2.0), at(t + SPEED_DT_S / 2.0));
             out.t_s.push(t);
             for k in 0..5 {
-                out.speed[k].push((p1[k] - p0[k]).abs() / SPEED_DT_S);
+                let v = (p1[k] - p0[k]).abs() / SPEED_DT_S;
+                out.speed[k].push(v);
+                out.peak[k] = out.peak[k].max(v);
             }
         }
         Some(out)
@@ -88,10 +92,7 @@ pub fn show(
     };
     let peaks: Vec<String> = axes
         .iter()
-        .map(|&(name, k, limit, _)| {
-            let peak = share(k, limit).into_iter().fold(0.0, f64::max);
-            format!("{name} {peak:.0} %")
-        })
+        .map(|&(name, k, limit, _)| format!("{name} {:.0} %", 100.0 * s.peak[k] / limit))
         .collect();
     let limits: Vec<String> = axes
         .iter()
@@ -180,7 +181,7 @@ mod tests {
             order,
         );
         let tp = crate::motion::lower(&geometries, &plan, &profile).unwrap();
-        let s = AxisSamples::of(&tp).unwrap();
+        let s = AxisSamples::of(&tp, &tp.pose_track()).unwrap();
         let b_peak = s.speed[4].iter().copied().fold(0.0, f64::max);
         let b_limit = profile.axis_b.as_ref().unwrap().0.max_velocity;
         assert!(
@@ -195,6 +196,6 @@ mod tests {
             .iter_mut()
             .for_each(|f| f.pose = Pose::default());
         let tp = crate::motion::lower(&geometries, &plan, &flat).unwrap();
-        assert!(AxisSamples::of(&tp).is_none());
+        assert!(!tp.moves_extra_axes());
     }
 }

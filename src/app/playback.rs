@@ -110,15 +110,10 @@ pub fn state_text(l: &Lowered, t_s: f64) -> String {
     };
     // Z, A and B where the job turns them
     let pose = l.poses.as_ref().map_or(String::new(), |track| {
-        let p = track.at(t_s).values();
-        let words = ["Z", "A", "B"];
-        (0..3)
-            .filter(|&k| l.pose_axes[k])
-            .map(|k| match k {
-                0 => format!(", Z {:.1} mm", p[0]),
-                _ => format!(", {} {:.1}°", words[k], p[k]),
-            })
-            .collect()
+        format!(
+            ", {}",
+            super::words::pose_axes_words(&track.at(t_s), l.pose_axes, 1)
+        )
     });
     format!(
         "{doing}{how}; stage ({:.1}, {:.1}) mm{pose}; laser {}",

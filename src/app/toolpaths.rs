@@ -47,8 +47,9 @@ impl Lowered {
         }
         let route_mm = route_points_mm(&toolpath);
         let motion = MotionSamples::of(&toolpath);
-        let axes = AxisSamples::of(&toolpath);
+        // a job that turns Z, A or B: where they stand, and their speeds for the plot
         let poses = toolpath.moves_extra_axes().then(|| toolpath.pose_track());
+        let axes = poses.as_ref().and_then(|t| AxisSamples::of(&toolpath, t));
         let start = toolpath.start_pose.values();
         let pose_axes = [0, 1, 2].map(|k| {
             start[k] != 0.0

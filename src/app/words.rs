@@ -7,17 +7,22 @@ use crate::document::{MachineProfile, Pose, ScanField};
 /// A pose in words, the axes `profile` has and any other the pose turns (`Z -60.83 mm,
 /// A 29.65°, B -36.81°`): empty for a flat machine's rest pose.
 pub fn pose_words(pose: &Pose, profile: &MachineProfile) -> String {
+    let shown = crate::document::ExtraAxisId::ALL
+        .map(|id| profile.extra_axis(id).is_some() || pose.values()[id.index()] != 0.0);
+    pose_axes_words(pose, shown, 2)
+}
+
+/// The `shown` axes of a pose (Z, A, B) in words with `decimals`: `Z -60.8 mm, A 29.6°`.
+pub fn pose_axes_words(pose: &Pose, shown: [bool; 3], decimals: usize) -> String {
     crate::document::ExtraAxisId::ALL
         .into_iter()
-        .filter_map(|id| {
+        .filter(|id| shown[id.index()])
+        .map(|id| {
             let v = pose.values()[id.index()];
-            if profile.extra_axis(id).is_none() && v == 0.0 {
-                return None;
+            match id {
+                crate::document::ExtraAxisId::Z => format!("Z {v:.decimals$} mm"),
+                _ => format!("{} {v:.decimals$}°", id.word()),
             }
-            Some(match id {
-                crate::document::ExtraAxisId::Z => format!("Z {v:.2} mm"),
-                _ => format!("{} {v:.2}°", id.word()),
-            })
         })
         .collect::<Vec<_>>()
         .join(", ")

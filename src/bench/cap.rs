@@ -161,12 +161,18 @@ pub fn order_three_ways(
         )?;
         Ok(tour.order)
     };
+    let say = |done: u64, what: &str| {
+        ctx.progress("order", done, 2, format!("{n} placements: {what}"));
+    };
+    say(0, "ordering by 3-D distance");
     let by_distance = search(TravelCost::Distance3d(poses.clone()), &as_is, seed)?;
+    say(1, "ordering by 5-axis time");
     let by_time = search(
         TravelCost::PoseTime(stage.clone(), poses),
         &by_distance,
         seed,
     )?;
+    say(2, "ordered three ways");
     let base_s = move_time_s(fields, &as_is, &stage);
     let row = |method, order: Vec<usize>| {
         let t = move_time_s(fields, &order, &stage);

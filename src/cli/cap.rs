@@ -2,6 +2,7 @@
 //! on a spherical cap, its placements ordered as is, by 3-D distance and by 5-axis time, each
 //! timed on a 5-axis profile; a Markdown table to stdout.
 
+use super::progress::BarProgress;
 use anyhow::{Context, Result};
 use clap::Args;
 use galvoplan::bench::cap::{order_three_ways, Cap, CapOrder};
@@ -9,11 +10,13 @@ use galvoplan::document::{
     save_project, sync_layers, write_atomic, Document, Geometry, MachineProfile, ScanField, Source,
     DEFAULT_LAYER,
 };
+use galvoplan::export::check_outputs;
 use galvoplan::geom::Pt;
 use galvoplan::import::ImportOptions;
-use galvoplan::job::JobCtx;
+use galvoplan::job::{CancelToken, JobCtx};
 use galvoplan::pipeline::{load_production, place_document_fields};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 #[derive(Args, Debug)]
 pub struct CapBenchArgs {
@@ -40,11 +43,32 @@ pub struct CapBenchArgs {
     #[arg(long, value_name = "OUT.galvoplan")]
     project: Option<PathBuf>,
     /// How many placements the project holds (from the layout's first).
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", requires = "project")]
     placements: Option<usize>,
 }
 
+/// The files the run reads that exist (built-in profile names are not files).
+fn inputs(a: &CapBenchArgs) -> Vec<&Path> {
+    [
+        a.artwork.as_path(),
+        Path::new(&a.layout_profile),
+        Path::new(&a.profile),
+    ]
+    .into_iter()
+    .filter(|p| p.exists())
+    .collect()
+}
+
+/// The files the run writes, with what each is.
+fn outputs(a: &CapBenchArgs) -> Vec<(&'static str, &Path)> {
+    [("JSON rows", &a.json), ("project", &a.project)]
+        .into_iter()
+        .filter_map(|(what, p)| Some((what, p.as_deref()?)))
+        .collect()
+}
+
 pub fn run(a: &CapBenchArgs) -> Result<()> {
+    check_outputs(&inputs(a), &outputs(a))?;
     anyhow::ensure!(
         a.radius.is_finite() && a.radius > 0.0,
         "--radius must be a positive number of mm, not {}",
@@ -62,7 +86,8 @@ pub fn run(a: &CapBenchArgs) -> Result<()> {
     let mut doc = loaded.doc;
     // a layout only: strokes larger than a field are cut at field borders
     doc.settings.split_oversize = true;
-    let ctx = JobCtx::default();
+    let progress = Arc::new(BarProgress::new());
+    let ctx = JobCtx::new(CancelToken::new(), progress.clone());
     place_document_fields(&mut doc, &ctx)?;
     let cap = Cap {
         radius_mm: a.radius,
@@ -77,7 +102,9 @@ pub fn run(a: &CapBenchArgs) -> Result<()> {
             .check_pose(f.id, &f.pose)
             .with_context(|| format!("{source}: on the cap of radius {} mm", a.radius))?;
     }
-    let rows = order_three_ways(&laid, &profile, a.seed, &ctx)?;
+    let rows = order_three_ways(&laid, &profile, a.seed, &ctx);
+    progress.finish();
+    let rows = rows?;
     print!("{}", table(&rows, laid.len(), &profile.name, a.radius));
     if let Some(p) = &a.json {
         let text = serde_json::to_string_pretty(&rows)?;

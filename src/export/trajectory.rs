@@ -52,8 +52,15 @@ pub fn trajectory_csv(toolpath: &Toolpath, period_s: f64, axes: &[ExtraAxisId]) 
     let track = (!axes.is_empty()).then(|| toolpath.pose_track());
     for k in 0..samples {
         let t_s = k as f64 * period_s;
-        push_row(&mut out, t_s, &toolpath.state_at(t_s), 7, mm_decimals);
-        push_axes(&mut out, track.as_ref(), t_s, axes, mm_decimals);
+        let extra = extra_axes(track.as_ref(), t_s, axes);
+        push_row(
+            &mut out,
+            t_s,
+            &toolpath.state_at(t_s),
+            &extra,
+            7,
+            mm_decimals,
+        );
     }
     out
 }
@@ -67,23 +74,13 @@ fn push_header(out: &mut String, axes: &[ExtraAxisId]) {
     out.push('\n');
 }
 
-/// The axes beyond X/Y at `t_s`, at the end of the row [`push_row`] wrote.
-fn push_axes(
-    out: &mut String,
-    track: Option<&PoseTrack>,
-    t_s: f64,
-    axes: &[ExtraAxisId],
-    decimals: usize,
-) {
+/// The positions of `axes` (beyond X/Y) at `t_s` on `track` (none without a track).
+fn extra_axes(track: Option<&PoseTrack>, t_s: f64, axes: &[ExtraAxisId]) -> Vec<f64> {
     let Some(track) = track else {
-        return;
+        return Vec::new();
     };
     let pose = track.at(t_s).values();
-    out.pop();
-    for id in axes {
-        let _ = write!(out, ",{:.decimals$}", pose[id.index()]);
-    }
-    out.push('\n');
+    axes.iter().map(|id| pose[id.index()]).collect()
 }
 
 /// Decimals of the positions sampled every `period_s`: 6 (1 nm … 1 µm) at 1 ms, two more for
@@ -95,17 +92,18 @@ fn position_decimals(period_s: f64) -> usize {
     6 + 2 * tenfolds.min(3.0) as usize
 }
 
-/// One CSV row in [`TRAJECTORY_HEADER`]'s columns: time with `t_decimals`, positions (mm) with
-/// `mm_decimals`.
+/// One CSV row in [`TRAJECTORY_HEADER`]'s columns, then the `extra` axes' positions: time with
+/// `t_decimals`, positions (mm, deg) with `mm_decimals`.
 fn push_row(
     out: &mut String,
     t_s: f64,
     m: &crate::motion::MachineState,
+    extra: &[f64],
     t_decimals: usize,
     mm_decimals: usize,
 ) {
     let (t, p) = (t_decimals, mm_decimals);
-    let _ = writeln!(
+    let _ = write!(
         out,
         "{t_s:.t$},{:.p$},{:.p$},{:.p$},{:.p$},{}",
         m.stage.x,
@@ -114,6 +112,10 @@ fn push_row(
         m.scan.y,
         u8::from(m.laser)
     );
+    for v in extra {
+        let _ = write!(out, ",{v:.p$}");
+    }
+    out.push('\n');
 }
 
 /// The toolpath's exact states, one CSV row each (the trajectory's columns): the start, every
@@ -128,8 +130,8 @@ pub fn waypoints_csv(toolpath: &Toolpath, axes: &[ExtraAxisId]) -> String {
     let track = (!axes.is_empty()).then(|| toolpath.pose_track());
     for (t_s, m) in states {
         // exact states: time to the nanosecond, positions to 0.1 µm
-        push_row(&mut out, t_s, &m, 9, 7);
-        push_axes(&mut out, track.as_ref(), t_s, axes, 7);
+        let extra = extra_axes(track.as_ref(), t_s, axes);
+        push_row(&mut out, t_s, &m, &extra, 9, 7);
     }
     out
 }
