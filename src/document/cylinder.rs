@@ -17,7 +17,48 @@
 //! predistort`] subdivides it until the scanner's straight moves land within a chord tolerance
 //! of it on the surface.
 
+use super::MachineProfile;
 use crate::geom::Pt;
+use thiserror::Error;
+
+/// A cylinder job the machine or the drawing cannot make.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum CylinderError {
+    /// Not a diameter.
+    #[error("the cylinder's diameter must be a positive number of mm, not {0}")]
+    Diameter(f64),
+    /// The machine has no rotary A axis.
+    #[error("a cylinder job needs an A axis: the machine '{profile}' has {axes}")]
+    NoRotary {
+        /// The machine's name.
+        profile: String,
+        /// Its axes in words.
+        axes: String,
+    },
+    /// The profile does not say its depth of focus.
+    #[error("a cylinder job needs the scanner's depth of focus ([scanner] depth_of_focus_mm) in the machine '{0}'")]
+    NoDepthOfFocus(String),
+    /// A drawing taller than the circumference.
+    #[error("the drawing is {height:.2} mm high around the cylinder, more than its circumference {circumference:.2} mm (⌀{diameter} mm)")]
+    TooTall {
+        /// The drawing's height (its y extent), mm.
+        height: f64,
+        /// π·D, mm.
+        circumference: f64,
+        /// D, mm.
+        diameter: f64,
+    },
+    /// Strips thinner than the laser spot.
+    #[error("on ⌀{diameter} mm the strips in focus would be {strip:.3} mm high, thinner than the {spot} mm spot: a larger depth of focus or diameter is needed")]
+    ThinStrips {
+        /// D, mm.
+        diameter: f64,
+        /// The strip's height, mm.
+        strip: f64,
+        /// The spot, mm.
+        spot: f64,
+    },
+}
 
 /// A cylinder on the rotary axis.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -31,6 +72,41 @@ pub struct Cylinder {
 const MAX_DEPTH: u32 = 8;
 
 impl Cylinder {
+    /// Checks a cylinder job of a drawing `height_mm` high around the cylinder on `profile`;
+    /// returns the strips' height in focus, mm.
+    pub fn check(&self, profile: &MachineProfile, height_mm: f64) -> Result<f64, CylinderError> {
+        let d = self.diameter_mm;
+        if !(d.is_finite() && d > 0.0) {
+            return Err(CylinderError::Diameter(d));
+        }
+        if profile.axis_a.is_none() {
+            return Err(CylinderError::NoRotary {
+                profile: profile.name.clone(),
+                axes: profile.axes_words(),
+            });
+        }
+        let dof = profile
+            .scanner
+            .depth_of_focus_mm
+            .ok_or_else(|| CylinderError::NoDepthOfFocus(profile.name.clone()))?;
+        let circumference = self.circumference_mm();
+        if height_mm > circumference {
+            return Err(CylinderError::TooTall {
+                height: height_mm,
+                circumference,
+                diameter: d,
+            });
+        }
+        let strip = self.strip_height_mm(dof, profile.field_mm[1]);
+        if strip < profile.laser.spot_mm {
+            return Err(CylinderError::ThinStrips {
+                diameter: d,
+                strip,
+                spot: profile.laser.spot_mm,
+            });
+        }
+        Ok(strip)
+    }
     /// Radius, mm.
     pub fn radius_mm(&self) -> f64 {
         self.diameter_mm / 2.0
@@ -42,7 +118,10 @@ impl Cylinder {
     /// The largest angle from the top still in focus, rad: `acos(1 − DOF/R)`.
     pub fn focus_half_angle(&self, dof_mm: f64) -> f64 {
         let r = self.radius_mm();
-        (1.0 - dof_mm / r).clamp(-1.0, 1.0).acos().min(std::f64::consts::FRAC_PI_2)
+        (1.0 - dof_mm / r)
+            .clamp(-1.0, 1.0)
+            .acos()
+            .min(std::f64::consts::FRAC_PI_2)
     }
     /// The arc height of a strip in focus, mm: `2·R·acos(1 − DOF/R)`, at most the upper half,
     /// capped by the scan field's height `field_mm` (whose ±half the scanner reaches: the arc
@@ -124,10 +203,7 @@ impl Cylinder {
         [0.25, 0.5, 0.75]
             .into_iter()
             .map(|t| {
-                let landed = Pt::new(
-                    a.x + t * edge.x,
-                    self.arc_of(va + t * (vb - va), a_deg),
-                );
+                let landed = Pt::new(a.x + t * edge.x, self.arc_of(va + t * (vb - va), a_deg));
                 // distance from the unrolled edge (its line; the landed point stays between
                 // the ends' normals)
                 if len == 0.0 {
@@ -144,6 +220,42 @@ impl Cylinder {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn bad_cylinder_jobs_are_one_line() {
+        let mut rotary = MachineProfile::builtin("rotary").unwrap();
+        rotary.scanner.depth_of_focus_mm = Some(0.8);
+        let c = Cylinder { diameter_mm: 40.0 };
+        assert!((c.check(&rotary, 100.0).unwrap() - 11.35).abs() < 0.01);
+        let words = |e: CylinderError| e.to_string();
+        let e = words(c.check(&rotary, 130.0).unwrap_err());
+        assert!(
+            e.contains("130.00 mm high") && e.contains("circumference 125.66 mm"),
+            "{e}"
+        );
+        let e = words(c.check(&MachineProfile::default(), 10.0).unwrap_err());
+        assert!(e.contains("needs an A axis") && e.contains("X, Y"), "{e}");
+        let e = words(
+            Cylinder { diameter_mm: 0.0 }
+                .check(&rotary, 1.0)
+                .unwrap_err(),
+        );
+        assert!(e.contains("not 0"), "{e}");
+        rotary.scanner.depth_of_focus_mm = Some(1e-7);
+        let e = words(c.check(&rotary, 10.0).unwrap_err());
+        assert!(e.contains("thinner than the 0.05 mm spot"), "{e}");
+        rotary.scanner.depth_of_focus_mm = None;
+        assert!(words(c.check(&rotary, 10.0).unwrap_err()).contains("depth_of_focus_mm"));
+        // a DOF of zero is refused with the profile
+        let e = MachineProfile::from_toml("[scanner]\ndepth_of_focus_mm = 0.0\n", "p.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("Depth of focus (mm) must be a positive number, not 0"),
+            "{e}"
+        );
+        assert!(!e.contains('\n'));
+    }
 
     #[test]
     fn strips_in_focus_follow_the_depth_of_focus_and_the_field() {

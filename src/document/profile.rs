@@ -107,6 +107,11 @@ pub struct ScannerSpeeds {
     pub jump_speed_mm_s: f64,
     /// Mark (laser on) speed in mm/s.
     pub mark_speed_mm_s: f64,
+    /// How far the surface may lie below the focus and still mark as in focus, mm: the height
+    /// of a strip around a cylinder follows from it (document/cylinder.rs). None: not known
+    /// (cylinder jobs need it).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub depth_of_focus_mm: Option<f64>,
 }
 
 impl Default for ScannerSpeeds {
@@ -114,6 +119,7 @@ impl Default for ScannerSpeeds {
         Self {
             jump_speed_mm_s: 5_000.0,
             mark_speed_mm_s: 1_000.0,
+            depth_of_focus_mm: None,
         }
     }
 }

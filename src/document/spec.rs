@@ -500,6 +500,14 @@ fn scanner_to_gcode_specs() -> Vec<FieldSpec<MachineProfile>> {
             Positive,
             |p| p.scanner.mark_speed_mm_s
         ),
+        optional!(
+            "Depth of focus",
+            "mm",
+            "scanner.depth_of_focus_mm",
+            "how far below the focus the surface still marks: a cylinder's strips follow from it",
+            Positive,
+            |p| p.scanner.depth_of_focus_mm
+        ),
         number!(
             "Laser on delay",
             "s",
