@@ -17,6 +17,30 @@
 //! predistort`] subdivides it until the scanner's straight moves land within a chord tolerance
 //! of it on the surface.
 
+// Work in progress (branch `cylinder`, issue 51), the way planned for the pipeline:
+//
+// * `Document.cylinder: Option<Cylinder>` (a job input, like the tray; in `PlanInputs` and the
+//   plan, so that a change makes plans stale and the lowering knows it); `--cylinder D` in the
+//   CLI, a Cylinder section in the GUI.
+// * Placement on the unrolled plane: a placement profile with `field_mm = [field_w, strip
+//   height]` and `stroke_mm = [stroke_x, drawing height]`; oversize strokes cut at the strips'
+//   borders (seams, as `--split-oversize`). Each field gets `pose.a_deg = angle_deg(centre y)`
+//   (beyond 360° where the drawing crosses the wrap line: no gap, no double mark).
+// * Stage position of a strip: `(centre x, stage Y over the cylinder's axis)`, not the unrolled
+//   centre: one mapping (`ScanField` → stage position) used by the lowering, `StepTime`, the
+//   time-order field path and the lower bound, so that no Y move is timed for a strip change.
+// * Lowering: the marking path pre-distorted by its field's angle (`predistort`, the chord
+//   tolerance of the import); each scanner edge timed at the pen's speed on the *surface*
+//   (its unrolled length / speed): per-edge Mark parts (`start_frac`, `end_frac`), as on the
+//   fly; G-code `F` per `G1` from the same ratio.
+// * Distance on a cylinder: chord between strip centres on the surface,
+//   `√(dx² + (2R·sin(Δθ/2))²)`.
+// * Outputs: report `cylinder {diameter, dof, strip height}`, each field's `a_deg`; the
+//   trajectory's `a_deg` column (exists); LinuxCNC: XAUV (exists), a cylinder job in
+//   check-linuxcnc.sh.
+// * Acceptance test: map every program move back (sampled along moves): axial = X + U,
+//   arc = R·(A·π/180 + asin(V/R)); within 0.02 mm of the flattened artwork, covered once.
+
 use super::MachineProfile;
 use crate::geom::Pt;
 use thiserror::Error;
