@@ -22,6 +22,8 @@ use std::path::Path;
 use std::time::Instant;
 use thiserror::Error;
 
+mod cylinder;
+
 /// A pipeline failure; the message names the file where one is involved.
 #[derive(Debug, Error)]
 pub enum PipelineError {
@@ -98,6 +100,14 @@ pub enum PipelineError {
         file: String,
         /// The cause.
         source: crate::document::ProductionError,
+    },
+    /// A cylinder job the machine or the drawing cannot make.
+    #[error("{file}: {source}")]
+    Cylinder {
+        /// The document's source file.
+        file: String,
+        /// The cause.
+        source: crate::document::CylinderError,
     },
     /// Hatching failed.
     #[error("{file}: {source}")]
@@ -188,8 +198,9 @@ pub fn load_production(
         return load_project_job(path, profile, settings, t0);
     }
     let mut opts = opts.clone();
-    opts.work_area_mm.get_or_insert(profile.stroke_mm);
-    opts.field_mm.get_or_insert(profile.field_mm);
+    let (stroke_mm, field_mm) = cylinder::import_reach(&profile, settings.cylinder);
+    opts.work_area_mm.get_or_insert(stroke_mm);
+    opts.field_mm.get_or_insert(field_mm);
     // the G-code's resolution: a unit in its last decimal
     opts.resolution_mm = profile.resolution_mm();
     let imported = import_file(path, &opts)?;
@@ -299,7 +310,10 @@ pub fn plan_document_lowered(
     doc: &mut Document,
     ctx: &JobCtx,
 ) -> Result<(Plan, Toolpath), PipelineError> {
-    check_poses(doc)?;
+    if doc.settings.cylinder.is_some() {
+        return plan_cylinder(doc, ctx);
+    }
+    check_poses(doc, &doc.fields)?;
     // a job whose fields turn Z, A or B has one motion: auto plans it step-and-scan
     let posed = doc.fields.iter().any(|f| !f.pose.is_rest());
     let auto = doc.settings.motion;
@@ -309,6 +323,25 @@ pub fn plan_document_lowered(
     let made = plan_step_or_auto(doc, ctx);
     doc.settings.motion = auto;
     made
+}
+
+/// [`plan_document_lowered`] on a cylinder: the strips placed on the work profile
+/// ([`cylinder::with_work_profile`]), then ordered and lowered on the machine.
+fn plan_cylinder(doc: &mut Document, ctx: &JobCtx) -> Result<(Plan, Toolpath), PipelineError> {
+    let t0 = Instant::now();
+    let (hatch_s, lower_bound) = cylinder::with_work_profile(doc, |doc| {
+        let hatch_s = derive_geometries(doc, ctx)?;
+        let (lower_bound, _) = place_and_choose(doc, ctx)?;
+        Ok((hatch_s, lower_bound))
+    })?;
+    let fields_s = (t0.elapsed().as_secs_f64() - hatch_s).max(0.0);
+    let (mut plan, toolpath) = order_document_lowered(doc, ctx)?;
+    plan.metrics.solve_s.hatch = hatch_s;
+    plan.metrics.solve_s.fields = fields_s;
+    plan.metrics.fields_lower_bound = Some(lower_bound);
+    plan.metrics.solve_s.total =
+        plan.metrics.solve_s.hatch + plan.metrics.solve_s.fields + plan.metrics.solve_s.order;
+    Ok((plan, toolpath))
 }
 
 /// [`plan_document_lowered`] once the poses are checked.
@@ -348,9 +381,9 @@ fn plan_step_or_auto(doc: &mut Document, ctx: &JobCtx) -> Result<(Plan, Toolpath
 
 /// The machine can take every field's pose, and a job whose fields turn or lift axes beyond X/Y
 /// is planned step-and-scan (on the fly keeps Z, A and B still).
-fn check_poses(doc: &Document) -> Result<(), PipelineError> {
+fn check_poses(doc: &Document, fields: &[ScanField]) -> Result<(), PipelineError> {
     let file = || doc.source.clone().unwrap_or_else(|| "document".into());
-    for f in &doc.fields {
+    for f in fields {
         doc.profile
             .check_pose(f.id, &f.pose)
             .map_err(|source| PipelineError::Pose {
@@ -358,7 +391,7 @@ fn check_poses(doc: &Document) -> Result<(), PipelineError> {
                 source: Box::new(source),
             })?;
     }
-    if doc.settings.motion == MotionMode::OnTheFly && doc.fields.iter().any(|f| !f.pose.is_rest()) {
+    if doc.settings.motion == MotionMode::OnTheFly && fields.iter().any(|f| !f.pose.is_rest()) {
         return Err(PipelineError::PosesOnTheFly {
             file: file(),
             axes: doc.profile.axes_words(),
@@ -584,7 +617,9 @@ fn relower(doc: &Document, plan: &mut Plan) -> Result<Toolpath, PipelineError> {
 /// at field borders, whichever the lowered job time says is faster ([`whole_or_cut`]); a
 /// step-and-scan solve stops with [`FieldError::Oversize`].
 pub fn place_document_fields(doc: &mut Document, ctx: &JobCtx) -> Result<usize, PipelineError> {
-    place_and_choose(doc, ctx).map(|(lower_bound, _)| lower_bound)
+    cylinder::with_work_profile(doc, |doc| {
+        place_and_choose(doc, ctx).map(|(lower_bound, _)| lower_bound)
+    })
 }
 
 /// [`place_document_fields`] for a workbench: where step-and-scan geometries are larger than
@@ -1019,15 +1054,17 @@ pub fn order_document_lowered(
     doc: &Document,
     ctx: &JobCtx,
 ) -> Result<(Plan, Toolpath), PipelineError> {
-    check_poses(doc)?;
+    let strips = cylinder::job_fields(doc)?;
+    let fields = strips.as_deref().unwrap_or(&doc.fields);
+    check_poses(doc, fields)?;
     let file = doc.source.clone().unwrap_or_else(|| "document".into());
     log_inputs(doc, ctx);
     let mut inputs = PlanInputs::of(doc);
-    if doc.fields.iter().any(|f| !f.pose.is_rest()) {
+    if fields.iter().any(|f| !f.pose.is_rest()) {
         // a job whose fields turn Z, A or B has one motion: auto plans it step-and-scan
         inputs.settings.motion = MotionMode::Step;
     }
-    let (plan, toolpath) = order_plan(&doc.geometries, &doc.fields, &inputs, ctx)
+    let (plan, toolpath) = order_plan(&doc.geometries, fields, &inputs, ctx)
         .map_err(|source| PipelineError::Order { file, source })?;
     complete_plan(doc, plan, toolpath, ctx)
 }

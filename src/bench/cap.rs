@@ -70,6 +70,7 @@ impl Cap {
             z_mm: h - radius,
             a_deg: -ny.asin().to_degrees(),
             b_deg: nx.atan2(nz).to_degrees(),
+            stage_y_mm: None,
         })
     }
     /// `fields` laid on the cap: each with its pose.

@@ -191,6 +191,11 @@ struct JobOpts {
     /// Cut geometries larger than a scan field at field borders (else they are an error).
     #[arg(long)]
     split_oversize: bool,
+    /// A cylinder job: the artwork is the unrolled surface (x along the axis, y around it in mm
+    /// of arc) of a cylinder of this diameter, mm, marked strip by strip on the rotary A axis
+    /// (the profile needs an A axis and [scanner] depth_of_focus_mm).
+    #[arg(long, value_name = "DIAMETER_MM")]
+    cylinder: Option<f64>,
     /// Chord tolerance for flattening curves, mm.
     #[arg(long, default_value_t = 0.01)]
     chord_tol: f64,
@@ -465,6 +470,9 @@ impl JobOpts {
             },
             hatch: self.hatch()?,
             seam: self.seam,
+            cylinder: self
+                .cylinder
+                .map(|diameter_mm| galvoplan::document::Cylinder { diameter_mm }),
         })
     }
     fn hatch(&self) -> Result<Option<HatchSettings>> {

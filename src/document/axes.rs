@@ -9,6 +9,7 @@
 use super::profile::AxisLimits;
 use super::validate::InvalidValue;
 use super::MachineProfile;
+use crate::geom::Pt;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
@@ -23,12 +24,24 @@ pub struct Pose {
     pub a_deg: f64,
     /// B (rotation about Y), degrees.
     pub b_deg: f64,
+    /// Where the stage's Y stands for this placement when not at its centre, mm: a cylinder's
+    /// strip, whose centre lies on the unrolled surface while the stage stays over the
+    /// cylinder's axis ([`super::Cylinder`]). None: at the centre.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stage_y_mm: Option<f64>,
 }
 
 impl Pose {
     /// The rest pose: nothing beyond X/Y.
     pub fn is_rest(&self) -> bool {
         *self == Pose::default()
+    }
+    /// Where the stage stands for a placement centred at `centre` in this pose.
+    pub fn stage_point(&self, centre: Pt) -> Pt {
+        match self.stage_y_mm {
+            Some(y) => Pt::new(centre.x, y),
+            None => centre,
+        }
     }
     /// How far each of Z, A and B moves from this pose to `to` (mm, deg, deg).
     pub fn turn_to(&self, to: &Pose) -> [f64; 3] {

@@ -17,31 +17,7 @@
 //! predistort`] subdivides it until the scanner's straight moves land within a chord tolerance
 //! of it on the surface.
 
-// Work in progress (branch `cylinder`, issue 51), the way planned for the pipeline:
-//
-// * `Document.cylinder: Option<Cylinder>` (a job input, like the tray; in `PlanInputs` and the
-//   plan, so that a change makes plans stale and the lowering knows it); `--cylinder D` in the
-//   CLI, a Cylinder section in the GUI.
-// * Placement on the unrolled plane: a placement profile with `field_mm = [field_w, strip
-//   height]` and `stroke_mm = [stroke_x, drawing height]`; oversize strokes cut at the strips'
-//   borders (seams, as `--split-oversize`). Each field gets `pose.a_deg = angle_deg(centre y)`
-//   (beyond 360° where the drawing crosses the wrap line: no gap, no double mark).
-// * Stage position of a strip: `(centre x, stage Y over the cylinder's axis)`, not the unrolled
-//   centre: one mapping (`ScanField` → stage position) used by the lowering, `StepTime`, the
-//   time-order field path and the lower bound, so that no Y move is timed for a strip change.
-// * Lowering: the marking path pre-distorted by its field's angle (`predistort`, the chord
-//   tolerance of the import); each scanner edge timed at the pen's speed on the *surface*
-//   (its unrolled length / speed): per-edge Mark parts (`start_frac`, `end_frac`), as on the
-//   fly; G-code `F` per `G1` from the same ratio.
-// * Distance on a cylinder: chord between strip centres on the surface,
-//   `√(dx² + (2R·sin(Δθ/2))²)`.
-// * Outputs: report `cylinder {diameter, dof, strip height}`, each field's `a_deg`; the
-//   trajectory's `a_deg` column (exists); LinuxCNC: XAUV (exists), a cylinder job in
-//   check-linuxcnc.sh.
-// * Acceptance test: map every program move back (sampled along moves): axial = X + U,
-//   arc = R·(A·π/180 + asin(V/R)); within 0.02 mm of the flattened artwork, covered once.
-
-use super::MachineProfile;
+use super::{MachineProfile, Pose};
 use crate::geom::Pt;
 use thiserror::Error;
 
@@ -72,6 +48,9 @@ pub enum CylinderError {
         /// D, mm.
         diameter: f64,
     },
+    /// On the fly around a cylinder (not made yet).
+    #[error("a cylinder is marked step-and-scan, the rotary at rest while a strip is marked: plan it with step-and-scan (or automatic motion)")]
+    OnTheFly,
     /// Strips thinner than the laser spot.
     #[error("on ⌀{diameter} mm the strips in focus would be {strip:.3} mm high, thinner than the {spot} mm spot: a larger depth of focus or diameter is needed")]
     ThinStrips {
@@ -85,10 +64,25 @@ pub enum CylinderError {
 }
 
 /// A cylinder on the rotary axis.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Cylinder {
     /// Diameter, mm.
     pub diameter_mm: f64,
+}
+
+/// How far the scanner's straight moves may land from the unrolled edge they mark, on the
+/// surface, mm: half the import's default chord tolerance (0.01 mm), so that flattening and
+/// landing together stay within 0.015 mm of the drawing.
+pub const LANDING_TOL_MM: f64 = 0.005;
+
+/// A path on the unrolled surface made ready for the scanner ([`Cylinder::predistort`]).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Predistorted {
+    /// The scanner's tool-centre points, mm.
+    pub scanner: Vec<Pt>,
+    /// The same points on the unrolled surface (the drawn path, refined), mm.
+    pub surface: Vec<Pt>,
 }
 
 /// Deepest subdivision of one edge (2⁸ pieces): far beyond what a chord tolerance needs on any
@@ -130,6 +124,58 @@ impl Cylinder {
             });
         }
         Ok(strip)
+    }
+    /// The profile the strips are placed with on the unrolled surface: the machine's, with
+    /// fields `strip_mm` high (the strips in focus, [`Cylinder::check`]) and a Y stroke of twice
+    /// the circumference, so that a drawing may cross the wrap line (y = π·D) without a cut.
+    pub fn work_profile(&self, machine: &MachineProfile, strip_mm: f64) -> MachineProfile {
+        let mut p = machine.clone();
+        p.field_mm[1] = strip_mm;
+        p.stroke_mm[1] = 2.0 * self.circumference_mm();
+        p
+    }
+    /// The stage's Y while marking: over the cylinder's axis, which lies under the middle of
+    /// the Y stroke (0 on a machine without Y).
+    pub fn stage_y_mm(machine: &MachineProfile) -> f64 {
+        machine.stroke_mm[1] / 2.0
+    }
+    /// Where the machine stands to mark the strip centred at arc `centre_y_mm`: the part turned
+    /// to the strip's angle (beyond 360° across the wrap line: no gap, no double mark), the
+    /// stage over the axis, and on a machine with Z the head raised by the radius so that the
+    /// focus stays on the cylinder's top (Z 0 focuses at the axis's height).
+    pub fn strip_pose(&self, machine: &MachineProfile, centre_y_mm: f64) -> Pose {
+        Pose {
+            z_mm: if machine.axis_z.is_some() {
+                self.radius_mm()
+            } else {
+                0.0
+            },
+            a_deg: self.angle_deg(centre_y_mm),
+            b_deg: 0.0,
+            stage_y_mm: Some(Self::stage_y_mm(machine)),
+        }
+    }
+    /// The surface length between two scanner points with the part at `a_deg` and the stage at
+    /// Y `stage_y`, mm: the distance of their unrolled images (a pre-distorted edge is a piece
+    /// of a straight unrolled edge).
+    pub fn surface_length_mm(&self, p: Pt, q: Pt, a_deg: f64, stage_y: f64) -> f64 {
+        self.unrolled(p, a_deg, stage_y)
+            .dist(self.unrolled(q, a_deg, stage_y))
+    }
+    /// The unrolled surface point the scanner's tool-centre point `p` lands on, mm.
+    pub fn unrolled(&self, p: Pt, a_deg: f64, stage_y: f64) -> Pt {
+        Pt::new(p.x, self.arc_of(p.y - stage_y, a_deg))
+    }
+    /// The scanner's speed along the pre-distorted edge `p`–`q` that marks the surface at
+    /// `surface_mm_s`, mm/s: slower by the edge's length against its surface length (by cos φ
+    /// across the strip).
+    pub fn scanner_speed_mm_s(&self, p: Pt, q: Pt, a_deg: f64, stage_y: f64, surface_mm_s: f64) -> f64 {
+        let s = self.surface_length_mm(p, q, a_deg, stage_y);
+        if s > 0.0 {
+            surface_mm_s * p.dist(q) / s
+        } else {
+            surface_mm_s
+        }
     }
     /// Radius, mm.
     pub fn radius_mm(&self) -> f64 {
@@ -179,41 +225,34 @@ impl Cylinder {
         self.radius_mm() * (1.0 - self.phi(arc_mm, a_deg).cos())
     }
     /// The unrolled polyline `path` (axial x, arc y) as the scanner's tool-centre points for a
-    /// strip at axial `centre_x`, stage Y `stage_y`, part at `a_deg`: each point at
-    /// `(x, stage_y + V)`, edges subdivided until the straight scanner moves land within
+    /// strip with the part at `a_deg` and the stage at Y `stage_y`: each point at
+    /// `(x, stage_y + V)`, edges bisected until the straight scanner moves land within
     /// `tol_mm` of the unrolled edge on the surface.
-    pub fn predistort(&self, path: &[Pt], a_deg: f64, stage_y: f64, tol_mm: f64) -> Vec<Pt> {
-        let at = |p: Pt| Pt::new(p.x, stage_y + self.scanner_v(p.y, a_deg));
-        let mut out = Vec::with_capacity(path.len());
+    pub fn predistort(&self, path: &[Pt], a_deg: f64, stage_y: f64, tol_mm: f64) -> Predistorted {
+        let mut surface = Vec::with_capacity(path.len());
         if let Some(&first) = path.first() {
-            out.push(at(first));
+            surface.push(first);
         }
         for w in path.windows(2) {
-            self.refine(w[0], w[1], a_deg, tol_mm, MAX_DEPTH, &at, &mut out);
+            self.refine(w[0], w[1], a_deg, tol_mm, MAX_DEPTH, &mut surface);
         }
-        out
+        let scanner = surface
+            .iter()
+            .map(|p| Pt::new(p.x, stage_y + self.scanner_v(p.y, a_deg)))
+            .collect();
+        Predistorted { scanner, surface }
     }
 
-    /// Appends the pre-distorted points after `a` up to `b` (an unrolled edge), bisecting
+    /// Appends the refined unrolled points after `a` up to `b` (an unrolled edge), bisecting
     /// while the scanner's straight move from `a` to `b` lands further than `tol_mm` from the
     /// edge at a quarter, half or three quarters.
-    #[allow(clippy::too_many_arguments)]
-    fn refine(
-        &self,
-        a: Pt,
-        b: Pt,
-        a_deg: f64,
-        tol_mm: f64,
-        depth: u32,
-        at: &dyn Fn(Pt) -> Pt,
-        out: &mut Vec<Pt>,
-    ) {
+    fn refine(&self, a: Pt, b: Pt, a_deg: f64, tol_mm: f64, depth: u32, out: &mut Vec<Pt>) {
         if depth > 0 && self.landing_error_mm(a, b, a_deg) > tol_mm {
             let m = Pt::new((a.x + b.x) / 2.0, (a.y + b.y) / 2.0);
-            self.refine(a, m, a_deg, tol_mm, depth - 1, at, out);
-            self.refine(m, b, a_deg, tol_mm, depth - 1, at, out);
+            self.refine(a, m, a_deg, tol_mm, depth - 1, out);
+            self.refine(m, b, a_deg, tol_mm, depth - 1, out);
         } else {
-            out.push(at(b));
+            out.push(b);
         }
     }
 
@@ -315,7 +354,7 @@ mod tests {
         // a diagonal across the strip, and an arc-wise line
         let path = [Pt::new(0.0, 15.0), Pt::new(8.0, 25.0), Pt::new(8.0, 16.0)];
         let tol = 0.005;
-        let out = c.predistort(&path, a_deg, 0.0, tol);
+        let out = c.predistort(&path, a_deg, 0.0, tol).scanner;
         assert!(out.len() > path.len());
         // every scanner chord, sampled finely, lands within tol of the unrolled path
         for w in out.windows(2) {

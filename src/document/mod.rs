@@ -32,7 +32,7 @@ pub use pens::{
     colour_word, layer_label, parse_colour, passes_of, pen_of, sync_layers, validate_layers, Layer,
     MarkTiming, Pen, PenLibrary, PensError, DEFAULT_LAYER, MAX_PASSES, PENS_VERSION,
 };
-pub use cylinder::{Cylinder, CylinderError};
+pub use cylinder::{Cylinder, CylinderError, Predistorted, LANDING_TOL_MM};
 pub use plan::{
     GenerationRecord, Metrics, MotionFigures, MotionRegion, ObjectiveKind, Plan, ScanField,
     StageTimes, Step, TimeBreakdown,

@@ -319,6 +319,10 @@ pub struct SolverSettings {
     /// where they cross a seam of the tiling.
     #[serde(default)]
     pub seam: crate::geom::seam::SeamForm,
+    /// A cylinder job: the artwork is the unrolled surface of this cylinder on the rotary A
+    /// axis (`--cylinder`); none: a flat job.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cylinder: Option<super::Cylinder>,
 }
 
 impl SolverSettings {
@@ -351,6 +355,7 @@ impl Default for SolverSettings {
             ga: GaParams::default(),
             hatch: None,
             seam: Default::default(),
+            cylinder: None,
         }
     }
 }

@@ -52,6 +52,8 @@ pub(super) struct PenWords {
     pub(super) on: String,
     pub(super) power: Option<f64>,
     pub(super) feed: String,
+    /// The feed, mm/min.
+    pub(super) feed_mm_min: f64,
     pub(super) comment: Option<String>,
     /// A dot's dwell (`G4 P`, seconds as RS274NGC reads it).
     pub(super) dot_dwell: String,
@@ -85,6 +87,7 @@ impl PenWords {
             on,
             power,
             feed: w.num(feed),
+            feed_mm_min: feed,
             comment,
             dot_dwell: crate::geom::format_mm(dot_dwell_s, 7),
         }
@@ -316,14 +319,26 @@ pub fn write_gcode_to(
             out.push_str(&pen.dot_dwell);
             out.push('\n');
         }
+        // around a cylinder each edge has its own feed: the one that marks the surface at the
+        // pen's (slower by cos φ across the strip)
+        let around = plan.settings.cylinder.map(|c| {
+            let a_deg = pose_of.get(&stroke.field).map_or(0.0, |p| p.a_deg);
+            (c, a_deg)
+        });
+        let mut from = first;
         for (j, &p) in rest.iter().enumerate() {
             out.push_str("G1 ");
             place(&mut out, p);
-            if j == 0 {
+            if let Some((c, a_deg)) = around {
+                let ratio = c.scanner_speed_mm_s(from, p, a_deg, stroke.stage.y, 1.0);
+                out.push_str(" F");
+                out.push_str(&w.num(pen.feed_mm_min * ratio));
+            } else if j == 0 {
                 out.push_str(" F");
                 out.push_str(&pen.feed);
             }
             out.push('\n');
+            from = p;
         }
         out.push_str(&d.laser_off);
         out.push('\n');

@@ -77,6 +77,8 @@ struct Program<'a, 'w> {
     pen: Option<Option<usize>>,
     /// That pen's feed (F), mm/min.
     feed: String,
+    /// That pen's mark speed, mm/s.
+    speed: f64,
     /// Layer comments are written (the plan's layers have pens of their own).
     comment_layers: bool,
 }
@@ -97,6 +99,7 @@ impl<'a, 'w> Program<'a, 'w> {
             settle_s: 0.0,
             pen: None,
             feed: String::new(),
+            speed: 0.0,
             comment_layers: false,
         }
     }
@@ -261,6 +264,7 @@ M65 P{sel}
             l.pen.mark_speed_mm_s(self.profile)
         });
         self.feed = self.w.num(speed * 60.0);
+        self.speed = speed;
         Ok(self.feed.clone())
     }
 
@@ -306,6 +310,8 @@ M65 P{sel}
                 self.scan_words(start.minus(first.stage))
             );
         }
+        // strokes whose marking has been written
+        let mut marked = 0;
         for seg in &toolpath.segments {
             self.spill(CHUNK_BYTES)?;
             match (seg.kind, seg.stage, seg.scan) {
@@ -316,7 +322,9 @@ M65 P{sel}
                     self.before_move(false);
                     self.settle_s = mv.settle_s;
                     let to = mv.position(seg.duration_s);
-                    if let Some(s) = toolpath.strokes.iter().find(|s| s.stage == to) {
+                    // the field of the next stroke marked (a cylinder's strips share a stage
+                    // position)
+                    if let Some(s) = toolpath.strokes.get(marked) {
                         if field != Some(s.field) {
                             field = Some(s.field);
                             self.field_comment(plan, s.field, to);
@@ -333,7 +341,13 @@ M65 P{sel}
                     self.before_move(false);
                     let _ = writeln!(self.out, "G0 {}", self.scan_words(to));
                 }
-                (SegmentKind::Mark, StageMotion::Hold(stage), ScanMotion::Mark { stroke, .. }) => {
+                (
+                    SegmentKind::Mark,
+                    StageMotion::Hold(stage),
+                    ScanMotion::Mark {
+                        stroke, start_frac, ..
+                    },
+                ) => {
                     let layer = toolpath.strokes.get(stroke).and_then(|s| s.layer);
                     let feed = self.pen_for(plan, layer, stroke)?;
                     let points = toolpath.stroke_points(stroke);
@@ -341,14 +355,33 @@ M65 P{sel}
                         return Err(GcodeError::EmptyStroke { stroke });
                     }
                     if crate::geom::is_dot(points) {
+                        marked += 1;
                         let pen = layer.and_then(|l| plan.layers.get(l)).map(|l| &l.pen);
                         self.dot(MarkTiming::of(pen, self.profile).dot_dwell_s);
                         continue;
                     }
+                    if start_frac > 0.0 {
+                        // a cylinder's edge by edge: the stroke's first part wrote them all
+                        continue;
+                    }
+                    marked += 1;
                     self.before_move(true);
-                    for (j, &p) in points.iter().enumerate().skip(1) {
-                        let words = self.scan_words(p.minus(stage));
-                        if j == 1 {
+                    let around = plan.settings.cylinder.map(|c| {
+                        let field = toolpath.strokes.get(stroke).map(|s| s.field);
+                        let a_deg = plan
+                            .fields
+                            .iter()
+                            .find(|f| Some(f.id) == field)
+                            .map_or(0.0, |f| f.pose.a_deg);
+                        (c, a_deg)
+                    });
+                    for (j, w) in points.windows(2).enumerate() {
+                        let words = self.scan_words(w[1].minus(stage));
+                        if let Some((c, a_deg)) = around {
+                            // the feed the lowering timed this edge with
+                            let speed = c.scanner_speed_mm_s(w[0], w[1], a_deg, stage.y, self.speed);
+                            let _ = writeln!(self.out, "G1 {words} F{}", self.w.num(speed * 60.0));
+                        } else if j == 0 {
                             let _ = writeln!(self.out, "G1 {words} F{feed}");
                         } else {
                             let _ = writeln!(self.out, "G1 {words}");

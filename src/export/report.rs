@@ -71,8 +71,25 @@ pub struct Report<'a> {
     /// the job is not a tray).
     #[serde(skip_serializing_if = "<[_]>::is_empty")]
     pub parts: &'a [PartRecord],
+    /// The cylinder of a cylinder job (absent on a flat one); each field's `pose.a_deg` is its
+    /// strip's angle.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cylinder: Option<ReportCylinder>,
     /// Import warnings.
     pub warnings: Vec<String>,
+}
+
+/// A cylinder job in the report.
+#[derive(Debug, Serialize)]
+pub struct ReportCylinder {
+    /// Diameter, mm.
+    pub diameter_mm: f64,
+    /// Circumference (the unrolled height), mm.
+    pub circumference_mm: f64,
+    /// The scanner's depth of focus, mm.
+    pub depth_of_focus_mm: Option<f64>,
+    /// The strips' height in focus (arc), mm.
+    pub strip_height_mm: Option<f64>,
 }
 
 /// The seams in the report.
@@ -133,6 +150,15 @@ pub fn report_json(source: &str, plan: &Plan, warnings: &[Warning]) -> String {
         pens: &plan.layers,
         history: &plan.history,
         parts: &plan.parts,
+        cylinder: plan.settings.cylinder.map(|c| {
+            let dof = plan.profile.scanner.depth_of_focus_mm;
+            ReportCylinder {
+                diameter_mm: c.diameter_mm,
+                circumference_mm: c.circumference_mm(),
+                depth_of_focus_mm: dof,
+                strip_height_mm: dof.map(|d| c.strip_height_mm(d, plan.profile.field_mm[1])),
+            }
+        }),
         seams: ReportSeams {
             count: plan.seams.seams(),
             length_mm: plan.seams.length_mm(),

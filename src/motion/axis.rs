@@ -113,6 +113,7 @@ impl StageMove {
             z_mm: z,
             a_deg: a,
             b_deg: b,
+            stage_y_mm: None,
         }
     }
     /// Move plus settling, s.
@@ -135,8 +136,11 @@ impl StageDynamics {
         self.plan_pose_move(from, &Pose::default(), to, &Pose::default())
     }
     /// The move from `from` at `from_pose` to `to` at `to_pose`. An axis the machine does not
-    /// have does not move ([`MachineProfile::check_pose`] refuses a pose that needs it).
+    /// have does not move ([`MachineProfile::check_pose`] refuses a pose that needs it). `from`
+    /// and `to` are placements' centres: the stage goes where their poses put it
+    /// ([`Pose::stage_point`]).
     pub fn plan_pose_move(&self, from: Pt, from_pose: &Pose, to: Pt, to_pose: &Pose) -> StageMove {
+        let (from, to) = (from_pose.stage_point(from), to_pose.stage_point(to));
         let x = AxisMove::new(from.x, to.x, &self.x);
         let y = AxisMove::new(from.y, to.y, &self.y);
         let (p, q) = (from_pose.values(), to_pose.values());

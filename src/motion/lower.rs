@@ -3,7 +3,9 @@
 use super::axis::StageDynamics;
 use super::controller::LinuxcncClock;
 use super::toolpath::{ScanMotion, Segment, SegmentKind, StageMotion, Toolpath};
-use crate::document::{Geometry, MachineProfile, MarkTiming, Plan, Pose, PoseError, ScanField};
+use crate::document::{
+    Geometry, MachineProfile, MarkTiming, Plan, Pose, PoseError, ScanField, LANDING_TOL_MM,
+};
 use crate::geom::{is_dot, Pt};
 use thiserror::Error;
 
@@ -117,11 +119,40 @@ pub fn lower(
                 geometry: step.geometry,
             });
         };
-        b.go_to(field.center, &field.pose, start.minus(field.center), k == 0);
+        let stage = field.pose.stage_point(field.center);
+        let timing = plan.mark_timing(g, profile);
+        let Some(cylinder) = plan.settings.cylinder else {
+            b.go_to(stage, &field.pose, start.minus(stage), k == 0);
+            let stroke = b
+                .path
+                .push_stroke(k, step.geometry, step.field, stage, &path);
+            b.mark(stroke, timing);
+            continue;
+        };
+        // around a cylinder: the scanner marks the path pre-distorted by the strip's angle,
+        // each edge at the speed that marks the surface at the pen's
+        let a_deg = field.pose.a_deg;
+        let scan = cylinder.predistort(&path, a_deg, stage.y, LANDING_TOL_MM);
+        let (Some(&start), Some(last)) = (scan.scanner.first(), scan.surface.len().checked_sub(1))
+        else {
+            continue;
+        };
+        b.go_to(stage, &field.pose, start.minus(stage), k == 0);
         let stroke = b
             .path
-            .push_stroke(k, step.geometry, step.field, field.center, &path);
-        b.mark(stroke, plan.mark_timing(g, profile));
+            .push_stroke(k, step.geometry, step.field, stage, &scan.scanner);
+        let surface_s = |j: usize| scan.surface[j].dist(scan.surface[j + 1]) / timing.speed_mm_s;
+        if last == 0 {
+            b.mark(stroke, timing);
+        } else {
+            b.mark_edges(stroke, &|j| {
+                let (p, q) = (scan.scanner[j], scan.scanner[j + 1]);
+                (
+                    surface_s(j),
+                    cylinder.scanner_speed_mm_s(p, q, a_deg, stage.y, timing.speed_mm_s),
+                )
+            });
+        }
     }
     b.end_pauses();
     Ok(b.path)
@@ -334,6 +365,46 @@ impl<'a> Builder<'a> {
         if !hidden {
             self.jump(offset);
         }
+    }
+
+    /// Marks stroke `stroke` (not a dot) edge by edge (a cylinder's pre-distorted path): on
+    /// delay, one mark part per edge, off delay. `edge(j)` is edge `j`'s time at the pen's speed on the
+    /// surface, s, and the scanner's speed along it, mm/s (on a controller clock, the `G1`'s
+    /// feed, whose exact-stop move the clock times).
+    fn mark_edges(&mut self, stroke: usize, edge: &dyn Fn(usize) -> (f64, f64)) {
+        let laser = &self.profile.laser;
+        let (on_s, off_s) = (laser.on_delay_s, laser.off_delay_s);
+        self.hold(SegmentKind::LaserOnDelay, on_s);
+        self.before_move(true);
+        let points = self.path.stroke_points(stroke).to_vec();
+        let length_mm = self.path.strokes[stroke].length_mm;
+        let mut along = 0.0;
+        for (j, w) in points.windows(2).enumerate() {
+            let (surface_s, scanner_mm_s) = edge(j);
+            let d = w[1].minus(w[0]);
+            let duration_s = match &self.clock {
+                Some(c) => c.move_s([0.0, 0.0, d.x, d.y], Some(scanner_mm_s)),
+                None => surface_s,
+            };
+            let start_frac = if length_mm > 0.0 { along / length_mm } else { 0.0 };
+            along += d.norm();
+            let end_frac = if j + 2 == points.len() || length_mm <= 0.0 {
+                1.0
+            } else {
+                (along / length_mm).min(1.0)
+            };
+            let stage = StageMotion::Hold(self.stage_at);
+            let scan = ScanMotion::Mark {
+                stroke,
+                start_frac,
+                end_frac,
+            };
+            self.push(SegmentKind::Mark, duration_s, stage, scan);
+        }
+        if let Some(&end) = points.last() {
+            self.scan_at = end.minus(self.stage_at);
+        }
+        self.hold(SegmentKind::LaserOffDelay, off_s);
     }
 
     /// Marks stroke `stroke` as its pen says (`timing`) from where the scanner stands: on

@@ -1,0 +1,88 @@
+//! A cylinder job in the pipeline ([`crate::document::Cylinder`]): the strips in focus are
+//! placed on the unrolled surface as fields of a work profile (the machine's, with the strips'
+//! height), each field is posed at its strip's angle, and the job is ordered and lowered as
+//! step-and-scan on the machine itself.
+
+use super::PipelineError;
+use crate::document::{Cylinder, CylinderError, Document, MachineProfile, MotionMode, ScanField};
+use crate::geom::BBox;
+
+/// The document's cylinder and its strips' height in focus, mm; none on a flat job. Fails with
+/// the job's one-line reason ([`Cylinder::check`]).
+pub(super) fn setup(doc: &Document) -> Result<Option<(Cylinder, f64)>, PipelineError> {
+    let Some(cylinder) = doc.settings.cylinder else {
+        return Ok(None);
+    };
+    let drawn = if doc.artwork.is_empty() {
+        &doc.geometries
+    } else {
+        &doc.artwork
+    };
+    let extent = drawn.iter().fold(BBox::EMPTY, |b, g| b.union(g.bbox()));
+    let height = if extent.is_empty() {
+        0.0
+    } else {
+        extent.max_y - extent.min_y
+    };
+    let err = |source| PipelineError::Cylinder {
+        file: doc.source.clone().unwrap_or_else(|| "document".into()),
+        source,
+    };
+    if doc.settings.motion == MotionMode::OnTheFly {
+        return Err(err(CylinderError::OnTheFly));
+    }
+    let strip = cylinder.check(&doc.profile, height).map_err(err)?;
+    Ok(Some((cylinder, strip)))
+}
+
+/// Runs `f` on the document with the profile its fields are made for: on a cylinder the work
+/// profile ([`Cylinder::work_profile`]), cutting what is larger than a strip at the strips'
+/// borders, step-and-scan; the machine's profile and the settings come back afterwards, and
+/// the fields get their strips' poses ([`pose_strips`]).
+pub(super) fn with_work_profile<T>(
+    doc: &mut Document,
+    f: impl FnOnce(&mut Document) -> Result<T, PipelineError>,
+) -> Result<T, PipelineError> {
+    let Some((cylinder, strip)) = setup(doc)? else {
+        return f(doc);
+    };
+    let work = cylinder.work_profile(&doc.profile, strip);
+    let machine = std::mem::replace(&mut doc.profile, work);
+    let settings = doc.settings.clone();
+    doc.settings.split_oversize = true;
+    doc.settings.motion = MotionMode::Step;
+    let out = f(doc);
+    doc.profile = machine;
+    doc.settings = settings;
+    let out = out?;
+    doc.fields = pose_strips(&doc.fields, &cylinder, doc);
+    Ok(out)
+}
+
+/// `fields` each posed at its strip's angle on `cylinder` ([`Cylinder::strip_pose`]).
+pub(super) fn pose_strips(fields: &[ScanField], cylinder: &Cylinder, doc: &Document) -> Vec<ScanField> {
+    fields
+        .iter()
+        .map(|f| ScanField {
+            pose: cylinder.strip_pose(&doc.profile, f.center.y),
+            ..f.clone()
+        })
+        .collect()
+}
+
+/// The fields an ordering of the document starts from: its own, on a cylinder each posed at
+/// its strip's angle (fields moved by hand since their placement turn with them).
+pub(super) fn job_fields(doc: &Document) -> Result<Option<Vec<ScanField>>, PipelineError> {
+    Ok(setup(doc)?.map(|(cylinder, _)| pose_strips(&doc.fields, &cylinder, doc)))
+}
+
+/// The reach an import places the artwork in: on a cylinder the unrolled surface's (twice around
+/// the circumference, strips in focus as fields), else the machine's; as (stroke, field), mm.
+pub(super) fn import_reach(profile: &MachineProfile, cylinder: Option<Cylinder>) -> ([f64; 2], [f64; 2]) {
+    let work = cylinder.and_then(|c| {
+        let dof = profile.scanner.depth_of_focus_mm?;
+        Some(c.work_profile(profile, c.strip_height_mm(dof, profile.field_mm[1])))
+    });
+    let p = work.as_ref().unwrap_or(profile);
+    (p.stroke_mm, p.field_mm)
+}
