@@ -23,6 +23,7 @@ use std::time::Instant;
 use thiserror::Error;
 
 mod cylinder;
+pub use cylinder::{cylinder_strips, view_profile};
 
 /// A pipeline failure; the message names the file where one is involved.
 #[derive(Debug, Error)]
@@ -596,6 +597,7 @@ fn relower(doc: &Document, plan: &mut Plan) -> Result<Toolpath, PipelineError> {
         &plan.fields,
         &plan.order,
         &plan.profile,
+        plan.settings.cylinder,
         &toolpath,
     );
     plan.metrics = crate::document::Metrics {

@@ -34,7 +34,9 @@ fn landed_marks(gcode: &str, radius: f64) -> (Vec<Vec<Pt>>, f64) {
         let mut next = (x, a, u, v);
         for w in words {
             let (k, val) = w.split_at(1);
-            let Ok(val) = val.parse::<f64>() else { continue };
+            let Ok(val) = val.parse::<f64>() else {
+                continue;
+            };
             match k {
                 "X" => next.0 = val,
                 "A" => next.1 = val,
@@ -50,7 +52,11 @@ fn landed_marks(gcode: &str, radius: f64) -> (Vec<Vec<Pt>>, f64) {
             }
             "M5" => on = false,
             "G1" if on => {
-                assert_eq!((next.0, next.1), (x, a), "the stage moves while marking: {line}");
+                assert_eq!(
+                    (next.0, next.1),
+                    (x, a),
+                    "the stage moves while marking: {line}"
+                );
                 for k in 1..=20 {
                     let t = f64::from(k) / 20.0;
                     let (su, sv) = (u + t * (next.2 - u), v + t * (next.3 - v));
@@ -70,12 +76,16 @@ fn landed_marks(gcode: &str, radius: f64) -> (Vec<Vec<Pt>>, f64) {
 /// before or after counts (a drawing across the wrap line, marks turned beyond 360°). Paths
 /// whose box lies further than 1 mm are at least that far.
 fn dist_to(p: Pt, path: &[Pt], circumference: f64) -> f64 {
-    let (x0, x1) = path.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), q| {
-        (a.min(q.x), b.max(q.x))
-    });
-    let (y0, y1) = path.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), q| {
-        (a.min(q.y), b.max(q.y))
-    });
+    let (x0, x1) = path
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), q| {
+            (a.min(q.x), b.max(q.x))
+        });
+    let (y0, y1) = path
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), q| {
+            (a.min(q.y), b.max(q.y))
+        });
     [-2.0, -1.0, 0.0, 1.0, 2.0]
         .into_iter()
         .map(|turns| {
@@ -140,7 +150,10 @@ fn marks_land_on_the_drawing(svg: &std::path::Path, diameter: f64) {
             worst = worst.max(d);
         }
     }
-    assert!(worst <= LAND_TOL_MM, "a mark lands {worst} mm from the drawing");
+    assert!(
+        worst <= LAND_TOL_MM,
+        "a mark lands {worst} mm from the drawing"
+    );
     // nothing unmarked: every 0.1 mm of the drawing lies on a mark
     let mut uncovered: f64 = 0.0;
     for g in &drawing {
@@ -148,7 +161,10 @@ fn marks_land_on_the_drawing(svg: &std::path::Path, diameter: f64) {
             let n = (w[0].dist(w[1]) / 0.1).ceil().max(1.0) as usize;
             for k in 0..=n {
                 let t = k as f64 / n as f64;
-                let p = Pt::new(w[0].x + t * (w[1].x - w[0].x), w[0].y + t * (w[1].y - w[0].y));
+                let p = Pt::new(
+                    w[0].x + t * (w[1].x - w[0].x),
+                    w[0].y + t * (w[1].y - w[0].y),
+                );
                 let d = marks
                     .iter()
                     .map(|m| dist_to(p, m, around))
@@ -157,7 +173,10 @@ fn marks_land_on_the_drawing(svg: &std::path::Path, diameter: f64) {
             }
         }
     }
-    assert!(uncovered <= LAND_TOL_MM, "the drawing is {uncovered} mm from any mark");
+    assert!(
+        uncovered <= LAND_TOL_MM,
+        "the drawing is {uncovered} mm from any mark"
+    );
     // nothing twice: the marks are as long as the drawing (covered, so no part twice)
     let (marked, drawn): (f64, f64) = (
         marks.iter().map(|m| length(m)).sum(),
@@ -194,6 +213,38 @@ fn a_drawing_across_the_wrap_line_is_marked_without_a_gap_or_a_double_mark() {
     marks_land_on_the_drawing(&svg, 40.0);
 }
 
+/// On a machine whose rotary is slow against X, ordering on job time turns the part less: never
+/// slower than ordering on the distance between strips on the surface.
+#[test]
+fn the_time_order_is_never_slower_than_the_distance_order_on_a_slow_rotary() {
+    let profile = MachineProfile::load(
+        &common::root()
+            .join("tests/data/profiles/slow-rotary.toml")
+            .display()
+            .to_string(),
+    )
+    .unwrap();
+    let svg = common::root().join("assets/examples/demo.svg");
+    let time = |cost| {
+        let settings = SolverSettings {
+            cylinder: Some(Cylinder { diameter_mm: 100.0 }),
+            cost_model: cost,
+            ..SolverSettings::default()
+        };
+        let mut doc = load_artwork(&svg, profile.clone(), settings, &ImportOptions::default())
+            .unwrap()
+            .doc;
+        let (plan, _) = plan_document_lowered(&mut doc, &JobCtx::default()).unwrap();
+        assert!(plan.fields.len() > 20, "{} strips", plan.fields.len());
+        plan.metrics.job_time_s.unwrap()
+    };
+    let (t, d) = (
+        time(galvoplan::document::CostModel::Time),
+        time(galvoplan::document::CostModel::Distance),
+    );
+    assert!(t <= d * 1.001, "by time {t} s, by distance {d} s");
+}
+
 fn galvoplan(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_galvoplan"))
         .args(args)
@@ -219,11 +270,25 @@ fn bad_cylinder_jobs_say_why_in_one_line() {
         .to_string();
     // taller than the circumference: 110 mm on ⌀30 (94.25 mm)
     let e = one_line_error(&galvoplan(&[
-        "plan", &sleeve, "--profile", "rotary", "--cylinder", "30", "-o", &out,
+        "plan",
+        &sleeve,
+        "--profile",
+        "rotary",
+        "--cylinder",
+        "30",
+        "-o",
+        &out,
     ]));
     assert!(e.contains("more than its circumference 94.25 mm"), "{e}");
     // no A axis
-    let e = one_line_error(&galvoplan(&["plan", &sleeve, "--cylinder", "40", "-o", &out]));
+    let e = one_line_error(&galvoplan(&[
+        "plan",
+        &sleeve,
+        "--cylinder",
+        "40",
+        "-o",
+        &out,
+    ]));
     assert!(e.contains("needs an A axis"), "{e}");
     // a DOF of zero
     let zero = dir.path().join("zero.toml");
@@ -238,7 +303,10 @@ fn bad_cylinder_jobs_say_why_in_one_line() {
         "-o",
         &out,
     ]));
-    assert!(e.contains("Depth of focus (mm) must be a positive number, not 0"), "{e}");
+    assert!(
+        e.contains("Depth of focus (mm) must be a positive number, not 0"),
+        "{e}"
+    );
     // strips thinner than the spot: a 1 µm DOF on ⌀1 mm
     let thin = dir.path().join("thin.toml");
     let rotary = std::fs::read_to_string(common::root().join("assets/profiles/rotary.toml"))
@@ -275,8 +343,16 @@ fn bad_cylinder_jobs_say_why_in_one_line() {
     assert!(e.contains("diameter"), "{e}");
     // on the fly
     let e = one_line_error(&galvoplan(&[
-        "plan", &sleeve, "--profile", "rotary", "--cylinder", "40", "--motion", "on-the-fly",
-        "-o", &out,
+        "plan",
+        &sleeve,
+        "--profile",
+        "rotary",
+        "--cylinder",
+        "40",
+        "--motion",
+        "on-the-fly",
+        "-o",
+        &out,
     ]));
     assert!(e.contains("step-and-scan"), "{e}");
 }

@@ -2535,3 +2535,33 @@ fn a_five_axis_job_shows_its_axes_in_their_units_and_compares_time_with_distance
         "{why}"
     );
 }
+
+/// A cylinder job in the workbench: the Cylinder section says the strips in focus in words,
+/// typing the diameter places strips of that height on the unrolled surface posed at their
+/// angles, the solve marks them, and the playback shows the angle.
+#[test]
+fn a_cylinder_job_places_strips_in_focus_and_says_their_height() {
+    let mut h = opened(&common::root().join("assets/examples/sleeve.svg"));
+    let rotary = galvoplan::document::MachineProfile::builtin("rotary").unwrap();
+    h.state_mut()
+        .execute(Command::SetProfile(Box::new(rotary)))
+        .unwrap();
+    settle(&mut h);
+    section(&mut h, "Cylinder");
+    h.get_by_label_contains("A flat job.");
+    set_text(&mut h, "Cylinder diameter (mm)", "40");
+    settle(&mut h);
+    h.get_by_label_contains("Cylinder ⌀40 mm: strips in focus are 11.35 mm high");
+    let doc = h.state().session.doc();
+    assert!(doc.fields.len() > 3);
+    for f in &doc.fields {
+        assert!((f.size[1] - 11.35).abs() < 0.01, "{:?}", f.size);
+        assert!((f.pose.a_deg - (f.center.y / 20.0).to_degrees()).abs() < 1e-9);
+    }
+    let plan = solve(&mut h, "Run HHA");
+    assert!(plan.metrics.job_time_s.unwrap() > 0.0);
+    // too thin a tube for this drawing: said in words
+    set_text(&mut h, "Cylinder diameter (mm)", "30");
+    settle(&mut h);
+    h.get_by_label_contains("Cylinder ⌀30 mm cannot be marked: the drawing is 110.00 mm high");
+}

@@ -231,7 +231,7 @@ impl Canvas<'_> {
             .chain(self.fields.iter().map(ScanField::bbox))
             .fold(BBox::EMPTY, BBox::union);
         if b.is_empty() || !b.width().is_finite() {
-            return Self::reach(self.profile);
+            return Self::reach(&self.profile);
         }
         let m = 0.03 * b.width().max(b.height()).max(1.0);
         (
@@ -276,7 +276,7 @@ impl Canvas<'_> {
             );
             let (lo, hi) = self.content_bounds();
             let (lo, hi) = if state.fit_whole {
-                let (rlo, rhi) = Canvas::reach(self.profile);
+                let (rlo, rhi) = Canvas::reach(&self.profile);
                 (
                     Pt::new(lo.x.min(rlo.x), lo.y.min(rlo.y)),
                     Pt::new(hi.x.max(rhi.x), hi.y.max(rhi.y)),
@@ -328,7 +328,7 @@ impl Canvas<'_> {
         } = state.drag
         {
             // the seam being moved, across the work area
-            let (lo, hi) = Canvas::reach(self.profile);
+            let (lo, hi) = Canvas::reach(&self.profile);
             let (a, b) = if axis == 0 {
                 (Pt::new(at_mm, lo.y), Pt::new(at_mm, hi.y))
             } else {
@@ -762,7 +762,7 @@ impl Canvas<'_> {
         match self.fields.iter().find(|f| f.geometries.contains(&k)) {
             Some(f) => lines.push(format!(
                 "  allocated to {} {}",
-                super::words::field_word(f, self.profile),
+                super::words::field_word(f, &self.profile),
                 super::words::field_number(self.fields, self.visiting, f.id)
             )),
             None if self.out_of_reach.contains(&k) => lines.push(
@@ -809,7 +809,7 @@ impl Canvas<'_> {
             ));
         }
         if let Some(f) = field {
-            let word = super::words::field_word(f, self.profile);
+            let word = super::words::field_word(f, &self.profile);
             let size = if word == "field" {
                 String::new()
             } else {
@@ -824,7 +824,7 @@ impl Canvas<'_> {
                 super::words::count(f.geometries.len(), "stroke", "strokes"),
                 if f.locked { ", locked" } else { "" }
             ));
-            let pose = super::words::pose_words(&f.pose, self.profile);
+            let pose = super::words::pose_words(&f.pose, &self.profile);
             if !pose.is_empty() {
                 lines.push(format!("  pose {pose}"));
             }

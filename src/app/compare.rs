@@ -847,7 +847,8 @@ fn plan_canvas<'a>(
     Canvas {
         label: "",
         geometries: &doc.geometries,
-        profile: &doc.profile,
+        profile: crate::pipeline::view_profile(doc),
+        cylinder: plan.settings.cylinder,
         fields: &plan.fields,
         seams: &plan.seams.lines,
         tiling: plan.tiling.as_ref(),

@@ -408,6 +408,8 @@ impl App {
             ui.selectable_value(&mut self.view.section, Section::Profile, "Machine profile");
             ui.selectable_value(&mut self.view.section, Section::Tray, "Tray")
                 .on_hover_text("Repeat the part over a tray: columns, rows, pitch, serial numbers");
+            ui.selectable_value(&mut self.view.section, Section::Cylinder, "Cylinder")
+                .on_hover_text("Mark around a cylinder on the rotary axis: its diameter");
         });
         ui.separator();
         match self.view.section {
@@ -429,6 +431,7 @@ impl App {
                 }
             }
             Section::Tray => self.tray_ui(ui),
+            Section::Cylinder => self.cylinder_ui(ui),
             Section::Profile => {
                 if let Some(cmd) = self
                     .panels
@@ -802,7 +805,8 @@ fn workbench_canvas<'a>(
     Canvas {
         label: "Work area",
         geometries: &doc.geometries,
-        profile: &doc.profile,
+        profile: crate::pipeline::view_profile(doc),
+        cylinder: doc.settings.cylinder,
         fields: &doc.fields,
         seams: &doc.seams.lines,
         tiling: doc.tiling.as_ref(),

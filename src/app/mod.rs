@@ -19,6 +19,7 @@ pub mod axis_plot;
 pub mod canvas;
 pub mod commands;
 pub mod compare;
+mod cylinder_panel;
 pub mod draw;
 pub mod files;
 mod hit;
@@ -161,6 +162,8 @@ pub enum Section {
     Profile,
     /// A production job: the part repeated over a tray, serials.
     Tray,
+    /// A cylinder job: the diameter, the strips in focus.
+    Cylinder,
 }
 
 /// Durations of recent frames.

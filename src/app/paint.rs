@@ -67,7 +67,7 @@ pub fn paint(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect, id: egu
 fn paint_background(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) {
     painter.rect_filled(rect, 0.0, Color32::from_gray(252));
     let s = |q: Pt| view.to_screen(rect, q);
-    let (lo, hi) = Canvas::reach(c.profile);
+    let (lo, hi) = Canvas::reach(&c.profile);
     let [sw, sh] = c.profile.stroke_mm;
     painter.rect_filled(Rect::from_two_pos(s(lo), s(hi)), 0.0, Color32::WHITE);
     painter.rect_stroke(
@@ -90,13 +90,58 @@ fn paint_background(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) 
         6.0,
         4.0,
     ));
-    painter.text(
-        s(Pt::new(0.0, 0.0)) + Vec2::new(2.0, -2.0),
-        Align2::LEFT_BOTTOM,
-        format!("base stroke {sw:.0} × {sh:.0} mm"),
-        FontId::proportional(11.0),
-        Color32::from_gray(120),
-    );
+    let Some(cylinder) = c.cylinder else {
+        painter.text(
+            s(Pt::new(0.0, 0.0)) + Vec2::new(2.0, -2.0),
+            Align2::LEFT_BOTTOM,
+            format!("base stroke {sw:.0} × {sh:.0} mm"),
+            FontId::proportional(11.0),
+            Color32::from_gray(120),
+        );
+        return;
+    };
+    paint_wrap_lines(painter, cylinder, (lo, hi), &s);
+}
+
+/// A cylinder's unrolled surface: its wrap lines (y = 0, one and two turns around, where the
+/// surface meets itself) dashed and named, across the reach.
+fn paint_wrap_lines(
+    painter: &Painter,
+    cylinder: crate::document::Cylinder,
+    (lo, hi): (Pt, Pt),
+    s: &dyn Fn(Pt) -> Pos2,
+) {
+    let around = cylinder.circumference_mm();
+    let colour = Color32::from_rgb(37, 99, 235);
+    for turn in 0..=2 {
+        let y = f64::from(turn) * around;
+        let line = [Pt::new(lo.x, y), Pt::new(hi.x, y)].map(s);
+        painter.extend(Shape::dashed_line(
+            &line,
+            Stroke::new(1.5, colour),
+            8.0,
+            5.0,
+        ));
+        let words = match turn {
+            0 => format!(
+                "cylinder ⌀{} mm unrolled: x along its axis, y around it (0°)",
+                crate::geom::format_mm(cylinder.diameter_mm, 3)
+            ),
+            _ => format!(
+                "wrap line: {} turn{} around ({:.1} mm), the surface meets itself",
+                turn,
+                if turn == 1 { "" } else { "s" },
+                y
+            ),
+        };
+        painter.text(
+            line[0] + Vec2::new(2.0, -2.0),
+            Align2::LEFT_BOTTOM,
+            words,
+            FontId::proportional(11.0),
+            colour,
+        );
+    }
 }
 
 /// A fingerprint of everything [`heavy_shapes`] draws but the view: a raster is shown only for
@@ -269,7 +314,7 @@ fn paint_field_labels(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect
             numbers.get_or_insert_with(|| super::words::field_numbers(c.fields, c.visiting));
         let number = numbers.get(&f.id).copied().unwrap_or_default();
         // a scan field shows its number; a region larger than the scan field says so
-        let name = match super::words::field_word(f, c.profile) {
+        let name = match super::words::field_word(f, &c.profile) {
             "field" => format!("{number}"),
             word => format!("{word} {number}"),
         };
@@ -462,7 +507,7 @@ fn idle_move_shapes(
     };
     let tp = &l.toolpath;
     let ends = |k: usize| {
-        let p = tp.stroke_points(k);
+        let p = l.points(k);
         p.first().copied().zip(p.last().copied())
     };
     for k in 1..tp.strokes.len() {
@@ -481,12 +526,11 @@ fn idle_move_shapes(
 
 /// The start `S` and end `E` of a planned path.
 fn paint_markers(painter: &Painter, l: &Lowered, view: &View, rect: Rect) {
-    let tp = &l.toolpath;
     let ends = |k: usize| {
-        let p = tp.stroke_points(k);
+        let p = l.points(k);
         p.first().copied().zip(p.last().copied())
     };
-    let n = tp.strokes.len();
+    let n = l.toolpath.strokes.len();
     if let (Some((start, _)), Some((_, end))) = (ends(0), n.checked_sub(1).and_then(ends)) {
         let s = |q: Pt| view.to_screen(rect, q);
         start_end_markers(painter, s(start), s(end));
@@ -771,7 +815,8 @@ mod tests {
         Canvas {
             label: "test",
             geometries: &doc.geometries,
-            profile: &doc.profile,
+            profile: std::borrow::Cow::Borrowed(&doc.profile),
+            cylinder: None,
             fields: &doc.fields,
             seams: &[],
             tiling: None,

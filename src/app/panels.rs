@@ -223,6 +223,8 @@ fn is_wide<T>(spec: &FieldSpec<T>) -> bool {
 pub struct Editors {
     profile: Form<MachineProfile>,
     settings: Form<SolverSettings>,
+    /// The Cylinder section's diameter.
+    cylinder: Form<SolverSettings>,
     /// Last error of choosing a built-in profile.
     file_error: Option<String>,
     /// A profile file to load or save, for the window to ask a path for.
@@ -238,6 +240,7 @@ impl Default for Editors {
                 ..Form::new(profile_specs())
             },
             settings: Form::new(settings_specs()),
+            cylinder: Form::new(spec::cylinder_specs()),
             file_error: None,
             file_request: None,
         }
@@ -251,7 +254,23 @@ impl Editors {
             .error
             .iter()
             .chain(&self.settings.error)
+            .chain(&self.cylinder.error)
             .any(Option::is_some)
+    }
+
+    /// The Cylinder section: the diameter, and what the machine makes of it in words
+    /// (`words`); returns the command for an accepted change.
+    pub fn cylinder_ui(
+        &mut self,
+        ui: &mut egui::Ui,
+        settings: &SolverSettings,
+        words: &str,
+    ) -> Option<Command> {
+        ui.add(egui::Label::new(words).wrap());
+        ui.add_space(4.0);
+        self.cylinder
+            .ui(ui, "cylinder-grid", settings, validate_settings)
+            .map(|s| Command::SetSettings(Box::new(s)))
     }
 
     /// A profile file to load or save that the operator asked for.

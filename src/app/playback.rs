@@ -275,7 +275,7 @@ pub fn paint(
         range
             .filter_map(|k| {
                 // at screen resolution, and none off the canvas
-                super::draw::screen_line(tp.stroke_points(k), false, &to_screen, clip)
+                super::draw::screen_line(l.points(k), false, &to_screen, clip)
                     .map(|pts| polyline(pts.into_iter(), marks))
             })
             .collect()
@@ -291,18 +291,24 @@ pub fn paint(
         &marks_done,
     );
     let state = tp.state_at(t_s);
+    // on a cylinder: the surface under the head, the strip in focus around it
+    let (tcp, stage_at) = l.shown_at(t_s);
+    let field_mm = match l.unrolled.as_ref().and_then(|u| u.strip_mm) {
+        Some(strip) => [field_mm[0], strip],
+        None => field_mm,
+    };
     if let Some(&(start_s, end_s)) = l.mark_s.get(n_done) {
         if state.laser && t_s >= start_s && end_s > start_s {
             let u = (t_s - start_s) / (end_s - start_s);
-            let pts = partial(tp.stroke_points(n_done), u, state.tcp());
+            let pts = partial(l.points(n_done), u, tcp);
             painter.add(polyline(pts.into_iter().map(to_screen), marks));
         }
     }
-    let stage = to_screen(state.stage);
+    let stage = to_screen(stage_at);
     let half = Pt::new(field_mm[0] / 2.0, field_mm[1] / 2.0);
     let r = Rect::from_two_pos(
-        to_screen(state.stage.minus(half)),
-        to_screen(state.stage.plus(half)),
+        to_screen(stage_at.minus(half)),
+        to_screen(stage_at.plus(half)),
     );
     painter.rect(
         r,
@@ -315,7 +321,7 @@ pub fn paint(
     let cross = Stroke::new(2.5, STAGE);
     painter.line_segment([stage - Vec2::X * arm, stage + Vec2::X * arm], cross);
     painter.line_segment([stage - Vec2::Y * arm, stage + Vec2::Y * arm], cross);
-    let spot = to_screen(state.tcp());
+    let spot = to_screen(tcp);
     if state.laser {
         painter.circle(spot, 6.0, LASER, Stroke::new(1.5, Color32::WHITE));
     } else {

@@ -53,7 +53,9 @@ pub struct Canvas<'a> {
     /// The artwork.
     pub geometries: &'a [Geometry],
     /// The machine (stroke and field size).
-    pub profile: &'a MachineProfile,
+    pub profile: std::borrow::Cow<'a, MachineProfile>,
+    /// A cylinder job's cylinder: the work area is its unrolled surface.
+    pub cylinder: Option<crate::document::Cylinder>,
     /// Fields to draw.
     pub fields: &'a [ScanField],
     /// Seams: where artwork larger than a field is cut (drawn with the fields).

@@ -31,6 +31,22 @@ pub struct Lowered {
     /// Per geometry (index), where its first stroke comes in the marking order, 0…1 (−1: not
     /// marked): the canvas colours marks by it.
     pub rank_by_geometry: Vec<f32>,
+    /// A cylinder job seen on its unrolled surface, as the canvas draws it (`None`: flat).
+    pub unrolled: Option<Unrolled>,
+}
+
+/// A cylinder job on the unrolled surface: the canvas shows the drawing where it lands, not
+/// the scanner's pre-distorted moves.
+#[derive(Debug, Clone)]
+pub struct Unrolled {
+    /// The cylinder.
+    pub cylinder: crate::document::Cylinder,
+    /// The stage's Y while marking (over the cylinder's axis), mm.
+    pub stage_y_mm: f64,
+    /// The strips' height in focus, mm (none: the profile says no depth of focus).
+    pub strip_mm: Option<f64>,
+    /// The toolpath with every stroke's points on the unrolled surface.
+    pub points: Toolpath,
 }
 
 impl Lowered {
@@ -68,7 +84,54 @@ impl Lowered {
             poses,
             pose_axes,
             rank_by_geometry,
+            unrolled: None,
         }
+    }
+
+    /// `toolpath` of `plan` indexed ([`Lowered::new`]), and on a cylinder seen on its unrolled
+    /// surface.
+    pub fn of(plan: &Plan, toolpath: Toolpath) -> Self {
+        let mut l = Self::new(toolpath);
+        if let Some(cylinder) = plan.settings.cylinder {
+            let angle: std::collections::HashMap<usize, f64> =
+                plan.fields.iter().map(|f| (f.id, f.pose.a_deg)).collect();
+            let points = l.toolpath.with_points_mapped(|st, p| {
+                let a = angle.get(&st.field).copied().unwrap_or(0.0);
+                cylinder.unrolled(p, a, st.stage.y)
+            });
+            let dof = plan.profile.scanner.depth_of_focus_mm;
+            l.unrolled = Some(Unrolled {
+                cylinder,
+                stage_y_mm: crate::document::Cylinder::stage_y_mm(&plan.profile),
+                strip_mm: dof.map(|d| cylinder.strip_height_mm(d, plan.profile.field_mm[1])),
+                points,
+            });
+        }
+        l
+    }
+
+    /// Stroke `k`'s points as the canvas draws them: on the unrolled surface for a cylinder.
+    pub fn points(&self, k: usize) -> &[Pt] {
+        match &self.unrolled {
+            Some(u) => u.points.stroke_points(k),
+            None => self.toolpath.stroke_points(k),
+        }
+    }
+
+    /// Where the canvas shows the tool point and the stage at `t_s` (on a cylinder: the surface
+    /// point under the scanner, and the middle of the strip under the head, with the part as
+    /// turned then).
+    pub fn shown_at(&self, t_s: f64) -> (Pt, Pt) {
+        let state = self.toolpath.state_at(t_s);
+        let (Some(u), Some(track)) = (&self.unrolled, &self.poses) else {
+            return (state.tcp(), state.stage);
+        };
+        let a = track.at(t_s).a_deg;
+        let tcp = u.cylinder.unrolled(state.tcp(), a, u.stage_y_mm);
+        let stage = u
+            .cylinder
+            .unrolled(Pt::new(state.stage.x, u.stage_y_mm), a, u.stage_y_mm);
+        (tcp, stage)
     }
 
     /// True when the stage moves on a continuous route while the scanner marks.
@@ -144,7 +207,7 @@ struct Entry {
 /// Lowers `plan` of `doc` and indexes it (or says in words why it cannot be lowered).
 fn lower(doc: &Document, plan: &Plan) -> Result<Arc<Lowered>, String> {
     lower_plan(doc, plan)
-        .map(|t| Arc::new(Lowered::new(t)))
+        .map(|t| Arc::new(Lowered::of(plan, t)))
         .map_err(|e| format!("cannot lower {} to a toolpath: {e}", plan.name))
 }
 
@@ -159,7 +222,7 @@ impl Prelowered {
     pub fn of(plan: &Plan, toolpath: Toolpath) -> Self {
         Self(Entry {
             key: Key::of(plan),
-            result: Ok(Arc::new(Lowered::new(toolpath))),
+            result: Ok(Arc::new(Lowered::of(plan, toolpath))),
         })
     }
 

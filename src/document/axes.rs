@@ -422,7 +422,8 @@ mod tests {
                 &Pose {
                     z_mm: -10.0,
                     a_deg: 20.0,
-                    b_deg: -30.0
+                    b_deg: -30.0,
+                    stage_y_mm: None,
                 }
             )
             .is_ok());

@@ -169,13 +169,27 @@ impl Cylinder {
     /// The scanner's speed along the pre-distorted edge `p`–`q` that marks the surface at
     /// `surface_mm_s`, mm/s: slower by the edge's length against its surface length (by cos φ
     /// across the strip).
-    pub fn scanner_speed_mm_s(&self, p: Pt, q: Pt, a_deg: f64, stage_y: f64, surface_mm_s: f64) -> f64 {
+    pub fn scanner_speed_mm_s(
+        &self,
+        p: Pt,
+        q: Pt,
+        a_deg: f64,
+        stage_y: f64,
+        surface_mm_s: f64,
+    ) -> f64 {
         let s = self.surface_length_mm(p, q, a_deg, stage_y);
         if s > 0.0 {
             surface_mm_s * p.dist(q) / s
         } else {
             surface_mm_s
         }
+    }
+    /// The 3-D distance between two points of the unrolled surface on the cylinder, mm: the
+    /// chord `√(dx² + (2R·sin(Δθ/2))²)`, Δθ their angle apart (a turn apart is the same point).
+    pub fn surface_distance_mm(&self, a: Pt, b: Pt) -> f64 {
+        let r = self.radius_mm();
+        let dy = 2.0 * r * ((b.y - a.y) / (2.0 * r)).sin().abs();
+        (b.x - a.x).hypot(dy)
     }
     /// Radius, mm.
     pub fn radius_mm(&self) -> f64 {

@@ -135,6 +135,11 @@ pub fn staleness(plan: &Plan, doc: &Document) -> Vec<String> {
         &planned,
         &now,
     ));
+    why.extend(super::spec::differences(
+        &super::spec::cylinder_specs(),
+        &planned,
+        &now,
+    ));
     why
 }
 

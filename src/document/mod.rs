@@ -3,8 +3,8 @@
 mod artwork_import;
 mod axes;
 mod choices;
-mod cylinder;
 mod code;
+mod cylinder;
 mod geometry;
 mod hatch;
 mod inputs;
@@ -23,6 +23,7 @@ mod warning;
 pub use artwork_import::{ArtworkImport, LayerHidden, Place, PlaceError, SkippedLayer};
 pub use axes::{AxisFileError, ExtraAxis, ExtraAxisId, LinearAxis, Pose, PoseError, RotaryAxis};
 pub use code::{CodeKind, CodeOptions, CodeSpec, Ecc, CODE_LAYER};
+pub use cylinder::{Cylinder, CylinderError, Predistorted, LANDING_TOL_MM};
 pub use geometry::{is_hatch_output, Geometry, Run, RunOrder, Source, HATCH_LAYER_PREFIX};
 pub use hatch::{
     FillRule, FillShapes, HatchSettings, HatchSpecError, HatchStyle, OutlineMode, MIN_SPACING_MM,
@@ -32,7 +33,6 @@ pub use pens::{
     colour_word, layer_label, parse_colour, passes_of, pen_of, sync_layers, validate_layers, Layer,
     MarkTiming, Pen, PenLibrary, PensError, DEFAULT_LAYER, MAX_PASSES, PENS_VERSION,
 };
-pub use cylinder::{Cylinder, CylinderError, Predistorted, LANDING_TOL_MM};
 pub use plan::{
     GenerationRecord, Metrics, MotionFigures, MotionRegion, ObjectiveKind, Plan, ScanField,
     StageTimes, Step, TimeBreakdown,

@@ -364,6 +364,7 @@ impl SolverSettings {
     /// Checks ranges; the error names the first bad value in the GUI's words.
     pub fn validate(&self) -> Result<(), InvalidValue> {
         super::spec::check_all(&super::spec::settings_specs(), self)?;
+        super::spec::check_all(&super::spec::cylinder_specs(), self)?;
         let ga = &self.ga;
         if !(ga.population_min <= ga.population && ga.population <= ga.population_max) {
             return Err(InvalidValue::new(

@@ -889,6 +889,27 @@ pub fn settings_specs() -> Vec<FieldSpec<SolverSettings>> {
     search
 }
 
+/// The cylinder of a cylinder job (the GUI's Cylinder section; a plan is stale when it
+/// changes).
+pub fn cylinder_specs() -> Vec<FieldSpec<SolverSettings>> {
+    vec![FieldSpec {
+        label: "Cylinder diameter",
+        unit: "mm",
+        key: "cylinder.diameter_mm",
+        help: "mark around a cylinder of this diameter on the rotary A axis: the artwork is its \
+               unrolled surface, x along the axis, y around it; empty: a flat job",
+        rule: Rule::Positive,
+        optional: true,
+        shapes_plan: true,
+        show: |t| show_opt(t.cylinder.map(|c| c.diameter_mm)),
+        number: |t| t.cylinder.map(|c| c.diameter_mm),
+        parse: |t, s| {
+            t.cylinder = parse_optional(s)?.map(|diameter_mm| super::Cylinder { diameter_mm });
+            Ok(())
+        },
+    }]
+}
+
 /// A pen's values (the layers panel's rows).
 pub fn pen_specs() -> Vec<FieldSpec<Pen>> {
     use Rule::Positive;

@@ -379,7 +379,8 @@ M65 P{sel}
                         let words = self.scan_words(w[1].minus(stage));
                         if let Some((c, a_deg)) = around {
                             // the feed the lowering timed this edge with
-                            let speed = c.scanner_speed_mm_s(w[0], w[1], a_deg, stage.y, self.speed);
+                            let speed =
+                                c.scanner_speed_mm_s(w[0], w[1], a_deg, stage.y, self.speed);
                             let _ = writeln!(self.out, "G1 {words} F{}", self.w.num(speed * 60.0));
                         } else if j == 0 {
                             let _ = writeln!(self.out, "G1 {words} F{feed}");

@@ -264,6 +264,7 @@ mod tests {
             z_mm: 5.0,
             a_deg: 10.0,
             b_deg: 60.0,
+            stage_y_mm: None,
         };
         let m = st.plan_pose_move(Pt::new(100.0, 100.0), &from, Pt::new(140.0, 100.0), &to);
         let want = eq14_s(60.0, f_b, t_b);

@@ -449,12 +449,22 @@ pub fn waypoint_states(toolpath: &Toolpath) -> Vec<(f64, MachineState)> {
         out.push((first.start_s, toolpath.state_at(first.start_s)));
     }
     for seg in &toolpath.segments {
-        if let ScanMotion::Mark { stroke, .. } = seg.scan {
+        if let ScanMotion::Mark {
+            stroke,
+            start_frac,
+            end_frac,
+        } = seg.scan
+        {
+            // the vertices inside the part of the stroke this segment marks (all of it in
+            // step-and-scan, an edge of a cylinder's strip)
             let length = toolpath.strokes.get(stroke).map_or(0.0, |s| s.length_mm);
             let arc = toolpath.stroke_arc_mm(stroke);
+            let part = end_frac - start_frac;
+            let whole = start_frac == 0.0 && end_frac == 1.0;
             for &a in arc.iter().skip(1).take(arc.len().saturating_sub(2)) {
-                if length > 0.0 {
-                    let t_s = seg.start_s + a / length * seg.duration_s;
+                let f = if length > 0.0 { a / length } else { 0.0 };
+                if length > 0.0 && part > 0.0 && (whole || (f > start_frac && f < end_frac)) {
+                    let t_s = seg.start_s + (f - start_frac) / part * seg.duration_s;
                     out.push((t_s, toolpath.state_at(t_s)));
                 }
             }

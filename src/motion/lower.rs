@@ -386,7 +386,11 @@ impl<'a> Builder<'a> {
                 Some(c) => c.move_s([0.0, 0.0, d.x, d.y], Some(scanner_mm_s)),
                 None => surface_s,
             };
-            let start_frac = if length_mm > 0.0 { along / length_mm } else { 0.0 };
+            let start_frac = if length_mm > 0.0 {
+                along / length_mm
+            } else {
+                0.0
+            };
             along += d.norm();
             let end_frac = if j + 2 == points.len() || length_mm <= 0.0 {
                 1.0

@@ -254,6 +254,28 @@ impl Toolpath {
         self.strokes.len() - 1
     }
 
+    /// A copy whose strokes' points are mapped by `f(stroke, point)`: the job seen on another
+    /// surface (a cylinder's unrolled one, for the canvas); the strokes' lengths follow the new
+    /// points, the segments are kept.
+    pub fn with_points_mapped(&self, f: impl Fn(&Stroke, Pt) -> Pt) -> Toolpath {
+        let mut out = self.clone();
+        for st in &mut out.strokes {
+            let mut arc = 0.0;
+            let mut last: Option<Pt> = None;
+            for k in st.points.clone() {
+                let p = f(st, self.points[k]);
+                if let Some(q) = last {
+                    arc += p.dist(q);
+                }
+                out.points[k] = p;
+                out.arc_mm[k] = arc;
+                last = Some(p);
+            }
+            st.length_mm = arc;
+        }
+        out
+    }
+
     /// The same job run on a controller clock of `period_s`, where the laser can switch only on
     /// a tick: each mark starts on a tick (the wait before it, at its start with the laser off,
     /// grows to the next tick) and lasts whole ticks (marked slightly slower when its length at

@@ -1,6 +1,6 @@
 //! Travel costs: what one move between two points costs the ordering.
 
-use crate::document::Pose;
+use crate::document::{Cylinder, Pose};
 use crate::geom::Pt;
 use crate::motion::StageDynamics;
 use std::collections::HashMap;
@@ -50,6 +50,9 @@ pub enum TravelCost {
     /// Euclidean distance in 3-D between placements (X, Y and the poses' Z), mm: seed 002's
     /// "3D Euclidean" ordering, blind to the rotary axes.
     Distance3d(PoseMap),
+    /// The 3-D distance between points of a cylinder's unrolled surface, on the cylinder
+    /// ([`Cylinder::surface_distance_mm`]), mm.
+    Surface(Cylinder),
 }
 
 impl TravelCost {
@@ -65,7 +68,12 @@ impl TravelCost {
                 let dz = poses.at(a).z_mm - poses.at(b).z_mm;
                 a.dist(b).hypot(dz)
             }
+            TravelCost::Surface(cylinder) => cylinder.surface_distance_mm(a, b),
         }
+    }
+    /// The distance between placements: on a cylinder's surface, else in the plane.
+    pub fn distance(cylinder: Option<Cylinder>) -> Self {
+        cylinder.map_or(TravelCost::Distance, TravelCost::Surface)
     }
     /// The cost of moving the stage between placements: stage time over every axis the
     /// placements use.

@@ -4,14 +4,16 @@
 //!   the next starts (laser off). The approach from the start position and a final return are
 //!   excluded.
 //! * `marked_mm`: total marked length.
-//! * `base_mm`: length of the polyline through the field centres in visiting order.
+//! * `base_mm`: length of the polyline through the field centres in visiting order (on a
+//!   cylinder, of the chords between them on its surface).
 //! * `covered_area_mm2`: area covered by exactly one field (seed 000 §5.1);
 //!   `overlap_pct = 100 · (1 − covered / (fields · field area))`.
 //! * `direction_changes`: see [`direction_changes`].
 //! * `job_time_s`: the lowered toolpath's duration, with `job_time_breakdown_s` by what the
 //!   machine does ([`crate::motion`]).
 
-use crate::document::{Geometry, MachineProfile, Metrics, ScanField, Step};
+use super::cost::TravelCost;
+use crate::document::{Cylinder, Geometry, MachineProfile, Metrics, ScanField, Step};
 use crate::geom::Pt;
 use crate::motion::Toolpath;
 
@@ -19,12 +21,14 @@ use crate::motion::Toolpath;
 /// figures match what `check_trajectory.py` reports for a default `--trajectory`.
 pub const MOTION_SAMPLE_PERIOD_S: f64 = 1e-3;
 
-/// Computes all metrics of an ordering; `fields` in visiting order, `toolpath` its lowering.
+/// Computes all metrics of an ordering; `fields` in visiting order, `toolpath` its lowering;
+/// on a `cylinder`, `base_mm` is measured on its surface (the strips' centres 3-D apart).
 pub fn compute(
     geometries: &[Geometry],
     fields: &[ScanField],
     steps: &[Step],
     profile: &MachineProfile,
+    cylinder: Option<Cylinder>,
     toolpath: &Toolpath,
 ) -> Metrics {
     let idle_mm = idle_mm(geometries, steps);
@@ -36,7 +40,12 @@ pub fn compute(
         + 0.0;
     let centers: Vec<Pt> = fields.iter().map(|f| f.center).collect();
     // `+ 0.0` turns the empty sum (−0.0) into 0.0
-    let base_mm = centers.windows(2).map(|w| w[0].dist(w[1])).sum::<f64>() + 0.0;
+    let metric = TravelCost::distance(cylinder);
+    let base_mm = centers
+        .windows(2)
+        .map(|w| metric.between(w[0], w[1]))
+        .sum::<f64>()
+        + 0.0;
     // the three costly figures side by side (on a 3,043-field job: 150 → about 80 ms, which is
     // also what a cancelled solve waits for before it has its plan)
     let (((covered_area_mm2, overlap_pct), motion), direction_changes) = rayon::join(

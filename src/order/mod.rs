@@ -177,6 +177,7 @@ pub fn order_plan(
         &plan.fields,
         &plan.order,
         &inputs.profile,
+        settings.cylinder,
         &best.toolpath,
     );
     m.solve_s.order = order_s;

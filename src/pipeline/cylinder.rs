@@ -60,7 +60,11 @@ pub(super) fn with_work_profile<T>(
 }
 
 /// `fields` each posed at its strip's angle on `cylinder` ([`Cylinder::strip_pose`]).
-pub(super) fn pose_strips(fields: &[ScanField], cylinder: &Cylinder, doc: &Document) -> Vec<ScanField> {
+pub(super) fn pose_strips(
+    fields: &[ScanField],
+    cylinder: &Cylinder,
+    doc: &Document,
+) -> Vec<ScanField> {
     fields
         .iter()
         .map(|f| ScanField {
@@ -78,11 +82,37 @@ pub(super) fn job_fields(doc: &Document) -> Result<Option<Vec<ScanField>>, Pipel
 
 /// The reach an import places the artwork in: on a cylinder the unrolled surface's (twice around
 /// the circumference, strips in focus as fields), else the machine's; as (stroke, field), mm.
-pub(super) fn import_reach(profile: &MachineProfile, cylinder: Option<Cylinder>) -> ([f64; 2], [f64; 2]) {
+pub(super) fn import_reach(
+    profile: &MachineProfile,
+    cylinder: Option<Cylinder>,
+) -> ([f64; 2], [f64; 2]) {
     let work = cylinder.and_then(|c| {
         let dof = profile.scanner.depth_of_focus_mm?;
         Some(c.work_profile(profile, c.strip_height_mm(dof, profile.field_mm[1])))
     });
     let p = work.as_ref().unwrap_or(profile);
     (p.stroke_mm, p.field_mm)
+}
+
+/// The profile the document's fields are shown and edited with: on a cylinder the work
+/// profile (strips in focus on the unrolled surface), else the machine's; a cylinder the
+/// machine or the drawing cannot make shows the machine's (its reason is the solve's error).
+pub fn view_profile(doc: &Document) -> std::borrow::Cow<'_, MachineProfile> {
+    match setup(doc) {
+        Ok(Some((cylinder, strip))) => {
+            std::borrow::Cow::Owned(cylinder.work_profile(&doc.profile, strip))
+        }
+        _ => std::borrow::Cow::Borrowed(&doc.profile),
+    }
+}
+
+/// The height of the document's cylinder strips in focus, mm, or why the cylinder job cannot be
+/// made (its one-line reason, without the file); a flat job has none (0).
+pub fn cylinder_strips(doc: &Document) -> Result<f64, CylinderError> {
+    match setup(doc) {
+        Ok(Some((_, strip))) => Ok(strip),
+        Ok(None) => Ok(0.0),
+        Err(PipelineError::Cylinder { source, .. }) => Err(source),
+        Err(_) => Ok(0.0),
+    }
 }

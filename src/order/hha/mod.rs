@@ -32,7 +32,9 @@ use super::tsp::{
 };
 use super::vertex::{optimal_vertices, vea};
 use super::{OrderError, Ordering};
-use crate::document::{Geometry, MachineProfile, ScanField, SolverSettings, Step, VertexMode};
+use crate::document::{
+    Cylinder, Geometry, MachineProfile, ScanField, SolverSettings, Step, VertexMode,
+};
 use crate::geom::Pt;
 use crate::job::{Cancelled, JobCtx};
 use crate::order::cost::TravelCost;
@@ -125,6 +127,7 @@ fn top_left_field(fields: &[ScanField], profile: &MachineProfile) -> usize {
 pub fn field_order(
     fields: &[ScanField],
     profile: &MachineProfile,
+    cylinder: Option<Cylinder>,
     ctx: &JobCtx,
 ) -> Result<Vec<usize>, Cancelled> {
     let n = fields.len();
@@ -133,13 +136,16 @@ pub fn field_order(
     }
     let first = top_left_field(fields, profile);
     let c: Vec<Pt> = fields.iter().map(|f| f.center).collect();
-    let dist = |i: usize, j: usize| c[i].dist(c[j]);
+    // around a cylinder: the distance between strip centres on its surface
+    let metric = TravelCost::distance(cylinder);
+    let dist = |i: usize, j: usize| metric.between(c[i], c[j]);
     if n <= EXACT_FIELDS {
         return Ok(exact_path(&dist, n, first, None));
     }
     let order = cheapest_arc(n, first, None, &dist);
     let mut prob = PathProblem::points(&c, &vec![0.0; n], 0.0);
     prob.fixed_first = true;
+    prob.metric = metric;
     let mut tour = Tour {
         order,
         flipped: vec![false; n],
@@ -158,9 +164,10 @@ fn field_order_candidates(
     fields: &[ScanField],
     cent: &[Pt],
     profile: &MachineProfile,
+    cylinder: Option<Cylinder>,
     ctx: &JobCtx,
 ) -> Result<(Vec<usize>, Option<Vec<usize>>), Cancelled> {
-    let by_centre = field_order(fields, profile, ctx)?;
+    let by_centre = field_order(fields, profile, cylinder, ctx)?;
     let n = fields.len();
     if !(3..=GAP_PATH_MAX_FIELDS).contains(&n) {
         return Ok((by_centre, None));
@@ -674,7 +681,8 @@ pub fn hha_order(
     // engine alone finds it; HHA gives it only its start
     let lone_free = !time_follows && live.len() == 1;
     let cent: Vec<Pt> = geometries.iter().map(Geometry::centroid).collect();
-    let (by_centre, by_gap) = field_order_candidates(&live_owned, &cent, profile, ctx)?;
+    let (by_centre, by_gap) =
+        field_order_candidates(&live_owned, &cent, profile, settings.cylinder, ctx)?;
     stage_s.push(("field_order".into(), t.elapsed().as_secs_f64()));
     ctx.progress("order", 1, 4, "HHA: field order");
 

@@ -23,7 +23,13 @@ fn field_path_starts_top_left_with_a_free_end() {
         .enumerate()
         .map(|(k, &x)| field(k, x, 35.0, vec![]))
         .collect();
-    let order = field_order(&fields, &MachineProfile::default(), &JobCtx::default()).unwrap();
+    let order = field_order(
+        &fields,
+        &MachineProfile::default(),
+        None,
+        &JobCtx::default(),
+    )
+    .unwrap();
     let visited: Vec<f64> = order.iter().map(|&k| xs[k]).collect();
     assert_eq!(visited, vec![35.0, 70.0, 140.0, 210.0, 280.0]);
 }
@@ -39,7 +45,13 @@ fn field_path_with_many_fields_is_a_permutation_from_top_left() {
             vec![],
         ));
     }
-    let order = field_order(&fields, &MachineProfile::default(), &JobCtx::default()).unwrap();
+    let order = field_order(
+        &fields,
+        &MachineProfile::default(),
+        None,
+        &JobCtx::default(),
+    )
+    .unwrap();
     let mut s = order.clone();
     s.sort();
     assert_eq!(s, (0..30).collect::<Vec<_>>());
@@ -182,7 +194,7 @@ fn the_gap_path_wins_where_the_geometries_meet_off_the_centre_path() {
         JobCtx::default(),
     );
     let cent: Vec<Pt> = gs.iter().map(Geometry::centroid).collect();
-    let (by_centre, by_gap) = field_order_candidates(&fields, &cent, &p, &ctx).unwrap();
+    let (by_centre, by_gap) = field_order_candidates(&fields, &cent, &p, None, &ctx).unwrap();
     assert_eq!(by_centre, vec![0, 1, 2]);
     assert_eq!(by_gap, Some(vec![0, 2, 1]));
     let stages = Stages {
@@ -216,7 +228,7 @@ fn many_fields_try_only_the_centre_path() {
     let cent: Vec<Pt> = gs.iter().map(Geometry::centroid).collect();
     let ctx = JobCtx::default();
     let (_, by_gap) =
-        field_order_candidates(&fields, &cent, &MachineProfile::default(), &ctx).unwrap();
+        field_order_candidates(&fields, &cent, &MachineProfile::default(), None, &ctx).unwrap();
     assert_eq!(by_gap, None);
 }
 
