@@ -2563,5 +2563,9 @@ fn a_cylinder_job_places_strips_in_focus_and_says_their_height() {
     // too thin a tube for this drawing: said in words
     set_text(&mut h, "Cylinder diameter (mm)", "30");
     settle(&mut h);
-    h.get_by_label_contains("Cylinder ⌀30 mm cannot be marked: the drawing is 110.00 mm high");
+    h.get_by_label_contains(
+        "Cylinder ⌀30 mm cannot be marked: the drawing is 106.00 mm high around the cylinder, \
+         more than its circumference 94.25 mm",
+    );
+    assert!(h.state().status().contains("more than its circumference"));
 }

@@ -323,8 +323,12 @@ M65 P{sel}
                     self.settle_s = mv.settle_s;
                     let to = mv.position(seg.duration_s);
                     // the field of the next stroke marked (a cylinder's strips share a stage
-                    // position)
-                    if let Some(s) = toolpath.strokes.get(marked) {
+                    // position); on a flat job where the move ends exactly on its centre
+                    let next = toolpath.strokes.get(marked);
+                    let arrived = |s: &&crate::motion::Stroke| {
+                        plan.settings.cylinder.is_some() || s.stage == to
+                    };
+                    if let Some(s) = next.filter(arrived) {
                         if field != Some(s.field) {
                             field = Some(s.field);
                             self.field_comment(plan, s.field, to);
