@@ -24,10 +24,12 @@ use rayon::prelude::*;
 /// The import options a tray's texts are shaped and placed with: the document's machine, its
 /// placement, and the chord tolerance the artwork was imported with.
 fn options(doc: &Document, prod: &Production) -> ImportOptions {
+    // around a cylinder: its unrolled surface
+    let reach = crate::document::Cylinder::reach_profile(&doc.profile, doc.settings.cylinder);
     ImportOptions {
         chord_tol_mm: prod.chord_tol_mm,
-        work_area_mm: Some(doc.profile.stroke_mm),
-        field_mm: Some(doc.profile.field_mm),
+        work_area_mm: Some(reach.stroke_mm),
+        field_mm: Some(reach.field_mm),
         place: doc.import.place,
         resolution_mm: doc.profile.resolution_mm(),
         ..ImportOptions::default()
@@ -347,8 +349,9 @@ fn check_reach(
     if b.is_empty() {
         return Err(ProductionError::Tray("the part has nothing to mark".into()));
     }
-    let [sw, sh] = doc.profile.stroke_mm;
-    let [fw, fh] = doc.profile.field_mm;
+    let reach = crate::document::Cylinder::reach_profile(&doc.profile, doc.settings.cylinder);
+    let [sw, sh] = reach.stroke_mm;
+    let [fw, fh] = reach.field_mm;
     let (rw, rh) = (sw + fw, sh + fh);
     let (w, h) = (b.max_x - b.min_x, b.max_y - b.min_y);
     const SLACK_MM: f64 = 1e-6;

@@ -252,6 +252,55 @@ fn galvoplan(args: &[&str]) -> Output {
         .unwrap()
 }
 
+/// A tray of parts with their serials and a DataMatrix each, hatched, around a cylinder: planned
+/// as on a flat job, every part in the report, every strip posed.
+#[test]
+fn trays_codes_and_hatch_work_around_a_cylinder() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("t.ngc").display().to_string();
+    let report = dir.path().join("t.json").display().to_string();
+    let part = common::root()
+        .join("assets/examples/part.svg")
+        .display()
+        .to_string();
+    let o = galvoplan(&[
+        "plan",
+        &part,
+        "--profile",
+        "rotary",
+        "--cylinder",
+        "60",
+        "--array",
+        "2x2@40,32",
+        "--serial",
+        "1001",
+        "--code",
+        "datamatrix:GP{serial:05}@3,3:6",
+        "--hatch",
+        "lines:0.1",
+        "-o",
+        &out,
+        "--report",
+        &report,
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert_eq!(r["parts"].as_array().unwrap().len(), 4);
+    assert_eq!(r["cylinder"]["diameter_mm"], 60.0);
+    for f in r["fields"].as_array().unwrap() {
+        let (y, a) = (
+            f["center"][1].as_f64().unwrap(),
+            f["pose"]["a_deg"].as_f64().unwrap(),
+        );
+        assert!((a - (y / 30.0).to_degrees()).abs() < 1e-9, "{f}");
+    }
+    let gcode = std::fs::read_to_string(&out).unwrap();
+    assert!(gcode
+        .lines()
+        .any(|l| l.starts_with("G0 X") && l.contains(" A")));
+}
+
 /// One line on stderr, exit status 1.
 fn one_line_error(out: &Output) -> String {
     assert!(!out.status.success());

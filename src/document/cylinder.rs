@@ -134,6 +134,21 @@ impl Cylinder {
         p.stroke_mm[1] = 2.0 * self.circumference_mm();
         p
     }
+    /// The profile a job's artwork is placed in: on a cylinder (`cylinder`, with a depth of
+    /// focus) the work profile of its strips ([`Cylinder::work_profile`]), else `machine`.
+    pub fn reach_profile(
+        machine: &MachineProfile,
+        cylinder: Option<Cylinder>,
+    ) -> std::borrow::Cow<'_, MachineProfile> {
+        let work = cylinder.and_then(|c| {
+            let dof = machine.scanner.depth_of_focus_mm?;
+            Some(c.work_profile(machine, c.strip_height_mm(dof, machine.field_mm[1])))
+        });
+        match work {
+            Some(p) => std::borrow::Cow::Owned(p),
+            None => std::borrow::Cow::Borrowed(machine),
+        }
+    }
     /// The stage's Y while marking: over the cylinder's axis, which lies under the middle of
     /// the Y stroke (0 on a machine without Y).
     pub fn stage_y_mm(machine: &MachineProfile) -> f64 {

@@ -80,17 +80,13 @@ pub(super) fn job_fields(doc: &Document) -> Result<Option<Vec<ScanField>>, Pipel
     Ok(setup(doc)?.map(|(cylinder, _)| pose_strips(&doc.fields, &cylinder, doc)))
 }
 
-/// The reach an import places the artwork in: on a cylinder the unrolled surface's (twice around
-/// the circumference, strips in focus as fields), else the machine's; as (stroke, field), mm.
+/// The reach an import places the artwork in ([`Cylinder::reach_profile`]), as (stroke,
+/// field), mm.
 pub(super) fn import_reach(
     profile: &MachineProfile,
     cylinder: Option<Cylinder>,
 ) -> ([f64; 2], [f64; 2]) {
-    let work = cylinder.and_then(|c| {
-        let dof = profile.scanner.depth_of_focus_mm?;
-        Some(c.work_profile(profile, c.strip_height_mm(dof, profile.field_mm[1])))
-    });
-    let p = work.as_ref().unwrap_or(profile);
+    let p = Cylinder::reach_profile(profile, cylinder);
     (p.stroke_mm, p.field_mm)
 }
 
