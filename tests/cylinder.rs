@@ -317,46 +317,29 @@ fn bad_cylinder_jobs_say_why_in_one_line() {
         .join("assets/examples/sleeve.svg")
         .display()
         .to_string();
+    // `plan INPUT ARGS -o out`, refused in one line
+    let refused = |input: &str, args: &[&str]| {
+        let mut all = vec!["plan", input];
+        all.extend_from_slice(args);
+        all.extend_from_slice(&["-o", &out]);
+        one_line_error(&galvoplan(&all))
+    };
     // taller than the circumference: 110 mm on ⌀30 (94.25 mm)
-    let e = one_line_error(&galvoplan(&[
-        "plan",
-        &sleeve,
-        "--profile",
-        "rotary",
-        "--cylinder",
-        "30",
-        "-o",
-        &out,
-    ]));
+    let e = refused(&sleeve, &["--profile", "rotary", "--cylinder", "30"]);
     assert!(e.contains("more than its circumference 94.25 mm"), "{e}");
     // no A axis
-    let e = one_line_error(&galvoplan(&[
-        "plan",
-        &sleeve,
-        "--cylinder",
-        "40",
-        "-o",
-        &out,
-    ]));
+    let e = refused(&sleeve, &["--cylinder", "40"]);
     assert!(e.contains("needs an A axis"), "{e}");
     // a DOF of zero
     let zero = dir.path().join("zero.toml");
     std::fs::write(&zero, "version = 5\n[scanner]\ndepth_of_focus_mm = 0.0\n").unwrap();
-    let e = one_line_error(&galvoplan(&[
-        "plan",
-        &sleeve,
-        "--profile",
-        &zero.display().to_string(),
-        "--cylinder",
-        "40",
-        "-o",
-        &out,
-    ]));
+    let zero = zero.display().to_string();
+    let e = refused(&sleeve, &["--profile", &zero, "--cylinder", "40"]);
     assert!(
         e.contains("Depth of focus (mm) must be a positive number, not 0"),
         "{e}"
     );
-    // strips thinner than the spot: a 1 µm DOF on ⌀1 mm
+    // strips thinner than the spot: a 0.01 µm DOF on ⌀1 mm
     let thin = dir.path().join("thin.toml");
     let rotary = std::fs::read_to_string(common::root().join("assets/profiles/rotary.toml"))
         .unwrap()
@@ -368,40 +351,23 @@ fn bad_cylinder_jobs_say_why_in_one_line() {
         r##"<svg xmlns="http://www.w3.org/2000/svg" width="10mm" height="3mm" viewBox="0 0 10 3"><line x1="1" y1="1" x2="5" y2="2" stroke="#000"/></svg>"##,
     )
     .unwrap();
-    let e = one_line_error(&galvoplan(&[
-        "plan",
-        &small.display().to_string(),
-        "--profile",
-        &thin.display().to_string(),
-        "--cylinder",
-        "1",
-        "-o",
-        &out,
-    ]));
+    let (small, thin) = (small.display().to_string(), thin.display().to_string());
+    let e = refused(&small, &["--profile", &thin, "--cylinder", "1"]);
     assert!(e.contains("thinner than the"), "{e}");
     // not a diameter
-    let e = one_line_error(&galvoplan(&[
-        "plan",
-        &sleeve,
-        "--profile",
-        "rotary",
-        "--cylinder=-3",
-        "-o",
-        &out,
-    ]));
+    let e = refused(&sleeve, &["--profile", "rotary", "--cylinder=-3"]);
     assert!(e.contains("diameter"), "{e}");
     // on the fly
-    let e = one_line_error(&galvoplan(&[
-        "plan",
+    let e = refused(
         &sleeve,
-        "--profile",
-        "rotary",
-        "--cylinder",
-        "40",
-        "--motion",
-        "on-the-fly",
-        "-o",
-        &out,
-    ]));
+        &[
+            "--profile",
+            "rotary",
+            "--cylinder",
+            "40",
+            "--motion",
+            "on-the-fly",
+        ],
+    );
     assert!(e.contains("step-and-scan"), "{e}");
 }
