@@ -23,7 +23,7 @@ use std::time::Instant;
 use thiserror::Error;
 
 mod cylinder;
-pub use cylinder::{cylinder_strips, view_profile};
+pub use cylinder::cylinder_strips;
 
 /// A pipeline failure; the message names the file where one is involved.
 #[derive(Debug, Error)]
@@ -199,9 +199,10 @@ pub fn load_production(
         return load_project_job(path, profile, settings, t0);
     }
     let mut opts = opts.clone();
-    let (stroke_mm, field_mm) = cylinder::import_reach(&profile, settings.cylinder);
-    opts.work_area_mm.get_or_insert(stroke_mm);
-    opts.field_mm.get_or_insert(field_mm);
+    // around a cylinder: its unrolled surface
+    let reach = crate::document::Cylinder::reach_profile(&profile, settings.cylinder);
+    opts.work_area_mm.get_or_insert(reach.stroke_mm);
+    opts.field_mm.get_or_insert(reach.field_mm);
     // the G-code's resolution: a unit in its last decimal
     opts.resolution_mm = profile.resolution_mm();
     let imported = import_file(path, &opts)?;

@@ -25,7 +25,7 @@ use rayon::prelude::*;
 /// placement, and the chord tolerance the artwork was imported with.
 fn options(doc: &Document, prod: &Production) -> ImportOptions {
     // around a cylinder: its unrolled surface
-    let reach = crate::document::Cylinder::reach_profile(&doc.profile, doc.settings.cylinder);
+    let reach = doc.reach_profile();
     ImportOptions {
         chord_tol_mm: prod.chord_tol_mm,
         work_area_mm: Some(reach.stroke_mm),
@@ -349,7 +349,7 @@ fn check_reach(
     if b.is_empty() {
         return Err(ProductionError::Tray("the part has nothing to mark".into()));
     }
-    let reach = crate::document::Cylinder::reach_profile(&doc.profile, doc.settings.cylinder);
+    let reach = doc.reach_profile();
     let [sw, sh] = reach.stroke_mm;
     let [fw, fh] = reach.field_mm;
     let (rw, rh) = (sw + fw, sh + fh);

@@ -187,9 +187,11 @@ pub fn apply(doc: &mut Document, cmd: &Command) -> Result<Outcome, String> {
 /// stage's stroke.
 fn set_profile(doc: &mut Document, p: &MachineProfile) {
     doc.profile = p.clone();
-    let [sw, sh] = doc.profile.stroke_mm;
+    // on a cylinder: its strips
+    let reach = doc.reach_profile().into_owned();
+    let [sw, sh] = reach.stroke_mm;
     for f in &mut doc.fields {
-        f.size = doc.profile.field_mm;
+        f.size = reach.field_mm;
         f.center = Pt::new(f.center.x.clamp(0.0, sw), f.center.y.clamp(0.0, sh));
     }
 }

@@ -847,7 +847,7 @@ fn plan_canvas<'a>(
     Canvas {
         label: "",
         geometries: &doc.geometries,
-        profile: crate::pipeline::view_profile(doc),
+        profile: doc.reach_profile(),
         cylinder: plan.settings.cylinder,
         fields: &plan.fields,
         seams: &plan.seams.lines,

@@ -805,7 +805,7 @@ fn workbench_canvas<'a>(
     Canvas {
         label: "Work area",
         geometries: &doc.geometries,
-        profile: crate::pipeline::view_profile(doc),
+        profile: doc.reach_profile(),
         cylinder: doc.settings.cylinder,
         fields: &doc.fields,
         seams: &doc.seams.lines,

@@ -169,6 +169,11 @@ pub struct Document {
 }
 
 impl Document {
+    /// The profile the document's fields are placed and edited with: on a cylinder job the
+    /// strips on its unrolled surface ([`Cylinder::reach_profile`]), else the machine's.
+    pub fn reach_profile(&self) -> std::borrow::Cow<'_, MachineProfile> {
+        Cylinder::reach_profile(&self.profile, self.settings.cylinder)
+    }
     /// Checks profile, settings and layers, that every geometry's layer is in the table and
     /// that fields and plans name geometries the document has. The CLI, the GUI and the project
     /// loader all call it.

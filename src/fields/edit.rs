@@ -19,7 +19,7 @@ pub enum EditError {
 }
 
 fn clamp_center(doc: &Document, c: Pt) -> Pt {
-    let [sw, sh] = doc.profile.stroke_mm;
+    let [sw, sh] = doc.reach_profile().stroke_mm;
     let fin = |v: f64| if v.is_finite() { v } else { 0.0 };
     Pt::new(fin(c.x).clamp(0.0, sw), fin(c.y).clamp(0.0, sh))
 }
@@ -53,7 +53,7 @@ pub fn add_field(doc: &mut Document, center: Pt) -> (usize, Allocation) {
     doc.fields.push(ScanField {
         id,
         center,
-        size: doc.profile.field_mm,
+        size: doc.reach_profile().field_mm,
         locked: false,
         geometries: Vec::new(),
         pose: Default::default(),
@@ -83,7 +83,13 @@ pub fn replace_automatically(doc: &mut Document, ctx: &JobCtx) -> Result<Allocat
     if settings.fields == FieldsMode::Greedy {
         settings.fields = FieldsMode::Auto;
     }
-    let placement = place_fields(&doc.geometries, &doc.profile, &settings, &locked, ctx)?;
+    let placement = place_fields(
+        &doc.geometries,
+        &doc.reach_profile(),
+        &settings,
+        &locked,
+        ctx,
+    )?;
     doc.fields = placement.fields;
     Ok(reallocate(doc))
 }

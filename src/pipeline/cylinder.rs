@@ -4,7 +4,7 @@
 //! step-and-scan on the machine itself.
 
 use super::PipelineError;
-use crate::document::{Cylinder, CylinderError, Document, MachineProfile, MotionMode, ScanField};
+use crate::document::{Cylinder, CylinderError, Document, MotionMode, ScanField};
 use crate::geom::BBox;
 
 /// The document's cylinder and its strips' height in focus, mm; none on a flat job. Fails with
@@ -78,28 +78,6 @@ pub(super) fn pose_strips(
 /// its strip's angle (fields moved by hand since their placement turn with them).
 pub(super) fn job_fields(doc: &Document) -> Result<Option<Vec<ScanField>>, PipelineError> {
     Ok(setup(doc)?.map(|(cylinder, _)| pose_strips(&doc.fields, &cylinder, doc)))
-}
-
-/// The reach an import places the artwork in ([`Cylinder::reach_profile`]), as (stroke,
-/// field), mm.
-pub(super) fn import_reach(
-    profile: &MachineProfile,
-    cylinder: Option<Cylinder>,
-) -> ([f64; 2], [f64; 2]) {
-    let p = Cylinder::reach_profile(profile, cylinder);
-    (p.stroke_mm, p.field_mm)
-}
-
-/// The profile the document's fields are shown and edited with: on a cylinder the work
-/// profile (strips in focus on the unrolled surface), else the machine's; a cylinder the
-/// machine or the drawing cannot make shows the machine's (its reason is the solve's error).
-pub fn view_profile(doc: &Document) -> std::borrow::Cow<'_, MachineProfile> {
-    match setup(doc) {
-        Ok(Some((cylinder, strip))) => {
-            std::borrow::Cow::Owned(cylinder.work_profile(&doc.profile, strip))
-        }
-        _ => std::borrow::Cow::Borrowed(&doc.profile),
-    }
 }
 
 /// The height of the document's cylinder strips in focus, mm, or why the cylinder job cannot be
