@@ -284,6 +284,15 @@ fn trays_codes_and_hatch_work_around_a_cylinder() {
         &report,
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // the cuts at the strips' borders in one line
+    let said = String::from_utf8_lossy(&o.stderr);
+    let cuts: Vec<&str> = said.lines().filter(|l| l.contains("cut at")).collect();
+    assert_eq!(cuts.len(), 1, "{said}");
+    assert!(
+        cuts[0].contains("taller than a strip in focus")
+            && cuts[0].contains("are cut at the strips' borders"),
+        "{said}"
+    );
     let r: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
     assert_eq!(r["parts"].as_array().unwrap().len(), 4);

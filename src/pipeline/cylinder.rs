@@ -56,7 +56,39 @@ pub(super) fn with_work_profile<T>(
     doc.settings = settings;
     let out = out?;
     doc.fields = pose_strips(&doc.fields, &cylinder, doc);
+    group_cuts(doc, &cylinder, strip);
     Ok(out)
+}
+
+/// The words that begin the one warning of a cylinder's cuts.
+const CUTS_PREFIX: &str = "around the cylinder: ";
+
+/// On a cylinder, cutting what is taller than a strip is the job's way, not a surprise per
+/// geometry: the cut warnings become notes (kept in the report), and one warning says how many
+/// geometries are cut where the part turns between strips (a seam on the part).
+fn group_cuts(doc: &mut Document, cylinder: &Cylinder, strip: f64) {
+    doc.warnings.retain(|w| !w.message.starts_with(CUTS_PREFIX));
+    let mut cut = 0;
+    for w in &mut doc.warnings {
+        if w.message.contains(crate::fields::SPLIT_WORDS) {
+            w.note = true;
+            cut += 1;
+        }
+    }
+    if cut > 0 {
+        doc.warnings.push(crate::document::Warning {
+            element: String::new(),
+            line: None,
+            message: format!(
+                "{CUTS_PREFIX}{cut} geometr{} taller than a strip in focus ({strip:.2} mm on ⌀{} mm) \
+                 {} cut at the strips' borders, where the part turns between them",
+                if cut == 1 { "y" } else { "ies" },
+                crate::geom::format_mm(cylinder.diameter_mm, 3),
+                if cut == 1 { "is" } else { "are" },
+            ),
+            note: false,
+        });
+    }
 }
 
 /// `fields` each posed at its strip's angle on `cylinder` ([`Cylinder::strip_pose`]).
