@@ -248,8 +248,9 @@ pub fn load_production(
     })
 }
 
-/// A project's artwork and fields as a job for `profile` and `settings` (the command line's):
-/// its fields are kept as placed (locked), with their poses.
+/// A project's artwork and fields as a job for `profile` and `settings` (the command line's;
+/// a cylinder job's cylinder unless they name one): its fields are kept as placed (locked),
+/// with their poses.
 fn load_project_job(
     path: &Path,
     profile: MachineProfile,
@@ -259,7 +260,12 @@ fn load_project_job(
     let mut doc =
         crate::document::load_project(path).map_err(|e| PipelineError::Project(Box::new(e)))?;
     doc.profile = profile;
-    doc.settings = settings;
+    // a cylinder job stays one unless the command line names another cylinder
+    let cylinder = settings.cylinder.or(doc.settings.cylinder);
+    doc.settings = SolverSettings {
+        cylinder,
+        ..settings
+    };
     doc.plans.clear();
     for f in &mut doc.fields {
         f.locked = true;

@@ -310,6 +310,45 @@ fn trays_codes_and_hatch_work_around_a_cylinder() {
         .any(|l| l.starts_with("G0 X") && l.contains(" A")));
 }
 
+/// A cylinder job saved as a project stays one: `plan` of the project (without `--cylinder`)
+/// marks its strips around the cylinder, where the drawing says.
+#[test]
+fn a_saved_cylinder_job_plans_around_its_cylinder() {
+    let dir = tempfile::tempdir().unwrap();
+    let svg = common::root().join("assets/examples/sleeve.svg");
+    let settings = SolverSettings {
+        cylinder: Some(Cylinder { diameter_mm: 40.0 }),
+        ..SolverSettings::default()
+    };
+    let rotary = MachineProfile::builtin("rotary").unwrap();
+    let mut doc = load_artwork(&svg, rotary, settings, &ImportOptions::default())
+        .unwrap()
+        .doc;
+    galvoplan::pipeline::place_document_fields(&mut doc, &JobCtx::default()).unwrap();
+    let project = dir.path().join("sleeve.galvoplan");
+    galvoplan::document::save_project(&doc, &project).unwrap();
+    let out = dir.path().join("p.ngc");
+    let o = galvoplan(&[
+        "plan",
+        &project.display().to_string(),
+        "-o",
+        &out.display().to_string(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let gcode = std::fs::read_to_string(&out).unwrap();
+    let (marks, defocus) = landed_marks(&gcode, 20.0);
+    assert!(defocus <= 0.8 + 1e-9);
+    let drawing: Vec<Vec<Pt>> = doc.artwork.iter().map(polyline).collect();
+    let c = Cylinder { diameter_mm: 40.0 }.circumference_mm();
+    for p in marks.iter().flatten() {
+        let d = drawing
+            .iter()
+            .map(|g| dist_to(*p, g, c))
+            .fold(f64::INFINITY, f64::min);
+        assert!(d <= LAND_TOL_MM, "{p:?} lands {d} mm from the drawing");
+    }
+}
+
 /// One line on stderr, exit status 1.
 fn one_line_error(out: &Output) -> String {
     assert!(!out.status.success());

@@ -106,10 +106,26 @@ pub(super) fn pose_strips(
         .collect()
 }
 
-/// The fields an ordering of the document starts from: its own, on a cylinder each posed at
-/// its strip's angle (fields moved by hand since their placement turn with them).
+/// The fields an ordering of the document starts from when they are not its own (none: its
+/// own): on a cylinder each posed at its strip's angle (fields moved by hand since their
+/// placement turn with them); on a flat job, strips left from a cylinder job at rest (their
+/// poses were the cylinder's).
 pub(super) fn job_fields(doc: &Document) -> Result<Option<Vec<ScanField>>, PipelineError> {
-    Ok(setup(doc)?.map(|(cylinder, _)| pose_strips(&doc.fields, &cylinder, doc)))
+    if let Some((cylinder, _)) = setup(doc)? {
+        return Ok(Some(pose_strips(&doc.fields, &cylinder, doc)));
+    }
+    if doc.fields.iter().all(|f| f.pose.stage_y_mm.is_none()) {
+        return Ok(None);
+    }
+    let flat = doc.fields.iter().map(|f| ScanField {
+        pose: if f.pose.stage_y_mm.is_some() {
+            Default::default()
+        } else {
+            f.pose
+        },
+        ..f.clone()
+    });
+    Ok(Some(flat.collect()))
 }
 
 /// The height of the document's cylinder strips in focus, mm, or why the cylinder job cannot be
