@@ -129,12 +129,20 @@ pub enum Remedy {
     /// The artwork fits within the laser's reach but lies outside it: place it elsewhere
     /// (centred on the base stroke, or at a corner).
     Place,
+    /// The machine has no Y stroke (it turns the part on its A axis instead): the artwork lies
+    /// beyond a flat job's reach; mark it around a cylinder.
+    Cylinder,
 }
 
 impl PipelineError {
     /// What could help, when the operator can act on the cause.
     pub fn remedy(&self) -> Option<Remedy> {
         match self {
+            PipelineError::Fields {
+                source:
+                    FieldError::Artwork { stroke_mm, .. } | FieldError::OutOfReach { stroke_mm, .. },
+                ..
+            } if stroke_mm[1] <= 0.0 => Some(Remedy::Cylinder),
             PipelineError::Fields {
                 source: FieldError::Oversize { .. },
                 ..

@@ -375,6 +375,12 @@ fn bad_cylinder_jobs_say_why_in_one_line() {
     // taller than the circumference: 110 mm on ⌀30 (94.25 mm)
     let e = refused(&sleeve, &["--profile", "rotary", "--cylinder", "30"]);
     assert!(e.contains("more than its circumference 94.25 mm"), "{e}");
+    // a flat job on a machine that turns the part: the cylinder is the way
+    let e = refused(&sleeve, &["--profile", "rotary"]);
+    assert!(
+        e.contains("use --cylinder DIAMETER_MM to mark around it"),
+        "{e}"
+    );
     // no A axis
     let e = refused(&sleeve, &["--cylinder", "40"]);
     assert!(e.contains("needs an A axis"), "{e}");

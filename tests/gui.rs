@@ -2564,8 +2564,14 @@ fn a_cylinder_job_places_strips_in_focus_and_says_their_height() {
     set_text(&mut h, "Cylinder diameter (mm)", "30");
     settle(&mut h);
     h.get_by_label_contains(
-        "Cylinder ⌀30 mm cannot be marked: the drawing is 106.00 mm high around the cylinder, \
+        "Cylinder ⌀30 mm cannot be marked: the drawing spans 106.00 mm around the cylinder, \
          more than its circumference 94.25 mm",
     );
     assert!(h.state().status().contains("more than its circumference"));
+    // the solve buttons say why they cannot run
+    let why = h.state().solve_blocker().unwrap();
+    assert!(
+        why.contains("more than its circumference 94.25 mm"),
+        "{why}"
+    );
 }

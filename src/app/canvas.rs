@@ -211,6 +211,16 @@ pub enum CanvasAction {
 const HOVER_PX: f32 = 6.0;
 
 impl Canvas<'_> {
+    /// What the canvas calls field `f` ([`super::words::field_word`]); a cylinder's strips are
+    /// fields (a cylinder is never marked on the fly), whatever the diameter typed since.
+    pub fn field_word(&self, f: &crate::document::ScanField) -> &'static str {
+        if self.cylinder.is_some() {
+            "field"
+        } else {
+            super::words::field_word(f, &self.profile)
+        }
+    }
+
     /// Reach of the laser: the base stroke grown by half a field.
     pub fn reach(profile: &MachineProfile) -> (Pt, Pt) {
         let [fw, fh] = profile.field_mm;
@@ -762,7 +772,7 @@ impl Canvas<'_> {
         match self.fields.iter().find(|f| f.geometries.contains(&k)) {
             Some(f) => lines.push(format!(
                 "  allocated to {} {}",
-                super::words::field_word(f, &self.profile),
+                self.field_word(f),
                 super::words::field_number(self.fields, self.visiting, f.id)
             )),
             None if self.out_of_reach.contains(&k) => lines.push(
@@ -809,7 +819,7 @@ impl Canvas<'_> {
             ));
         }
         if let Some(f) = field {
-            let word = super::words::field_word(f, &self.profile);
+            let word = self.field_word(f);
             let size = if word == "field" {
                 String::new()
             } else {

@@ -517,10 +517,21 @@ impl App {
         if large > 0 {
             self.oversize_ui(ui, large);
         }
+        // a machine that turns the part instead of moving it in Y: a cylinder is the way
+        let doc = self.session.doc();
+        let turns = doc.profile.stroke_mm[1] <= 0.0 && doc.settings.cylinder.is_none();
+        let cylinder = format!(
+            "beyond the stage's stroke plus half a field: {}.",
+            super::words::CYLINDER_ADVICE
+        );
         let advice = [(
             beyond,
-            "beyond the stage's stroke plus half a field: choose \"Placement: \
-                 centred\" in the Layers panel to move the artwork within reach.",
+            if turns {
+                cylinder.as_str()
+            } else {
+                "beyond the stage's stroke plus half a field: choose \"Placement: \
+                 centred\" in the Layers panel to move the artwork within reach."
+            },
         )];
         for (n, what) in advice.into_iter().filter(|(n, _)| *n > 0) {
             ui.add(

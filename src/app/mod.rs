@@ -876,6 +876,9 @@ impl App {
                 1 => "1 stroke is not covered by a scan field".to_string(),
                 n => format!("{n} strokes are not covered by a scan field"),
             })
+        } else if let Err(e) = crate::pipeline::cylinder_strips(self.session.doc()) {
+            // a cylinder the machine or the drawing cannot make
+            Some(e.to_string())
         } else {
             // a field whose pose the machine cannot take (an axis it lacks, beyond a travel)
             let doc = self.session.doc();

@@ -100,7 +100,7 @@ fn paint_background(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect) 
         );
         return;
     };
-    paint_wrap_lines(painter, cylinder, (lo, hi), &s);
+    paint_wrap_lines(painter, cylinder, (lo, hi), rect, &s);
 }
 
 /// A cylinder's unrolled surface: its wrap lines (y = 0, one and two turns around, where the
@@ -109,6 +109,7 @@ fn paint_wrap_lines(
     painter: &Painter,
     cylinder: crate::document::Cylinder,
     (lo, hi): (Pt, Pt),
+    rect: Rect,
     s: &dyn Fn(Pt) -> Pos2,
 ) {
     let around = cylinder.circumference_mm();
@@ -134,8 +135,10 @@ fn paint_wrap_lines(
                 y
             ),
         };
+        // the words stay on the canvas when the view is panned or zoomed past the line's start
+        let at = Pos2::new(line[0].x.max(rect.left()), line[0].y);
         painter.text(
-            line[0] + Vec2::new(2.0, -2.0),
+            at + Vec2::new(2.0, -2.0),
             Align2::LEFT_BOTTOM,
             words,
             FontId::proportional(11.0),
@@ -314,7 +317,7 @@ fn paint_field_labels(painter: &Painter, c: &Canvas<'_>, view: &View, rect: Rect
             numbers.get_or_insert_with(|| super::words::field_numbers(c.fields, c.visiting));
         let number = numbers.get(&f.id).copied().unwrap_or_default();
         // a scan field shows its number; a region larger than the scan field says so
-        let name = match super::words::field_word(f, &c.profile) {
+        let name = match c.field_word(f) {
             "field" => format!("{number}"),
             word => format!("{word} {number}"),
         };

@@ -33,6 +33,10 @@ pub fn count(n: usize, one: &str, many: &str) -> String {
     format!("{n} {}", if n == 1 { one } else { many })
 }
 
+/// What to do on a machine that turns the part instead of moving it in Y.
+pub const CYLINDER_ADVICE: &str = "this machine turns the part on its A axis instead of moving \
+    it in Y: give the part's diameter in the Cylinder section to mark around it";
+
 /// A pipeline error in the GUI's words: the message, then what the operator can do, naming
 /// the controls that do it.
 pub fn gui_error(e: &crate::pipeline::PipelineError) -> String {
@@ -45,6 +49,7 @@ pub fn gui_error(e: &crate::pipeline::PipelineError) -> String {
         Some(Remedy::Place) => format!(
             "{e}; choose \"Placement: centred\" in the Layers panel to move it within reach"
         ),
+        Some(Remedy::Cylinder) => format!("{e}; {CYLINDER_ADVICE}"),
         None => e.to_string(),
     }
 }

@@ -625,6 +625,10 @@ fn hint(e: &anyhow::Error) -> Option<&'static str> {
             "use --split-oversize to cut them at field borders, or --motion auto or on-the-fly"
         }
         Remedy::Place => "use --place centre or --place corner:X,Y",
+        Remedy::Cylinder => {
+            "the machine turns the part on its A axis instead of moving it in Y: use --cylinder \
+             DIAMETER_MM to mark around it"
+        }
     })
 }
 

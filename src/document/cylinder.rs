@@ -39,7 +39,7 @@ pub enum CylinderError {
     #[error("a cylinder job needs the scanner's depth of focus ([scanner] depth_of_focus_mm) in the machine '{0}'")]
     NoDepthOfFocus(String),
     /// A drawing taller than the circumference.
-    #[error("the drawing is {height:.2} mm high around the cylinder, more than its circumference {circumference:.2} mm (⌀{diameter} mm)")]
+    #[error("the drawing spans {height:.2} mm around the cylinder, more than its circumference {circumference:.2} mm (⌀{diameter} mm): it would overlap itself")]
     TooTall {
         /// The drawing's height (its y extent), mm.
         height: f64,
@@ -322,7 +322,7 @@ mod tests {
         let words = |e: CylinderError| e.to_string();
         let e = words(c.check(&rotary, 130.0).unwrap_err());
         assert!(
-            e.contains("130.00 mm high") && e.contains("circumference 125.66 mm"),
+            e.contains("spans 130.00 mm around") && e.contains("circumference 125.66 mm"),
             "{e}"
         );
         let e = words(c.check(&MachineProfile::default(), 10.0).unwrap_err());
