@@ -341,6 +341,19 @@ pub fn plan_document_lowered(
     made
 }
 
+/// Why auto planned one motion only, said like the whole-or-cut choice: the last solve's note
+/// replaces the one before.
+fn motion_notes(doc: &mut Document, plan: &Plan) {
+    doc.warnings.retain(|w| {
+        !w.message.starts_with(crate::order::FLY_NOT_PLANNED)
+            && !w.message.starts_with(crate::order::LINUXCNC_OTF_NOTE)
+            && !w.message.starts_with(crate::order::STREAMED_NOTE)
+    });
+    if let Some(note) = &plan.metrics.motion_note {
+        doc.warnings.push(choice_warning(note.clone()));
+    }
+}
+
 /// [`plan_document_lowered`] on a cylinder: the strips placed on the work profile
 /// ([`cylinder::with_work_profile`]), then ordered and lowered on the machine.
 fn plan_cylinder(doc: &mut Document, ctx: &JobCtx) -> Result<(Plan, Toolpath), PipelineError> {
@@ -352,6 +365,7 @@ fn plan_cylinder(doc: &mut Document, ctx: &JobCtx) -> Result<(Plan, Toolpath), P
     })?;
     let fields_s = (t0.elapsed().as_secs_f64() - hatch_s).max(0.0);
     let (mut plan, toolpath) = order_document_lowered(doc, ctx)?;
+    motion_notes(doc, &plan);
     plan.metrics.solve_s.hatch = hatch_s;
     plan.metrics.solve_s.fields = fields_s;
     plan.metrics.fields_lower_bound = Some(lower_bound);
@@ -378,15 +392,7 @@ fn plan_step_or_auto(doc: &mut Document, ctx: &JobCtx) -> Result<(Plan, Toolpath
     plan.metrics.solve_s.hatch = hatch_s;
     plan.metrics.solve_s.fields = fields_s;
     plan.metrics.fields_lower_bound = Some(lower_bound);
-    // why auto planned one motion only, said like the whole-or-cut choice (the last solve's)
-    doc.warnings.retain(|w| {
-        !w.message.starts_with(crate::order::FLY_NOT_PLANNED)
-            && !w.message.starts_with(crate::order::LINUXCNC_OTF_NOTE)
-            && !w.message.starts_with(crate::order::STREAMED_NOTE)
-    });
-    if let Some(note) = &plan.metrics.motion_note {
-        doc.warnings.push(choice_warning(note.clone()));
-    }
+    motion_notes(doc, &plan);
     if doc.geometries.iter().any(|g| g.pass > 0) {
         compare_unshifted(doc, &mut plan, &toolpath, ctx)?;
     }
@@ -504,7 +510,9 @@ pub fn derive_geometries(doc: &mut Document, ctx: &JobCtx) -> Result<f64, Pipeli
             .collect();
     }
     sync_layers(&mut doc.layers, &doc.artwork, &doc.settings.default_pen());
-    let key = DerivedKey::of(&doc.layers, doc.profile.field_mm, doc.tiling_set.as_ref());
+    // fills fit the fields they are placed in: on a cylinder its strips
+    let field_mm = doc.reach_profile().field_mm;
+    let key = DerivedKey::of(&doc.layers, field_mm, doc.tiling_set.as_ref());
     if doc.derived_with.as_ref() == Some(&key) {
         return Ok(0.0);
     }
@@ -520,7 +528,7 @@ pub fn derive_geometries(doc: &mut Document, ctx: &JobCtx) -> Result<f64, Pipeli
     let (tiling, cut) = cut_hatch_at_tiling(
         made.geometries,
         &doc.layers,
-        doc.profile.field_mm,
+        field_mm,
         doc.tiling_set.as_ref(),
     );
     doc.tiling = tiling;

@@ -131,6 +131,11 @@ fn marks_land_on_the_drawing(svg: &std::path::Path, diameter: f64) {
         .doc;
     let (plan, toolpath) = plan_document_lowered(&mut doc, &JobCtx::default()).unwrap();
     assert!(plan.fields.len() > 3, "{} strips", plan.fields.len());
+    // the geometries were made for the strips: made again from outside the solve (the GUI's
+    // layer edits), nothing changes
+    let fields = doc.fields.clone();
+    let again = galvoplan::pipeline::derive_geometries(&mut doc, &JobCtx::default()).unwrap();
+    assert_eq!((again, &doc.fields), (0.0, &fields));
     let gcode = galvoplan::export::write_gcode(&toolpath, &plan, doc.page_mm[1], "t").unwrap();
     let c = Cylinder {
         diameter_mm: diameter,

@@ -151,7 +151,7 @@ pub fn apply(doc: &mut Document, cmd: &Command) -> Result<Outcome, String> {
             if doc.derived_with.as_ref()
                 != Some(&DerivedKey::of(
                     layers,
-                    doc.profile.field_mm,
+                    doc.reach_profile().field_mm,
                     doc.tiling_set.as_ref(),
                 ))
             {

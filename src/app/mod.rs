@@ -524,7 +524,7 @@ impl App {
         }
         if Some(DerivedKey::of(
             &layers,
-            self.session.doc().profile.field_mm,
+            self.session.doc().reach_profile().field_mm,
             self.session.doc().tiling_set.as_ref(),
         )) == self.session.doc().derived_with
         {

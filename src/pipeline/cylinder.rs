@@ -35,10 +35,10 @@ pub(super) fn setup(doc: &Document) -> Result<Option<(Cylinder, f64)>, PipelineE
     Ok(Some((cylinder, strip)))
 }
 
-/// Runs `f` on the document with the profile its fields are made for: on a cylinder the work
-/// profile ([`Cylinder::work_profile`]), cutting what is larger than a strip at the strips'
-/// borders, step-and-scan; the machine's profile and the settings come back afterwards, and
-/// the fields get their strips' poses ([`pose_strips`]).
+/// Runs `f` on the document with the profile its fields are made for: on a cylinder, a flat
+/// job on the work profile ([`Cylinder::work_profile`]) that cuts what is larger than a strip
+/// at the strips' borders, step-and-scan; the machine's profile and the settings come back
+/// afterwards, and the fields get their strips' poses ([`pose_strips`]).
 pub(super) fn with_work_profile<T>(
     doc: &mut Document,
     f: impl FnOnce(&mut Document) -> Result<T, PipelineError>,
@@ -51,6 +51,8 @@ pub(super) fn with_work_profile<T>(
     let settings = doc.settings.clone();
     doc.settings.split_oversize = true;
     doc.settings.motion = MotionMode::Step;
+    // the work profile is the cylinder's already (`Document::reach_profile` is not applied twice)
+    doc.settings.cylinder = None;
     let out = f(doc);
     doc.profile = machine;
     doc.settings = settings;
