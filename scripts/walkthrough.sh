@@ -10,7 +10,7 @@
 # Environment (all optional):
 #   OUT          folder for the screenshots, steps.txt and app.log (default
 #                /tmp/galvoplan-walkthrough; its old PNGs are removed first)
-#   STEPS        which sections to replay (default "oversize texture isw dxf")
+#   STEPS        which sections to replay (default "oversize texture isw dxf cylinder")
 #   SHARED       the shared bench folder (default ../shared/bench beside the repository);
 #                a section whose files are missing is skipped, and steps.txt says so
 #   DISPLAY_NUM  the X display number for this script's Xvfb (default 77; must be free)
@@ -25,6 +25,10 @@
 #   isw       SHARED/instances/ISW-1017.svg: Run HHA (step-and-scan), Motion "On the fly",
 #             Run HHA again (motion plots); Compare; both again in 1500 x 1000 and 1280 x 720
 #   dxf       tests/data/dxf/entities-inch.dxf (layers CUT, ENGRAVE, BLOCKS, 0): layer colours
+#   cylinder  assets/examples/sleeve.svg (a tube's unrolled surface) on the built-in rotary
+#             machine: its advice; Cylinder diameter 40 mm (strips, wrap lines), F; Run HHA
+#             (motion plots with X and A); the Time slider mid-job (strip, spot, "A …°");
+#             diameter 30 mm, too small for the drawing: its words and the disabled Run HHA
 # Each section starts a fresh GUI session (its own empty HOME: no stored preferences).
 #
 # Every coordinate below is a control in the default layout of a 1600 x 1000 window at egui's
@@ -34,7 +38,7 @@ set -euo pipefail
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 BIN=${1:-${CARGO_TARGET_DIR:-$HOME/.cache/galvoplan-target}/release/galvoplan}
 OUT=${OUT:-/tmp/galvoplan-walkthrough}
-STEPS=${STEPS:-oversize texture isw dxf}
+STEPS=${STEPS:-oversize texture isw dxf cylinder}
 SHARED=$(realpath -m "${SHARED:-$ROOT/../shared/bench}")
 DISPLAY_NUM=${DISPLAY_NUM:-77}
 W=1600 H=1000                # the screen, and the window's size unless a step resizes it
@@ -57,10 +61,14 @@ BIN=$(realpath "$BIN")
 # --- the layout: screen positions (px) of controls in a 1600 x 1000 window -------------------
 TAB_SOLVER="136 62"          # left panel tabs: "Solver settings"
 TAB_PROFILE="248 62"         #   "Machine profile"
-MOTION_COMBO="115 162"       # Solver settings: the "Motion" combo box
-MOTION_OTF="185 236"         #   its open list: "On the fly (stage moves while marking)"
-SPLIT_OVERSIZE="15 232"      # Solver settings: "Split oversize geometries (on re-place)"
-LOAD_TOML="55 177"           # Machine profile: "Load TOML…" (below the machine's two-line name)
+TAB_CYLINDER="39 85"         #   "Cylinder" (the fifth tab, wrapped to a second row)
+MOTION_COMBO="115 186"       # Solver settings: the "Motion" combo box
+MOTION_OTF="185 260"         #   its open list: "On the fly (stage moves while marking)"
+SPLIT_OVERSIZE="15 255"      # Solver settings: "Split oversize geometries (on re-place)"
+LOAD_TOML="55 200"           # Machine profile: "Load TOML…" (below the machine's two-line name)
+MACHINE_COMBO="205 123"      # Machine profile: the "Machine" combo box
+MACHINE_ROTARY="255 250"     #   its open list: "Rotary machine: 300 mm X stage, A axis under it, …"
+CYL_DIAMETER="196 216"       # Cylinder: the "Cylinder diameter (mm)" field
 BTN_REPLACE="617 37"         # toolbar: "Re-place automatically"
 BTN_RUN_HHA="745 37"         # toolbar: "Run HHA" (it has no keyboard shortcut)
 BTN_WORKBENCH="1090 37"      # toolbar: the "Workbench" tab
@@ -68,6 +76,8 @@ BTN_COMPARE="1174 37"        # toolbar: the "Compare" tab
 BTN_FIT_VIEW="889 68"        # Compare tab, its top row: "Fit view" (with two plans A and B)
 PROMPT_PATH="790 519"        # the path field of the in-window "Load a machine profile" prompt
 BTN_CANCEL="186 987"         # status bar while a job runs: "Cancel" (right of the progress bar)
+TIME_SLIDER="699 68"         # playback row above the canvas: the Time slider's handle at t = 0
+TIME_MID="880 68"            #   the same slider about half way along (mid-job)
 CANVAS="820 520"             # the middle of the work-area canvas
 AWAY="1450 960"              # the right panel's empty bottom: no hover tooltip
 
@@ -214,7 +224,7 @@ oversize() {
   click "$SPLIT_OVERSIZE"
   click "$BTN_REPLACE"
   wait_quiet 30
-  click "1333 176"             # right panel: the "Warnings (n)" header, opened
+  click "1333 192"             # right panel: the "Warnings (n)" header, opened
   away
   shot oversize-replaced "Split oversize geometries ticked, Re-place automatically pressed: fields placed, the large shapes cut at field borders; the Warnings list opened; status bar"
 
@@ -326,8 +336,55 @@ dxf() {
   shot dxf-fit "F pressed: the whole reach with the drawing"
 }
 
+cylinder() {
+  start_gui assets/examples/sleeve.svg
+  click "$TAB_PROFILE"
+  click "$MACHINE_COMBO"
+  click "$MACHINE_ROTARY"
+  wait_quiet 30
+  away
+  shot cylinder-rotary "sleeve.svg (a tube's unrolled surface, 120 x 110 mm) opened; Machine profile > Machine: the built-in rotary machine (A axis): the right panel's advice says the machine turns the part on its A axis and to give the part's diameter in the Cylinder section"
+
+  click "$TAB_CYLINDER"
+  click "$CYL_DIAMETER"        # egui focuses the field; key focuses the window for the typing
+  key ctrl+a
+  xdotool type --delay 10 40
+  key Return
+  wait_quiet 30
+  away
+  shot cylinder-40 "Cylinder tab, diameter 40 + Enter: 'Cylinder ⌀40 mm: strips in focus are 11.35 mm high …' on the left; 25 strips about 70 x 11 mm on the canvas; the dashed blue wrap lines (0°, 1 turn at 125.7 mm); Warnings (1)"
+
+  move "$CANVAS"; key f
+  away
+  shot cylinder-40-fit "F pressed: the whole reach, with the wrap lines at 0°, 1 turn (125.7 mm) and 2 turns (251.3 mm)"
+
+  click "$BTN_RUN_HHA"
+  wait_quiet 60
+  away
+  shot cylinder-hha "Run HHA finished: the plan on the strips, the metrics, the 'Motion plots (axis speeds)' plot under the canvas with X and A"
+
+  # the Time slider's handle from t = 0 to mid-job (each "X Y" is two of drag's four numbers)
+  # shellcheck disable=SC2086
+  drag $TIME_SLIDER $TIME_MID
+  away
+  shot cylinder-playback "Time slider dragged to about half the job: the strip being marked outlined and the laser spot on the drawing, the readout 'marking stroke … stage (…) mm, A …°; laser on', the time line on the motion plot"
+
+  click "$TAB_CYLINDER"
+  click "$CYL_DIAMETER"
+  key ctrl+a
+  xdotool type --delay 10 30
+  key Return
+  wait_quiet 30
+  away
+  shot cylinder-30 "diameter 30 + Enter: 'Cylinder ⌀30 mm cannot be marked: the drawing spans 106.00 mm around the cylinder, more than its circumference 94.25 mm …' on the left, the red status bar; the plan is marked stale"
+
+  move "$BTN_RUN_HHA"
+  sleep 1
+  shot cylinder-hha-disabled "pointer on the disabled Run HHA: its tooltip gives the same reason (the drawing spans 106.00 mm around a 94.25 mm circumference)"
+}
+
 say "$BIN; screenshots in $OUT"
-for section in oversize texture isw dxf; do
+for section in oversize texture isw dxf cylinder; do
   if want "$section"; then
     "$section"
     stop_gui

@@ -513,13 +513,18 @@ impl App {
                 b.width() > fw || b.height() > fh
             })
             .count();
-        let beyond = far - large;
+        // a machine that turns the part instead of moving it in Y: a cylinder is the way, for
+        // the large and the far alike
+        let doc = self.session.doc();
+        let turns = doc.profile.stroke_mm[1] <= 0.0 && doc.settings.cylinder.is_none();
+        let (large, beyond) = if turns {
+            (0, far)
+        } else {
+            (large, far - large)
+        };
         if large > 0 {
             self.oversize_ui(ui, large);
         }
-        // a machine that turns the part instead of moving it in Y: a cylinder is the way
-        let doc = self.session.doc();
-        let turns = doc.profile.stroke_mm[1] <= 0.0 && doc.settings.cylinder.is_none();
         let cylinder = format!(
             "beyond the stage's stroke plus half a field: {}.",
             super::words::CYLINDER_ADVICE

@@ -666,9 +666,16 @@ impl App {
                         .fields
                         .iter()
                         .find_map(|f| doc.profile.check_pose(f.id, &f.pose).err());
+                    // a machine that turns the part with no cylinder given: that is the way
+                    let turns = doc.profile.stroke_mm[1] <= 0.0 && doc.settings.cylinder.is_none();
                     let cover = match (o.uncovered.len(), &pose) {
                         (_, Some(e)) => format!("the job cannot run on this machine: {e}"),
                         (0, None) => "every stroke is in a scan field".to_string(),
+                        (n, None) if turns => format!(
+                            "{} outside every scan field: {}",
+                            count(n, "stroke", "strokes"),
+                            words::CYLINDER_ADVICE
+                        ),
                         (n, None) => format!(
                             "{} outside every scan field: \"Re-place automatically\" places \
                              fields for them",
