@@ -2560,6 +2560,13 @@ fn a_cylinder_job_places_strips_in_focus_and_says_their_height() {
     }
     let plan = solve(&mut h, "Run HHA");
     assert!(plan.metrics.job_time_s.unwrap() > 0.0);
+    // the playback's readout: the stage's X (the machine has no Y) and the part's angle
+    let l = h.state().session.toolpath(0).unwrap().unwrap();
+    let words = galvoplan::app::playback::state_text(l, l.duration_s() / 2.0);
+    assert!(
+        words.contains("; stage X ") && words.contains(", A "),
+        "{words}"
+    );
     // too thin a tube for this drawing: said in words
     set_text(&mut h, "Cylinder diameter (mm)", "30");
     settle(&mut h);

@@ -115,10 +115,14 @@ pub fn state_text(l: &Lowered, t_s: f64) -> String {
             super::words::pose_axes_words(&track.at(t_s), l.pose_axes, 1)
         )
     });
+    // a machine without Y: its stage's X alone
+    let stage = if l.has_y {
+        format!("({:.1}, {:.1})", state.stage.x, state.stage.y)
+    } else {
+        format!("X {:.1}", state.stage.x)
+    };
     format!(
-        "{doing}{how}; stage ({:.1}, {:.1}) mm{pose}; laser {}",
-        state.stage.x,
-        state.stage.y,
+        "{doing}{how}; stage {stage} mm{pose}; laser {}",
         if state.laser { "on" } else { "off" }
     )
 }

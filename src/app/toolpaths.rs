@@ -33,6 +33,8 @@ pub struct Lowered {
     pub rank_by_geometry: Vec<f32>,
     /// A cylinder job seen on its unrolled surface, as the canvas draws it (`None`: flat).
     pub unrolled: Option<Unrolled>,
+    /// The machine moves its stage in Y (a rotary machine without Y turns the part instead).
+    pub has_y: bool,
 }
 
 /// A cylinder job on the unrolled surface: the canvas shows the drawing where it lands, not
@@ -85,6 +87,7 @@ impl Lowered {
             pose_axes,
             rank_by_geometry,
             unrolled: None,
+            has_y: true,
         }
     }
 
@@ -92,6 +95,7 @@ impl Lowered {
     /// surface.
     pub fn of(plan: &Plan, toolpath: Toolpath) -> Self {
         let mut l = Self::new(toolpath);
+        l.has_y = plan.profile.has_y();
         if let Some(cylinder) = plan.settings.cylinder {
             let angle: std::collections::HashMap<usize, f64> =
                 plan.fields.iter().map(|f| (f.id, f.pose.a_deg)).collect();
