@@ -135,11 +135,16 @@ fn paint_wrap_lines(
                 y
             ),
         };
-        // the words stay on the canvas when the view is panned or zoomed past the line's start
+        // the words stay on the canvas when the view is panned or zoomed past the line's start;
+        // the 0° line's above it, the turns' below theirs, where the drawing seldom reaches
         let at = Pos2::new(line[0].x.max(rect.left()), line[0].y);
+        let (offset, align) = match turn {
+            0 => (Vec2::new(2.0, -2.0), Align2::LEFT_BOTTOM),
+            _ => (Vec2::new(2.0, 2.0), Align2::LEFT_TOP),
+        };
         painter.text(
-            at + Vec2::new(2.0, -2.0),
-            Align2::LEFT_BOTTOM,
+            at + offset,
+            align,
             words,
             FontId::proportional(11.0),
             colour,
