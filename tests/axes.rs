@@ -4,15 +4,10 @@
 
 mod common;
 
-use std::path::Path;
-use std::process::{Command, Output};
+use common::{galvoplan, one_line_error};
 
-fn galvoplan(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_galvoplan"))
-        .args(args)
-        .output()
-        .unwrap()
-}
+use std::path::Path;
+use std::process::Output;
 
 fn ok(out: &Output) -> String {
     assert!(
@@ -21,14 +16,6 @@ fn ok(out: &Output) -> String {
         String::from_utf8_lossy(&out.stderr)
     );
     String::from_utf8_lossy(&out.stdout).into_owned()
-}
-
-/// One line on stderr, exit status 1.
-fn one_line_error(out: &Output) -> String {
-    assert!(!out.status.success());
-    let err = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
-    err
 }
 
 /// demo.svg's layout on seed000's 70 mm fields, laid on a cap of radius 200 mm: a stand-in

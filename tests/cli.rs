@@ -3,14 +3,8 @@
 
 mod common;
 
-use std::process::Command;
+use common::galvoplan;
 
-fn galvoplan(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_galvoplan"))
-        .args(args)
-        .output()
-        .unwrap()
-}
 
 #[test]
 fn plan_writes_gcode_report_preview_geometry() {

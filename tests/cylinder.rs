@@ -5,12 +5,13 @@
 
 mod common;
 
+use common::{galvoplan, one_line_error};
+
 use galvoplan::document::{Cylinder, Geometry, MachineProfile, SolverSettings};
 use galvoplan::geom::{point_segment_dist, Pt};
 use galvoplan::import::ImportOptions;
 use galvoplan::job::JobCtx;
 use galvoplan::pipeline::{load_artwork, plan_document_lowered};
-use std::process::{Command, Output};
 
 /// How far a landed mark may lie from the drawing, mm (the acceptance's figure).
 const LAND_TOL_MM: f64 = 0.02;
@@ -250,13 +251,6 @@ fn the_time_order_is_never_slower_than_the_distance_order_on_a_slow_rotary() {
     assert!(t <= d * 1.001, "by time {t} s, by distance {d} s");
 }
 
-fn galvoplan(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_galvoplan"))
-        .args(args)
-        .output()
-        .unwrap()
-}
-
 /// A tray of parts with their serials and a DataMatrix each, hatched, around a cylinder: planned
 /// as on a flat job, every part in the report, every strip posed.
 #[test]
@@ -352,14 +346,6 @@ fn a_saved_cylinder_job_plans_around_its_cylinder() {
             .fold(f64::INFINITY, f64::min);
         assert!(d <= LAND_TOL_MM, "{p:?} lands {d} mm from the drawing");
     }
-}
-
-/// One line on stderr, exit status 1.
-fn one_line_error(out: &Output) -> String {
-    assert!(!out.status.success());
-    let err = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
-    err
 }
 
 #[test]

@@ -10,6 +10,8 @@
 
 mod common;
 
+use common::galvoplan;
+
 use galvoplan::geom::{BBox, Pt};
 use galvoplan::import::{
     import_file, FontSource, HiddenLayers, ImportOptions, Imported, LayerHidden, Place,
@@ -592,13 +594,6 @@ fn placement_auto_keeps_what_is_in_reach_and_centres_the_331_mm_sheet() {
     let corner = sheet(Place::Corner([0.0, 0.0]));
     let b = extent(&corner);
     assert_eq!([b.min_x, b.min_y], [0.0, 0.0]);
-}
-
-fn galvoplan(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_galvoplan"))
-        .args(args)
-        .output()
-        .unwrap()
 }
 
 fn path(p: &Path) -> String {

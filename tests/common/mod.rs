@@ -4,6 +4,22 @@
 use galvoplan::document::{Document, Plan};
 use std::collections::HashSet;
 
+/// Runs the galvoplan binary with `args`.
+pub fn galvoplan(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_galvoplan"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+/// A refusal in one line: exit status not zero, one line on stderr (returned).
+pub fn one_line_error(out: &std::process::Output) -> String {
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    err
+}
+
 /// Repository root.
 pub fn root() -> std::path::PathBuf {
     std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
