@@ -112,3 +112,15 @@ pub fn label_layers(path: &mut Toolpath, geometries: &[Geometry], layers: &[Laye
 
 #[cfg(test)]
 mod tests;
+
+/// The built-in `linuxcnc` profile with a scan head's delays (laser on 0.1 ms, off 0.2 ms,
+/// jump 0.3 ms) and 5 ms of X settling: every pause a LinuxCNC program writes as a dwell.
+#[cfg(test)]
+pub(crate) fn linuxcnc_with_delays() -> crate::document::MachineProfile {
+    let mut profile = crate::document::MachineProfile::builtin("linuxcnc").unwrap();
+    profile.laser.on_delay_s = 1e-4;
+    profile.laser.off_delay_s = 2e-4;
+    profile.laser.jump_delay_s = 3e-4;
+    profile.axis_x.settle_s = 5e-3;
+    profile
+}

@@ -210,11 +210,7 @@ fn on_the_clock_marks_start_and_end_on_ticks() {
 #[test]
 fn linuxcnc_dwells_and_dots_are_timed_by_task_and_written_with_their_own_times() {
     use super::controller::{DWELL_TAIL_S, TASK_CYCLE_RUN_S, TASK_RESUME_S};
-    let mut profile = MachineProfile::builtin("linuxcnc").unwrap();
-    profile.laser.on_delay_s = 1e-4;
-    profile.laser.off_delay_s = 2e-4;
-    profile.laser.jump_delay_s = 3e-4;
-    profile.axis_x.settle_s = 5e-3;
+    let profile = super::linuxcnc_with_delays();
     let dot = |p: Pt| Geometry::new(vec![p], false, Source::default());
     // two dots and a line in one field, a dot in a field 100 mm to the right
     let g = vec![

@@ -368,12 +368,7 @@ mod tests {
     fn the_step_time_on_a_controller_clock_equals_the_lowered_job_time() {
         // LinuxCNC's exact-stop moves, with delays and settling as dwells (merged where
         // adjacent), as the lowering times them
-        let mut profile = MachineProfile::builtin("linuxcnc").unwrap();
-        profile.laser.on_delay_s = 1e-4;
-        profile.laser.off_delay_s = 2e-4;
-        profile.laser.jump_delay_s = 3e-4;
-        profile.axis_x.settle_s = 5e-3;
-        step_time_equals_lowered(&profile);
+        step_time_equals_lowered(&crate::motion::linuxcnc_with_delays());
         step_time_equals_lowered(&MachineProfile::builtin("linuxcnc").unwrap());
     }
 
