@@ -100,18 +100,13 @@ job() { # name svg mode [plan options...]; JOB_PROFILE: another profile than `li
   (cd "$OUT" && /usr/bin/python3 "$ROOT/scripts/linuxcnc_check.py" "$o.ngc" "$o.waypoints.csv" \
     --tol-mm 0.005 >"$o.interp.json" 2>"$o.interp.log")
   sim "$(realpath "$o.ngc")" "$o.sim.json"
-  python3 - "$name" "$mode" "$o" <<'PY' || status=1
+  PYTHONPATH="$ROOT/scripts" python3 - "$name" "$mode" "$o" <<'PY' || status=1
 import json, sys
+from linuxcnc_result import load
 name, mode, o = sys.argv[1:]
 rep = json.load(open(o + ".json"))["metrics"]
-try:
-    interp = json.load(open(o + ".interp.json"))
-except (OSError, ValueError):
-    interp = {"ok": False, "errors": ["the interpreter check did not run"]}
-try:
-    sim = json.load(open(o + ".sim.json"))
-except (OSError, ValueError):
-    sim = {"ok": False, "errors": ["LinuxCNC did not run (see %s.sim.json.log)" % o]}
+interp = load(o + ".interp.json", "the interpreter check did not run")
+sim = load(o + ".sim.json", "LinuxCNC did not run (see %s.sim.json.log)" % o)
 g = rep.get("job_time_s") or 0.0
 marking = (rep.get("job_time_breakdown_s") or {}).get("mark", 0.0)
 lc = sim.get("job_s")
@@ -151,15 +146,11 @@ stream_job() { # name svg
   GALVOPLAN_STREAM="$o.stream" GALVOPLAN_TRACE="$o.trace" sim "$(realpath "$o.ngc")" "$o.sim.json"
   python3 "$ROOT/scripts/linuxcnc_stream_check.py" "$o.stream" "$o.trace" --period-s "$PERIOD_S" \
     >"$o.check.json" 2>"$o.check.log"
-  python3 - "$name" "$o" <<'PY' || status=1
+  PYTHONPATH="$ROOT/scripts" python3 - "$name" "$o" <<'PY' || status=1
 import json, sys
+from linuxcnc_result import load
 name, o = sys.argv[1:]
 rep = json.load(open(o + ".json"))["metrics"]
-def load(path, what):
-    try:
-        return json.load(open(path))
-    except (OSError, ValueError):
-        return {"ok": False, "errors": [what]}
 sim = load(o + ".sim.json", "LinuxCNC did not run (see %s.sim.json.log)" % o)
 chk = load(o + ".check.json", "the trace check did not run (see %s.check.log)" % o)
 ok = bool(sim.get("ok") and chk.get("ok"))
@@ -233,15 +224,11 @@ axes_job() { # name mode builtin input [plan options...]: a job on a built-in ma
   (cd "$OUT" && /usr/bin/python3 "$ROOT/scripts/linuxcnc_check.py" "$o.ngc" "$o.waypoints.csv" \
     --tol-mm 0.005 >"$o.interp.json" 2>"$o.interp.log")
   MACHINE="$machine" sim "$(realpath "$o.ngc")" "$o.sim.json"
-  python3 - "$name" "$mode" "$o" "$machine/galvoplan.ini" <<'PY' || status=1
+  PYTHONPATH="$ROOT/scripts" python3 - "$name" "$mode" "$o" "$machine/galvoplan.ini" <<'PY' || status=1
 import json, re, sys
+from linuxcnc_result import load
 name, mode, o, ini = sys.argv[1:]
 rep = json.load(open(o + ".json"))["metrics"]
-def load(path, what):
-    try:
-        return json.load(open(path))
-    except (OSError, ValueError):
-        return {"ok": False, "errors": [what]}
 interp = load(o + ".interp.json", "the interpreter check did not run (see %s.interp.log)" % o)
 sim = load(o + ".sim.json", "LinuxCNC did not run (see %s.sim.json.log)" % o)
 coords = re.search(r"^COORDINATES = (\S+)", open(ini).read(), re.M)

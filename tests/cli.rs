@@ -5,7 +5,6 @@ mod common;
 
 use common::galvoplan;
 
-
 #[test]
 fn plan_writes_gcode_report_preview_geometry() {
     let dir = tempfile::tempdir().unwrap();

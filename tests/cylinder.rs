@@ -401,7 +401,11 @@ fn bad_cylinder_jobs_say_why_in_one_line() {
     assert!(e.contains("thinner than the"), "{e}");
     // not a diameter
     let e = refused(&sleeve, &["--profile", "rotary", "--cylinder=-3"]);
-    assert!(e.contains("diameter"), "{e}");
+    assert!(
+        e.contains("Cylinder diameter (mm) must be a positive number")
+            && e.contains("(--cylinder)"),
+        "{e}"
+    );
     // on the fly
     let e = refused(
         &sleeve,

@@ -1,6 +1,6 @@
 //! The Cylinder section: the diameter of a cylinder job and what the machine makes of it.
 
-use crate::document::{Cylinder, Document};
+use crate::document::Document;
 
 impl super::App {
     /// The Cylinder section; a changed diameter places the strips again (when idle).
@@ -21,24 +21,27 @@ impl super::App {
 /// The cylinder job in an operator's words: the strips in focus, or why the machine cannot
 /// mark it, or how to start one.
 pub fn cylinder_words(doc: &Document) -> String {
-    let Some(c) = doc.settings.cylinder else {
-        return "A flat job. To mark around a tube, ring or bottle on the rotary A axis, give its \
-                diameter: the drawing is then its unrolled surface, x along the axis and y around \
-                it."
-        .into();
-    };
-    let d = crate::geom::format_mm(c.diameter_mm, 3);
     match crate::pipeline::cylinder_strips(doc) {
-        Ok(strip) => format!(
-            "Cylinder ⌀{d} mm: strips in focus are {strip:.2} mm high (depth of focus {} mm); \
+        Ok(None) => "A flat job. To mark around a tube, ring or bottle on the rotary A axis, give \
+                     its diameter: the drawing is then its unrolled surface, x along the axis and \
+                     y around it."
+            .into(),
+        Ok(Some((c, strip))) => format!(
+            "Cylinder ⌀{} mm: strips in focus are {strip:.2} mm high (depth of focus {} mm); \
              {:.2} mm around. The part turns to each strip's angle; the scanner marks it from \
              above.",
+            crate::geom::format_mm(c.diameter_mm, 3),
             doc.profile
                 .scanner
                 .depth_of_focus_mm
                 .map_or("?".into(), |v| crate::geom::format_mm(v, 3)),
-            Cylinder::circumference_mm(&c),
+            c.circumference_mm(),
         ),
-        Err(why) => format!("Cylinder ⌀{d} mm cannot be marked: {why}"),
+        Err(why) => format!(
+            "Cylinder ⌀{} mm cannot be marked: {why}",
+            doc.settings
+                .cylinder
+                .map_or(String::new(), |c| crate::geom::format_mm(c.diameter_mm, 3))
+        ),
     }
 }

@@ -405,6 +405,7 @@ impl JobOpts {
                 "ga.stall_generations" => " (--ga-stall)",
                 "ga.max_generations" => " (--ga-generations)",
                 "ga.population" => " (--ga-population)",
+                "cylinder.diameter_mm" => " (--cylinder)",
                 _ => "",
             };
             anyhow::anyhow!("invalid settings: {e}{flag}")

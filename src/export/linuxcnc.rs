@@ -297,6 +297,11 @@ M65 P{sel}
     fn step_and_scan(&mut self, toolpath: &Toolpath, plan: &Plan) -> Result<(), GcodeError> {
         self.comment_layers = plan.layers.iter().any(|l| !l.pen.marks_as_profile());
         let mut field = None;
+        // a cylinder's strips by field id: the angle their marks are pre-distorted for
+        let angle: std::collections::HashMap<usize, f64> = match plan.settings.cylinder {
+            Some(_) => plan.fields.iter().map(|f| (f.id, f.pose.a_deg)).collect(),
+            None => Default::default(),
+        };
         // the lowering places stage and scanner at the first stroke's start: move there
         if let (Some(first), Some(&start)) =
             (toolpath.strokes.first(), toolpath.stroke_points(0).first())
@@ -372,12 +377,8 @@ M65 P{sel}
                     self.before_move(true);
                     let around = plan.settings.cylinder.map(|c| {
                         let field = toolpath.strokes.get(stroke).map(|s| s.field);
-                        let a_deg = plan
-                            .fields
-                            .iter()
-                            .find(|f| Some(f.id) == field)
-                            .map_or(0.0, |f| f.pose.a_deg);
-                        (c, a_deg)
+                        let a_deg = field.and_then(|f| angle.get(&f)).copied();
+                        (c, a_deg.unwrap_or(0.0))
                     });
                     for (j, w) in points.windows(2).enumerate() {
                         let words = self.scan_words(w[1].minus(stage));

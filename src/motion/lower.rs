@@ -133,9 +133,13 @@ pub fn lower(
         // each edge at the speed that marks the surface at the pen's
         let a_deg = field.pose.a_deg;
         let scan = cylinder.predistort(&path, a_deg, stage.y, LANDING_TOL_MM);
+        // a path with points stays one (never a stroke dropped without a word)
         let (Some(&start), Some(last)) = (scan.scanner.first(), scan.surface.len().checked_sub(1))
         else {
-            continue;
+            return Err(LowerError::Empty {
+                step: k,
+                geometry: step.geometry,
+            });
         };
         b.go_to(stage, &field.pose, start.minus(stage), k == 0);
         let stroke = b

@@ -7,9 +7,17 @@ use super::PipelineError;
 use crate::document::{Cylinder, CylinderError, Document, MotionMode, ScanField};
 use crate::geom::BBox;
 
-/// The document's cylinder and its strips' height in focus, mm; none on a flat job. Fails with
-/// the job's one-line reason ([`Cylinder::check`]).
+/// [`cylinder_strips`] failing with the document's file.
 pub(super) fn setup(doc: &Document) -> Result<Option<(Cylinder, f64)>, PipelineError> {
+    cylinder_strips(doc).map_err(|source| PipelineError::Cylinder {
+        file: doc.source.clone().unwrap_or_else(|| "document".into()),
+        source,
+    })
+}
+
+/// The document's cylinder and its strips' height in focus, mm; none on a flat job. Fails with
+/// the job's one-line reason ([`Cylinder::check`]; on the fly, which a cylinder is not marked).
+pub fn cylinder_strips(doc: &Document) -> Result<Option<(Cylinder, f64)>, CylinderError> {
     let Some(cylinder) = doc.settings.cylinder else {
         return Ok(None);
     };
@@ -24,14 +32,10 @@ pub(super) fn setup(doc: &Document) -> Result<Option<(Cylinder, f64)>, PipelineE
     } else {
         extent.max_y - extent.min_y
     };
-    let err = |source| PipelineError::Cylinder {
-        file: doc.source.clone().unwrap_or_else(|| "document".into()),
-        source,
-    };
     if doc.settings.motion == MotionMode::OnTheFly {
-        return Err(err(CylinderError::OnTheFly));
+        return Err(CylinderError::OnTheFly);
     }
-    let strip = cylinder.check(&doc.profile, height).map_err(err)?;
+    let strip = cylinder.check(&doc.profile, height)?;
     Ok(Some((cylinder, strip)))
 }
 
@@ -128,15 +132,4 @@ pub(super) fn job_fields(doc: &Document) -> Result<Option<Vec<ScanField>>, Pipel
         ..f.clone()
     });
     Ok(Some(flat.collect()))
-}
-
-/// The height of the document's cylinder strips in focus, mm, or why the cylinder job cannot be
-/// made (its one-line reason, without the file); a flat job has none (0).
-pub fn cylinder_strips(doc: &Document) -> Result<f64, CylinderError> {
-    match setup(doc) {
-        Ok(Some((_, strip))) => Ok(strip),
-        Ok(None) => Ok(0.0),
-        Err(PipelineError::Cylinder { source, .. }) => Err(source),
-        Err(_) => Ok(0.0),
-    }
 }
