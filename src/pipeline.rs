@@ -23,7 +23,7 @@ use std::time::Instant;
 use thiserror::Error;
 
 mod cylinder;
-pub use cylinder::cylinder_strips;
+pub use cylinder::{cylinder_strips, Strips};
 
 /// A pipeline failure; the message names the file where one is involved.
 #[derive(Debug, Error)]

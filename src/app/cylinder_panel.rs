@@ -5,7 +5,7 @@ use crate::document::Document;
 impl super::App {
     /// The Cylinder section; a changed diameter places the strips again (when idle).
     pub(super) fn cylinder_ui(&mut self, ui: &mut egui::Ui) {
-        let words = cylinder_words(self.session.doc());
+        let words = cylinder_words(self.session.doc(), &self.session.strips());
         let settings = self.session.doc().settings.clone();
         let Some(cmd) = self.panels.editors.cylinder_ui(ui, &settings, &words) else {
             return;
@@ -18,10 +18,11 @@ impl super::App {
     }
 }
 
-/// The cylinder job in an operator's words: the strips in focus, or why the machine cannot
-/// mark it, or how to start one.
-pub fn cylinder_words(doc: &Document) -> String {
-    match crate::pipeline::cylinder_strips(doc) {
+/// The cylinder job in an operator's words: the strips in focus (`strips`, as
+/// [`crate::pipeline::cylinder_strips`] found them), or why the machine cannot mark it, or how
+/// to start one.
+pub fn cylinder_words(doc: &Document, strips: &crate::pipeline::Strips) -> String {
+    match strips {
         Ok(None) => "A flat job. To mark around a tube, ring or bottle on the rotary A axis, give \
                      its diameter: the drawing is then its unrolled surface, x along the axis and \
                      y around it."

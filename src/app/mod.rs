@@ -883,7 +883,7 @@ impl App {
                 1 => "1 stroke is not covered by a scan field".to_string(),
                 n => format!("{n} strokes are not covered by a scan field"),
             })
-        } else if let Err(e) = crate::pipeline::cylinder_strips(self.session.doc()) {
+        } else if let Err(e) = self.session.strips() {
             // a cylinder the machine or the drawing cannot make
             Some(e.to_string())
         } else {

@@ -35,6 +35,11 @@ pub struct Session {
     layer_counts: Vec<(usize, usize)>,
     /// Closed geometries (counted once per change, not every frame).
     closed: usize,
+    /// The cylinder job's strips in focus (cylinder, height mm), none on a flat job, or why it
+    /// cannot be made (checked once per change: the solve buttons and the Cylinder section
+    /// read it every frame).
+    /// (None until the first refresh: a flat job.)
+    strips: Option<crate::pipeline::Strips>,
     /// Per plan, what changed since it was planned, in words (empty: current).
     stale: Vec<Vec<String>>,
     /// A problem with the open document (e.g. fields could not be placed).
@@ -81,6 +86,12 @@ impl Session {
     /// Geometries no field holds.
     pub fn uncovered(&self) -> &[usize] {
         &self.uncovered
+    }
+
+    /// The cylinder job's strips in focus, or why it cannot be made
+    /// ([`crate::pipeline::cylinder_strips`], as of the last change).
+    pub fn strips(&self) -> crate::pipeline::Strips {
+        self.strips.clone().unwrap_or(Ok(None))
     }
     /// Uncovered geometries no scan field can ever hold.
     pub fn out_of_reach(&self) -> &[usize] {
@@ -334,8 +345,9 @@ impl Session {
             .uncovered
             .iter()
             .copied()
-            .filter(|&k| !can_be_covered(&self.doc.geometries[k], &self.doc.profile))
+            .filter(|&k| !can_be_covered(&self.doc.geometries[k], &self.doc.reach_profile()))
             .collect();
+        self.strips = Some(crate::pipeline::cylinder_strips(&self.doc));
         self.layer_counts = layer_counts(&self.doc);
         self.closed = self.doc.geometries.iter().filter(|g| g.closed).count();
         self.can_reimport = super::files::can_reimport(&self.doc);

@@ -7,6 +7,10 @@ use super::PipelineError;
 use crate::document::{Cylinder, CylinderError, Document, MotionMode, ScanField};
 use crate::geom::BBox;
 
+/// A document's cylinder job as [`cylinder_strips`] finds it: the cylinder and its strips'
+/// height in focus (mm), none on a flat job, or why it cannot be made.
+pub type Strips = Result<Option<(Cylinder, f64)>, CylinderError>;
+
 /// [`cylinder_strips`] failing with the document's file.
 pub(super) fn setup(doc: &Document) -> Result<Option<(Cylinder, f64)>, PipelineError> {
     cylinder_strips(doc).map_err(|source| PipelineError::Cylinder {
@@ -17,7 +21,7 @@ pub(super) fn setup(doc: &Document) -> Result<Option<(Cylinder, f64)>, PipelineE
 
 /// The document's cylinder and its strips' height in focus, mm; none on a flat job. Fails with
 /// the job's one-line reason ([`Cylinder::check`]; on the fly, which a cylinder is not marked).
-pub fn cylinder_strips(doc: &Document) -> Result<Option<(Cylinder, f64)>, CylinderError> {
+pub fn cylinder_strips(doc: &Document) -> Strips {
     let Some(cylinder) = doc.settings.cylinder else {
         return Ok(None);
     };
